@@ -1,0 +1,10 @@
+// `qvr control`: run a fovea-sizing policy over a workload (placeholder until the controller
+// lands in this same change).
+#include "commands.h"
+
+namespace qvr::cli {
+Registered registerControl(CLI::App& app) {
+    CLI::App* cmd = app.add_subcommand("control", "Run a fovea-sizing policy over a workload");
+    return {cmd, [] { return 1; }};
+}
+}  // namespace qvr::cli

@@ -1,0 +1,37 @@
+// qvr: collaborative foveated rendering for mobile VR (Q-VR, ASPLOS '21) — one command with
+// subcommands. Start-up parsing may throw; main turns every failure into a message and a
+// non-zero exit (STYLE.md §5).
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{
+        "qvr — collaborative foveated rendering for mobile VR (Q-VR, ASPLOS '21).\n"
+        "The headset renders the fovea, a server renders the periphery at the resolution human\n"
+        "acuity allows, and a learned controller (LIWC) sizes the fovea every frame."};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "qvr 0.1.0");
+    std::vector<qvr::cli::Registered> commands;
+    commands.push_back(qvr::cli::registerPlan(app));
+    commands.push_back(qvr::cli::registerControl(app));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
+    }
+    try {
+        for (auto& c : commands) {
+            if (c.command->parsed()) return c.action();
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "qvr: error: %s\n", e.what());
+        return 1;
+    }
+    return 2;
+}

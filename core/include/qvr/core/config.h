@@ -1,0 +1,48 @@
+// Config loading: TOML through toml++, with every value range-checked and every unknown key
+// reported, so a typo in a profile is an error rather than a silently ignored setting.
+#pragma once
+
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+
+#include <toml++/toml.h>
+
+#include "qvr/core/expected.h"
+
+namespace qvr {
+
+Expected<toml::table> parseTomlText(std::string_view text, std::string_view source_name);
+Expected<toml::table> loadTomlFile(const std::string& path);
+// Reads a whole file, refusing files larger than max_bytes.
+Expected<std::string> readTextFile(const std::string& path, size_t max_bytes = size_t{1} << 20);
+
+// Reads typed values out of one table. Errors accumulate; check ok() once at the end so a user
+// sees every problem of a file in one message.
+class ConfigReader {
+public:
+    ConfigReader(const toml::table& table, std::string source_name);
+
+    // A number at a dotted path ("display.width_px"), within [min_value, max_value]. Returns the
+    // default when absent; records an error when present but of the wrong type or out of range.
+    double number(std::string_view path, double default_value, double min_value,
+                  double max_value);
+    int integer(std::string_view path, int default_value, int min_value, int max_value);
+    std::string string(std::string_view path, std::string default_value);
+    bool has(std::string_view path) const;
+
+    // Fails if the file holds keys that nothing asked for.
+    Status finish();
+
+private:
+    void fail(std::string message);
+    void markUsed(std::string_view path);
+
+    const toml::table& m_table;
+    std::string m_source;
+    std::string m_errors;
+    std::set<std::string> m_used;
+};
+
+}  // namespace qvr

@@ -1,0 +1,130 @@
+// TOML config reading with range checks and unknown-key detection.
+#include "qvr/core/config.h"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <fmt/format.h>
+
+namespace qvr {
+
+Expected<toml::table> parseTomlText(std::string_view text, std::string_view source_name) {
+    try {
+        return toml::parse(text, source_name);
+    } catch (const toml::parse_error& e) {
+        const auto& where = e.source().begin;
+        return makeError(fmt::format("{}:{}:{}: {}", source_name, where.line, where.column,
+                                     e.description()));
+    }
+}
+
+Expected<std::string> readTextFile(const std::string& path, size_t max_bytes) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return makeError(fmt::format("cannot open '{}'", path));
+    std::string text;
+    char buf[65536];
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+        text.append(buf, static_cast<size_t>(in.gcount()));
+        if (text.size() > max_bytes)
+            return makeError(fmt::format("'{}' is larger than {} bytes", path, max_bytes));
+    }
+    if (in.bad()) return makeError(fmt::format("error reading '{}'", path));
+    return text;
+}
+
+Expected<toml::table> loadTomlFile(const std::string& path) {
+    auto text = readTextFile(path);
+    if (!text) return makeError(text.error());
+    return parseTomlText(*text, path);
+}
+
+ConfigReader::ConfigReader(const toml::table& table, std::string source_name)
+    : m_table(table), m_source(std::move(source_name)) {}
+
+void ConfigReader::fail(std::string message) {
+    if (!m_errors.empty()) m_errors += "\n";
+    m_errors += fmt::format("{}: {}", m_source, message);
+}
+
+void ConfigReader::markUsed(std::string_view path) {
+    // Mark the key and all its parent tables as known.
+    std::string p(path);
+    while (true) {
+        m_used.insert(p);
+        const auto dot = p.rfind('.');
+        if (dot == std::string::npos) break;
+        p.resize(dot);
+    }
+}
+
+bool ConfigReader::has(std::string_view path) const {
+    return static_cast<bool>(m_table.at_path(path).node());
+}
+
+double ConfigReader::number(std::string_view path, double default_value, double min_value,
+                            double max_value) {
+    markUsed(path);
+    const auto node = m_table.at_path(path);
+    if (!node) return default_value;
+    std::optional<double> v = node.value<double>();
+    if (!v || !(node.is_floating_point() || node.is_integer())) {
+        fail(fmt::format("'{}' must be a number", path));
+        return default_value;
+    }
+    if (!std::isfinite(*v) || *v < min_value || *v > max_value) {
+        fail(fmt::format("'{}' = {} is outside [{}, {}]", path, *v, min_value, max_value));
+        return default_value;
+    }
+    return *v;
+}
+
+int ConfigReader::integer(std::string_view path, int default_value, int min_value,
+                          int max_value) {
+    markUsed(path);
+    const auto node = m_table.at_path(path);
+    if (!node) return default_value;
+    if (!node.is_integer()) {
+        fail(fmt::format("'{}' must be an integer", path));
+        return default_value;
+    }
+    const int64_t v = *node.value<int64_t>();
+    if (v < min_value || v > max_value) {
+        fail(fmt::format("'{}' = {} is outside [{}, {}]", path, v, min_value, max_value));
+        return default_value;
+    }
+    return static_cast<int>(v);
+}
+
+std::string ConfigReader::string(std::string_view path, std::string default_value) {
+    markUsed(path);
+    const auto node = m_table.at_path(path);
+    if (!node) return default_value;
+    if (!node.is_string()) {
+        fail(fmt::format("'{}' must be a string", path));
+        return default_value;
+    }
+    return *node.value<std::string>();
+}
+
+Status ConfigReader::finish() {
+    // Walk every key of the file; anything not asked for is unknown.
+    std::function<void(const toml::table&, const std::string&)> walk =
+        [&](const toml::table& t, const std::string& prefix) {
+            for (const auto& [k, v] : t) {
+                const std::string key = prefix.empty() ? std::string(k.str())
+                                                       : prefix + "." + std::string(k.str());
+                if (!m_used.count(key)) {
+                    fail(fmt::format("unknown key '{}'", key));
+                    continue;
+                }
+                if (const auto* sub = v.as_table()) walk(*sub, key);
+            }
+        };
+    walk(m_table, "");
+    if (m_errors.empty()) return Status::success();
+    return makeError(m_errors);
+}
+
+}  // namespace qvr

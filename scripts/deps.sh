@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs the Debian packages qvr needs, only those missing. Sourced by setup.sh and test.sh.
+# The list is the single place a new dependency is added.
+set -euo pipefail
+
+QVR_PACKAGES=(
+    build-essential cmake ninja-build pkg-config git
+    libfmt-dev libspdlog-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libglm-dev
+    libtbb-dev libhwy-dev
+    libgtest-dev libgmock-dev libbenchmark-dev
+    gnuplot-nox
+)
+
+qvr_install_deps() {
+    local missing=()
+    for p in "${QVR_PACKAGES[@]}"; do
+        if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+            missing+=("$p")
+        fi
+    done
+    if [ ${#missing[@]} -eq 0 ]; then
+        echo "qvr: all ${#QVR_PACKAGES[@]} Debian packages present"
+        return 0
+    fi
+    echo "qvr: installing ${missing[*]}"
+    local sudo=()
+    if [ "$(id -u)" -ne 0 ]; then sudo=(sudo); fi
+    "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+    "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+        "${missing[@]}"
+}
