@@ -3,8 +3,10 @@
 #include "commands.h"
 
 namespace qvr::cli {
-Registered registerControl(CLI::App& app) {
+static Registered registerControl(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("control", "Run a fovea-sizing policy over a workload");
     return {cmd, [] { return 1; }};
 }
+QVR_REGISTER_COMMAND(30, registerControl);
+
 }  // namespace qvr::cli

@@ -67,7 +67,7 @@ nlohmann::json planJson(const LayerPlan& p, const HmdProfile& profile) {
     return j;
 }
 
-Registered registerPlan(CLI::App& app) {
+static Registered registerPlan(CLI::App& app) {
     auto opts = std::make_shared<PlanOptions>();
     CLI::App* cmd = app.add_subcommand("plan", "Print the layer plan (Eq. 1) for a fovea radius");
     cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees of eccentricity")
@@ -119,5 +119,7 @@ Registered registerPlan(CLI::App& app) {
     };
     return {cmd, action};
 }
+
+QVR_REGISTER_COMMAND(20, registerPlan);
 
 }  // namespace qvr::cli

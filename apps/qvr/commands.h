@@ -1,9 +1,9 @@
-// Subcommand registration for the `qvr` command: each cmd_<name>.cpp defines one register
-// function that adds its subcommand and options to the CLI11 app and returns the action to run.
+// Subcommand registration for the `qvr` command. Each cmd_<name>.cpp defines a function that
+// adds its subcommand to the CLI11 app and returns the action to run, and registers it with
+// QVR_REGISTER_COMMAND; main.cpp needs no edit when a part adds a command.
 #pragma once
 
 #include <functional>
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,8 +11,8 @@
 
 namespace qvr::cli {
 
-// An action returns the process exit code. Bad input is reported on stderr with exit code 2;
-// runtime failures with 1.
+// An action returns the process exit code: 0 on success, 1 on a runtime failure, 2 on bad
+// input (malformed options, files or traces), with a message on stderr.
 using Action = std::function<int()>;
 
 struct Registered {
@@ -20,7 +20,25 @@ struct Registered {
     Action action;
 };
 
-Registered registerPlan(CLI::App& app);
-Registered registerControl(CLI::App& app);
+using RegisterFn = Registered (*)(CLI::App& app);
+
+struct CommandEntry {
+    int order;  // help lists commands in this order
+    RegisterFn fn;
+};
+
+inline std::vector<CommandEntry>& commandRegistry() {
+    static std::vector<CommandEntry> registry;
+    return registry;
+}
+
+inline bool addCommand(int order, RegisterFn fn) {
+    commandRegistry().push_back({order, fn});
+    return true;
+}
 
 }  // namespace qvr::cli
+
+// Use inside namespace qvr::cli, after the register function.
+#define QVR_REGISTER_COMMAND(order, fn) \
+    [[maybe_unused]] static const bool qvr_registered_##fn = addCommand(order, &fn)

@@ -1,6 +1,7 @@
 // qvr: collaborative foveated rendering for mobile VR (Q-VR, ASPLOS '21) — one command with
 // subcommands. Start-up parsing may throw; main turns every failure into a message and a
 // non-zero exit (STYLE.md §5).
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <vector>
@@ -17,9 +18,11 @@ int main(int argc, char** argv) {
         "acuity allows, and a learned controller (LIWC) sizes the fovea every frame."};
     app.require_subcommand(1);
     app.set_version_flag("--version", "qvr 0.1.0");
+    auto entries = qvr::cli::commandRegistry();
+    std::sort(entries.begin(), entries.end(),
+              [](const auto& a, const auto& b) { return a.order < b.order; });
     std::vector<qvr::cli::Registered> commands;
-    commands.push_back(qvr::cli::registerPlan(app));
-    commands.push_back(qvr::cli::registerControl(app));
+    for (const auto& e : entries) commands.push_back(e.fn(app));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
