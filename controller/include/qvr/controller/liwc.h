@@ -1,0 +1,85 @@
+// LIWC, the Lightweight Interaction-Aware Workload Controller (paper §4.1, Eq. 2). Each frame:
+// encode the motion, predict T_local and T_remote for the delta tags −5…+5° around the current
+// e1 from the frame's triangles in the fovea cone and the periphery's predicted bytes, add the
+// table's learned offset for (motion, eccentricity), and take the tag that best cancels the
+// imbalance. After the frame, fold the measured error into the table and refresh the GPU-rate
+// and throughput estimates. Choices where §4.1 is vague: docs/LIWC.md.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include "qvr/controller/liwc_table.h"
+#include "qvr/controller/motion_codec.h"
+#include "qvr/controller/policy.h"
+#include "qvr/controller/remote_size_table.h"
+
+namespace qvr {
+
+struct LiwcConfig {
+    double e1_initial_deg = 5.0;
+    double e1_min_deg = 1.0;
+    double e1_max_deg = 90.0;
+    int max_delta_deg = 5;      // delta tags −5…+5
+    bool interpolate = true;    // refine between the two tags that bracket the balance point
+    float alpha = 0.3f;         // the table's reward parameter α
+    double rate_ema = 0.5;      // weight of a new measurement in the GPU-rate/throughput/bits estimates
+    MotionThresholds motion;
+    // Cold-start estimates, before anything is measured.
+    double gpu_triangles_per_ms_initial = 50'000.0;
+    double throughput_bps_initial = 200e6;
+    double bits_per_pixel_initial = 1.0;
+    double bits_scale_exponent_initial = 0.7;
+};
+
+struct LiwcCandidate {
+    int delta_deg = 0;
+    double e1_deg = 0.0;
+    double t_local_pred_ms = 0.0;
+    double t_remote_pred_ms = 0.0;
+    double offset_ms = 0.0;
+    double imbalanceMs() const { return t_remote_pred_ms - t_local_pred_ms + offset_ms; }
+};
+
+class LiwcPolicy final : public FoveaPolicy {
+public:
+    LiwcPolicy(const WorkloadHeader& header, LiwcConfig config = {});
+
+    std::string_view name() const override { return "liwc"; }
+    Decision decide(const WorkloadFrame& frame) override;
+    void observe(const FrameMeasurement& m) override;
+
+    // Eq. 2 with the current estimates, without the table's offset.
+    double predictLocalMs(const WorkloadFrame& frame, double e1_deg) const;
+    double predictRemoteMs(const WorkloadFrame& frame, double e1_deg) const;
+
+    const LiwcTable& table() const { return m_table; }
+    LiwcTable& table() { return m_table; }
+    double gpuTrianglesPerMs() const { return m_gpu_triangles_per_ms; }
+    double throughputBps() const { return m_throughput_bps; }
+    double bitsPerPixelAt(double scale) const;
+    const std::array<LiwcCandidate, 11>& lastCandidates() const { return m_candidates; }
+    uint16_t lastMotion() const { return m_motion; }
+
+private:
+    const WorkloadHeader& m_header;
+    LiwcConfig m_config;
+    LiwcTable m_table;
+    RemoteSizeTable m_sizes;
+    // Estimates the updater refreshes.
+    double m_gpu_triangles_per_ms;
+    double m_throughput_bps;
+    double m_log_bits_at_1;     // log of bits per pixel at scale 1
+    double m_bits_exponent;     // growth with scale
+    // State between decide() and observe().
+    bool m_have_previous = false;
+    Pose m_previous_head;
+    Gaze m_previous_gaze;
+    double m_e1_deg;
+    uint16_t m_motion = 0;
+    std::array<LiwcCandidate, 11> m_candidates{};
+    double m_pending_model_imbalance_ms = 0.0;
+    int64_t m_pending_index = -1;
+};
+
+}  // namespace qvr

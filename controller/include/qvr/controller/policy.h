@@ -1,0 +1,82 @@
+// Fovea-sizing policies behind one interface (paper §4.1, §6): each frame a policy picks e1
+// before the frame renders, and later observes what the frame measured. Which measurements a
+// policy may use, and when, is the difference between them: LIWC reads the frame's own
+// triangles before rendering; the software-reactive policy sees measurements two frames late
+// (Fig. 4); the oracle knows the frame's true latency curve.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "qvr/workload/cost_model.h"
+#include "qvr/workload/workload.h"
+
+namespace qvr {
+
+struct Decision {
+    double e1_deg = 5.0;
+    // The policy's own prediction for this frame at the chosen e1 (NaN if it makes none).
+    double t_local_pred_ms = 0.0;
+    double t_remote_pred_ms = 0.0;
+};
+
+// What the headset measures about a frame once it is done.
+struct FrameMeasurement {
+    int64_t index = 0;
+    double e1_deg = 0.0;
+    double t_local_ms = 0.0;
+    double t_remote_ms = 0.0;
+    double triangles_local = 0.0;  // triangles in the fovea cone, both eyes
+    double middle_bytes = 0.0;
+    double outer_bytes = 0.0;
+    double middle_pixels = 0.0;    // both eyes, at s1
+    double outer_pixels = 0.0;     // both eyes, at s2
+    double s1 = 1.0;
+    double s2 = 1.0;
+    double throughput_bps = 0.0;   // measured from acknowledgements; 0 if nothing was sent
+};
+
+class FoveaPolicy {
+public:
+    virtual ~FoveaPolicy() = default;
+    virtual std::string_view name() const = 0;
+    // Called before frame `frame` renders. Policies other than LIWC and the oracle must not
+    // read the frame's per-ring data.
+    virtual Decision decide(const WorkloadFrame& frame) = 0;
+    // Called once frame `m.index` completes, in frame order.
+    virtual void observe(const FrameMeasurement& m) = 0;
+};
+
+// The paper's FFR: e1 fixed (5° by default).
+class FixedPolicy final : public FoveaPolicy {
+public:
+    explicit FixedPolicy(double e1_deg = 5.0) : m_e1_deg(e1_deg) {}
+    std::string_view name() const override { return "fixed"; }
+    Decision decide(const WorkloadFrame& frame) override;
+    void observe(const FrameMeasurement&) override {}
+
+private:
+    double m_e1_deg;
+};
+
+// The pure-software Q-VR of §6.1: picks e1 from previous frames' measured latencies, which
+// reach it lag_frames late, scaling them to candidate sizes with the plan's pixel counts; no
+// access to the frame's triangles before rendering.
+struct SoftwareReactiveConfig {
+    double e1_initial_deg = 5.0;
+    double e1_min_deg = 1.0;
+    double e1_max_deg = 90.0;
+    double max_step_deg = 5.0;
+    int lag_frames = 2;
+};
+std::unique_ptr<FoveaPolicy> makeSoftwareReactivePolicy(const WorkloadHeader& header,
+                                                        SoftwareReactiveConfig config = {});
+
+// The limit: knows each frame's true cost curve and picks the e1 minimising max(T_local,
+// T_remote) on a fine grid, with no step limit.
+std::unique_ptr<FoveaPolicy> makeOraclePolicy(const WorkloadHeader& header,
+                                              const CostModel& truth, double e1_min_deg = 1.0,
+                                              double e1_max_deg = 90.0);
+
+}  // namespace qvr
