@@ -23,7 +23,8 @@ struct PlanOptions {
 bool parseGaze(const std::string& text, Gaze& gaze) {
     double x = 0, y = 0;
     char tail = 0;
-    if (std::sscanf(text.c_str(), "%lf,%lf%c", &x, &y, &tail) != 2) return false;
+    if (std::sscanf(text.c_str(), "%lf,%lf%c", &x, &y, &tail) != 2)
+        return false;
     if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(x) > 80 || std::fabs(y) > 80)
         return false;
     gaze = {x, y};
@@ -31,8 +32,8 @@ bool parseGaze(const std::string& text, Gaze& gaze) {
 }
 
 nlohmann::json rectJson(const LayerRect& l) {
-    return {{"x0", l.rect.x0},        {"y0", l.rect.y0},          {"x1", l.rect.x1},
-            {"y1", l.rect.y1},        {"scale", l.scale},         {"width_px", l.width_px},
+    return {{"x0", l.rect.x0},          {"y0", l.rect.y0},     {"x1", l.rect.x1},
+            {"y1", l.rect.y1},          {"scale", l.scale},    {"width_px", l.width_px},
             {"height_px", l.height_px}, {"pixels", l.pixels()}};
 }
 
@@ -105,9 +106,10 @@ static Registered registerPlan(CLI::App& app) {
                    gaze.x_deg, gaze.y_deg, p.e1_deg, p.e2_deg, p.s1, p.s2);
         const auto& e = p.eyes[0];
         auto row = [](const char* name, const LayerRect& l) {
-            fmt::print("  {:<7} rect [{:4},{:4})x[{:4},{:4})  scale {:6.2f}  {:5}x{:<5} = {:9} px\n",
-                       name, l.rect.x0, l.rect.x1, l.rect.y0, l.rect.y1, l.scale, l.width_px,
-                       l.height_px, l.pixels());
+            fmt::print(
+                "  {:<7} rect [{:4},{:4})x[{:4},{:4})  scale {:6.2f}  {:5}x{:<5} = {:9} px\n", name,
+                l.rect.x0, l.rect.x1, l.rect.y0, l.rect.y1, l.scale, l.width_px, l.height_px,
+                l.pixels());
         };
         row("fovea", e.fovea);
         row("middle", e.middle);

@@ -6,8 +6,8 @@
 #include <exception>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "commands.h"
 
@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
     std::sort(entries.begin(), entries.end(),
               [](const auto& a, const auto& b) { return a.order < b.order; });
     std::vector<qvr::cli::Registered> commands;
-    for (const auto& e : entries) commands.push_back(e.fn(app));
+    for (const auto& e : entries)
+        commands.push_back(e.fn(app));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -30,7 +31,8 @@ int main(int argc, char** argv) {
     }
     try {
         for (auto& c : commands) {
-            if (c.command->parsed()) return c.action();
+            if (c.command->parsed())
+                return c.action();
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "qvr: error: %s\n", e.what());

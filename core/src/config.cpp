@@ -15,14 +15,15 @@ Expected<toml::table> parseTomlText(std::string_view text, std::string_view sour
         return toml::parse(text, source_name);
     } catch (const toml::parse_error& e) {
         const auto& where = e.source().begin;
-        return makeError(fmt::format("{}:{}:{}: {}", source_name, where.line, where.column,
-                                     e.description()));
+        return makeError(
+            fmt::format("{}:{}:{}: {}", source_name, where.line, where.column, e.description()));
     }
 }
 
 Expected<std::string> readTextFile(const std::string& path, size_t max_bytes) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) return makeError(fmt::format("cannot open '{}'", path));
+    if (!in)
+        return makeError(fmt::format("cannot open '{}'", path));
     std::string text;
     char buf[65536];
     while (in.read(buf, sizeof buf) || in.gcount() > 0) {
@@ -30,13 +31,15 @@ Expected<std::string> readTextFile(const std::string& path, size_t max_bytes) {
         if (text.size() > max_bytes)
             return makeError(fmt::format("'{}' is larger than {} bytes", path, max_bytes));
     }
-    if (in.bad()) return makeError(fmt::format("error reading '{}'", path));
+    if (in.bad())
+        return makeError(fmt::format("error reading '{}'", path));
     return text;
 }
 
 Expected<toml::table> loadTomlFile(const std::string& path) {
     auto text = readTextFile(path);
-    if (!text) return makeError(text.error());
+    if (!text)
+        return makeError(text.error());
     return parseTomlText(*text, path);
 }
 
@@ -44,7 +47,8 @@ ConfigReader::ConfigReader(const toml::table& table, std::string source_name)
     : m_table(table), m_source(std::move(source_name)) {}
 
 void ConfigReader::fail(std::string message) {
-    if (!m_errors.empty()) m_errors += "\n";
+    if (!m_errors.empty())
+        m_errors += "\n";
     m_errors += fmt::format("{}: {}", m_source, message);
 }
 
@@ -54,7 +58,8 @@ void ConfigReader::markUsed(std::string_view path) {
     while (true) {
         m_used.insert(p);
         const auto dot = p.rfind('.');
-        if (dot == std::string::npos) break;
+        if (dot == std::string::npos)
+            break;
         p.resize(dot);
     }
 }
@@ -67,7 +72,8 @@ double ConfigReader::number(std::string_view path, double default_value, double 
                             double max_value) {
     markUsed(path);
     const auto node = m_table.at_path(path);
-    if (!node) return default_value;
+    if (!node)
+        return default_value;
     std::optional<double> v = node.value<double>();
     if (!v || !(node.is_floating_point() || node.is_integer())) {
         fail(fmt::format("'{}' must be a number", path));
@@ -80,11 +86,11 @@ double ConfigReader::number(std::string_view path, double default_value, double 
     return *v;
 }
 
-int ConfigReader::integer(std::string_view path, int default_value, int min_value,
-                          int max_value) {
+int ConfigReader::integer(std::string_view path, int default_value, int min_value, int max_value) {
     markUsed(path);
     const auto node = m_table.at_path(path);
-    if (!node) return default_value;
+    if (!node)
+        return default_value;
     if (!node.is_integer()) {
         fail(fmt::format("'{}' must be an integer", path));
         return default_value;
@@ -100,7 +106,8 @@ int ConfigReader::integer(std::string_view path, int default_value, int min_valu
 std::string ConfigReader::string(std::string_view path, std::string default_value) {
     markUsed(path);
     const auto node = m_table.at_path(path);
-    if (!node) return default_value;
+    if (!node)
+        return default_value;
     if (!node.is_string()) {
         fail(fmt::format("'{}' must be a string", path));
         return default_value;
@@ -113,17 +120,19 @@ Status ConfigReader::finish() {
     std::function<void(const toml::table&, const std::string&)> walk =
         [&](const toml::table& t, const std::string& prefix) {
             for (const auto& [k, v] : t) {
-                const std::string key = prefix.empty() ? std::string(k.str())
-                                                       : prefix + "." + std::string(k.str());
+                const std::string key =
+                    prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
                 if (!m_used.count(key)) {
                     fail(fmt::format("unknown key '{}'", key));
                     continue;
                 }
-                if (const auto* sub = v.as_table()) walk(*sub, key);
+                if (const auto* sub = v.as_table())
+                    walk(*sub, key);
             }
         };
     walk(m_table, "");
-    if (m_errors.empty()) return Status::success();
+    if (m_errors.empty())
+        return Status::success();
     return makeError(m_errors);
 }
 

@@ -62,8 +62,10 @@ double EyeGeometry::coverEccentricityDeg(const Gaze& gaze) const {
 
 RealRect EyeGeometry::coneBounds(const Gaze& gaze, double radius_deg) const {
     const RealRect full{0.0, 0.0, static_cast<double>(m_width), static_cast<double>(m_height)};
-    if (radius_deg <= 0.0) return {};
-    if (radius_deg >= 90.0) return full;
+    if (radius_deg <= 0.0)
+        return {};
+    if (radius_deg >= 90.0)
+        return full;
     const glm::dvec3 g = gazeDirection(gaze);
     // Orthonormal basis around the gaze.
     const glm::dvec3 helper = std::fabs(g.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
@@ -114,7 +116,8 @@ RealRect EyeGeometry::coneBounds(const Gaze& gaze, double radius_deg) const {
 }
 
 PixelRect EyeGeometry::roundOut(const RealRect& r) const {
-    if (r.width() <= 0.0 || r.height() <= 0.0) return {};
+    if (r.width() <= 0.0 || r.height() <= 0.0)
+        return {};
     PixelRect p;
     p.x0 = std::clamp(static_cast<int>(std::floor(r.x0)), 0, m_width);
     p.y0 = std::clamp(static_cast<int>(std::floor(r.y0)), 0, m_height);

@@ -13,11 +13,17 @@ namespace qvr {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegPerRad = 180.0 / kPi;
-double tanDeg(double d) { return std::tan(d / kDegPerRad); }
+double tanDeg(double d) {
+    return std::tan(d / kDegPerRad);
+}
 }  // namespace
 
-double HmdProfile::focalXPx() const { return 0.5 * width_px / tanDeg(0.5 * fov_h_deg); }
-double HmdProfile::focalYPx() const { return 0.5 * height_px / tanDeg(0.5 * fov_v_deg); }
+double HmdProfile::focalXPx() const {
+    return 0.5 * width_px / tanDeg(0.5 * fov_h_deg);
+}
+double HmdProfile::focalYPx() const {
+    return 0.5 * height_px / tanDeg(0.5 * fov_v_deg);
+}
 
 double HmdProfile::pixelAngleDeg() const {
     const double ax = std::atan(1.0 / focalXPx()) * kDegPerRad;
@@ -29,7 +35,9 @@ double HmdProfile::scaleAt(double eccentricity_deg) const {
     return std::max(1.0, acuity.marDeg(eccentricity_deg) / pixelAngleDeg());
 }
 
-HmdProfile defaultHmdProfile() { return HmdProfile{}; }
+HmdProfile defaultHmdProfile() {
+    return HmdProfile{};
+}
 
 HmdProfile lowResHmdProfile() {
     HmdProfile p;
@@ -41,7 +49,8 @@ HmdProfile lowResHmdProfile() {
 
 Expected<HmdProfile> parseHmdProfile(std::string_view toml_text, std::string_view source_name) {
     auto table = parseTomlText(toml_text, source_name);
-    if (!table) return makeError(table.error());
+    if (!table)
+        return makeError(table.error());
     ConfigReader r(*table, std::string(source_name));
     HmdProfile p = defaultHmdProfile();
     p.name = r.string("name", std::string(source_name));
@@ -57,20 +66,23 @@ Expected<HmdProfile> parseHmdProfile(std::string_view toml_text, std::string_vie
         r.number("lens.chroma_blue_scale", p.lens.chroma_blue_scale, 0.9, 1.1);
     p.acuity.omega0_deg = r.number("acuity.omega0_deg", p.acuity.omega0_deg, 1e-4, 1.0);
     p.acuity.slope = r.number("acuity.slope", p.acuity.slope, 0.0, 1.0);
-    if (auto st = r.finish(); !st) return makeError(st.error());
+    if (auto st = r.finish(); !st)
+        return makeError(st.error());
     return p;
 }
 
 Expected<HmdProfile> loadHmdProfile(const std::string& path) {
     auto text = readTextFile(path);
-    if (!text) return makeError(text.error());
+    if (!text)
+        return makeError(text.error());
     return parseHmdProfile(*text, path);
 }
 
 Expected<HmdProfile> hmdProfileByName(const std::string& name_or_path) {
     if (name_or_path.empty() || name_or_path == "default" || name_or_path == "1920x2160")
         return defaultHmdProfile();
-    if (name_or_path == "low" || name_or_path == "1280x1600") return lowResHmdProfile();
+    if (name_or_path == "low" || name_or_path == "1280x1600")
+        return lowResHmdProfile();
     return loadHmdProfile(name_or_path);
 }
 

@@ -29,12 +29,14 @@ LayerRect makeLayer(const EyeGeometry& geometry, const RealRect& r, double scale
 double peripheryCost(const HmdProfile& profile, const EyeGeometry& geometry, const Gaze& gaze,
                      double e1_deg, double e2_deg) {
     const double cover = geometry.coverEccentricityDeg(gaze);
-    if (e1_deg >= cover) return 0.0;
+    if (e1_deg >= cover)
+        return 0.0;
     e2_deg = std::clamp(e2_deg, e1_deg, cover);
     const double s1 = profile.scaleAt(e1_deg);
     const double s2 = profile.scaleAt(e2_deg);
     double middle = 0.0;
-    if (e2_deg > e1_deg) middle = geometry.coneBounds(gaze, e2_deg).area() / (s1 * s1);
+    if (e2_deg > e1_deg)
+        middle = geometry.coneBounds(gaze, e2_deg).area() / (s1 * s1);
     double outer = 0.0;
     if (e2_deg < cover) {
         outer = static_cast<double>(geometry.width()) * geometry.height() / (s2 * s2);
@@ -46,7 +48,8 @@ LayerPlanner::LayerPlanner(const HmdProfile& profile) : m_profile(profile), m_ge
 
 double LayerPlanner::optimalE2Deg(const Gaze& gaze, double e1_deg) const {
     const double cover = m_geometry.coverEccentricityDeg(gaze);
-    if (e1_deg >= cover) return e1_deg;
+    if (e1_deg >= cover)
+        return e1_deg;
     auto cost = [&](double e2) { return peripheryCost(m_profile, m_geometry, gaze, e1_deg, e2); };
     // Scan: both ends exactly, and a grid in between.
     double best_e2 = e1_deg;
@@ -58,7 +61,8 @@ double LayerPlanner::optimalE2Deg(const Gaze& gaze, double e1_deg) const {
             best_e2 = e2;
         }
     };
-    for (double e2 = e1_deg + kScanStepDeg; e2 < cover; e2 += kScanStepDeg) consider(e2);
+    for (double e2 = e1_deg + kScanStepDeg; e2 < cover; e2 += kScanStepDeg)
+        consider(e2);
     consider(cover);
     // Refine inside the scan cell on either side of the best point.
     double lo = std::max(e1_deg, best_e2 - kScanStepDeg);

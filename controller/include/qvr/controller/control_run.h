@@ -18,7 +18,7 @@ struct ControlFrame {
     uint16_t motion = 0;
     double e1_deg = 0.0;
     double e2_deg = 0.0;
-    double t_local_ms = 0.0;   // truth under the cost model
+    double t_local_ms = 0.0;  // truth under the cost model
     double t_remote_ms = 0.0;
     double t_local_pred_ms = 0.0;  // the policy's prediction
     double t_remote_pred_ms = 0.0;
@@ -34,7 +34,7 @@ struct ControlSummary {
     double e1_deg_mean = 0.0;
     double ratio_final = 0.0;
     double remote_bytes_mean = 0.0;
-    double prediction_error_local_pct = 0.0;   // mean |pred − true| / true, where predicted
+    double prediction_error_local_pct = 0.0;  // mean |pred − true| / true, where predicted
     double prediction_error_remote_pct = 0.0;
     // First frame from which |T_remote/T_local − 1| stays under the tolerance; empty if never.
     std::optional<int> frames_to_balance;

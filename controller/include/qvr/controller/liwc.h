@@ -20,13 +20,17 @@ struct LiwcConfig {
     double e1_initial_deg = 5.0;
     double e1_min_deg = 1.0;
     double e1_max_deg = 90.0;
-    int max_delta_deg = 5;      // delta tags −5…+5
-    bool interpolate = true;    // refine between the two tags that bracket the balance point
-    float alpha = 0.3f;         // the table's reward parameter α
-    double rate_ema = 0.5;      // weight of a new measurement in the GPU-rate/throughput/bits estimates
+    int max_delta_deg = 5;    // delta tags −5…+5
+    bool interpolate = true;  // refine between the two tags that bracket the balance point
+    float alpha = 0.3f;       // the table's reward parameter α
+    double rate_ema = 0.5;  // weight of a new measurement in the GPU-rate/throughput/bits estimates
+    int table_warmup_frames = 3;  // frames that train only the estimates, not the table
     MotionThresholds motion;
+    // The GPU-rate estimate forgets old frames with this factor (recursive least squares).
+    double gpu_forgetting = 0.95;
     // Cold-start estimates, before anything is measured.
     double gpu_triangles_per_ms_initial = 50'000.0;
+    double gpu_pixels_per_ms_initial = 150'000.0;
     double throughput_bps_initial = 200e6;
     double bits_per_pixel_initial = 1.0;
     double bits_scale_exponent_initial = 0.7;
@@ -55,22 +59,27 @@ public:
 
     const LiwcTable& table() const { return m_table; }
     LiwcTable& table() { return m_table; }
-    double gpuTrianglesPerMs() const { return m_gpu_triangles_per_ms; }
+    double gpuTrianglesPerMs() const;
+    double gpuPixelsPerMs() const;
     double throughputBps() const { return m_throughput_bps; }
     double bitsPerPixelAt(double scale) const;
     const std::array<LiwcCandidate, 11>& lastCandidates() const { return m_candidates; }
     uint16_t lastMotion() const { return m_motion; }
 
 private:
+    void updateGpuRates(double triangles, double pixels, double t_local_ms);
+
     const WorkloadHeader& m_header;
     LiwcConfig m_config;
     LiwcTable m_table;
     RemoteSizeTable m_sizes;
-    // Estimates the updater refreshes.
-    double m_gpu_triangles_per_ms;
+    // Estimates the updater refreshes. The GPU: T_local ≈ θ0 + θ1·triangles + θ2·pixels (in
+    // units of 1e5), fitted by recursive least squares with covariance m_gpu_cov.
+    std::array<double, 3> m_gpu_theta;
+    std::array<double, 9> m_gpu_cov;
     double m_throughput_bps;
-    double m_log_bits_at_1;     // log of bits per pixel at scale 1
-    double m_bits_exponent;     // growth with scale
+    double m_log_bits_at_1;  // log of bits per pixel at scale 1
+    double m_bits_exponent;  // growth with scale
     // State between decide() and observe().
     bool m_have_previous = false;
     Pose m_previous_head;
@@ -79,7 +88,10 @@ private:
     uint16_t m_motion = 0;
     std::array<LiwcCandidate, 11> m_candidates{};
     double m_pending_model_imbalance_ms = 0.0;
-    int64_t m_pending_index = -1;
+    int m_pending_bucket = 0;
+    bool m_pending = false;
+    int m_observed = 0;
+    bool m_first_decision = true;
 };
 
 }  // namespace qvr

@@ -19,9 +19,9 @@ inline constexpr int kMotionCodes = 1 << kMotionBits;
 //   8 gaze moved vertically     9 …and upwards      (sign, only meaningful with bit 8)
 // Sign bits are cleared when their axis did not move, so each motion has one code.
 struct MotionThresholds {
-    double rotation_deg = 0.25;   // per frame; 22.5 °/s at 90 Hz
-    double translation_m = 0.002; // per frame; 0.18 m/s at 90 Hz
-    double gaze_deg = 0.5;        // per frame
+    double rotation_deg = 0.25;    // per frame; 22.5 °/s at 90 Hz
+    double translation_m = 0.002;  // per frame; 0.18 m/s at 90 Hz
+    double gaze_deg = 0.5;         // per frame
 };
 
 uint16_t encodeMotion(const Pose& previous_head, const Pose& head, const Gaze& previous_gaze,

@@ -28,13 +28,14 @@ struct FrameMeasurement {
     double t_local_ms = 0.0;
     double t_remote_ms = 0.0;
     double triangles_local = 0.0;  // triangles in the fovea cone, both eyes
+    double pixels_local = 0.0;     // shaded fovea pixels, both eyes
     double middle_bytes = 0.0;
     double outer_bytes = 0.0;
-    double middle_pixels = 0.0;    // both eyes, at s1
-    double outer_pixels = 0.0;     // both eyes, at s2
+    double middle_pixels = 0.0;  // both eyes, at s1
+    double outer_pixels = 0.0;   // both eyes, at s2
     double s1 = 1.0;
     double s2 = 1.0;
-    double throughput_bps = 0.0;   // measured from acknowledgements; 0 if nothing was sent
+    double throughput_bps = 0.0;  // measured from acknowledgements; 0 if nothing was sent
 };
 
 class FoveaPolicy {
@@ -75,8 +76,7 @@ std::unique_ptr<FoveaPolicy> makeSoftwareReactivePolicy(const WorkloadHeader& he
 
 // The limit: knows each frame's true cost curve and picks the e1 minimising max(T_local,
 // T_remote) on a fine grid, with no step limit.
-std::unique_ptr<FoveaPolicy> makeOraclePolicy(const WorkloadHeader& header,
-                                              const CostModel& truth, double e1_min_deg = 1.0,
-                                              double e1_max_deg = 90.0);
+std::unique_ptr<FoveaPolicy> makeOraclePolicy(const WorkloadHeader& header, const CostModel& truth,
+                                              double e1_min_deg = 1.0, double e1_max_deg = 90.0);
 
 }  // namespace qvr

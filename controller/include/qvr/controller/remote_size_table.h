@@ -10,6 +10,7 @@
 namespace qvr {
 
 struct PeripheryShape {
+    double fovea_pixels = 0.0;   // per eye, the fovea framebuffer
     double middle_pixels = 0.0;  // per eye
     double outer_pixels = 0.0;   // per eye
     double s1 = 1.0;

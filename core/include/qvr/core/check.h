@@ -5,19 +5,19 @@
 #include <cstdio>
 #include <cstdlib>
 
-#define QVR_CHECK(cond)                                                                       \
-    do {                                                                                      \
-        if (!(cond)) {                                                                        \
+#define QVR_CHECK(cond)                                                                         \
+    do {                                                                                        \
+        if (!(cond)) {                                                                          \
             std::fprintf(stderr, "qvr: check failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__); \
-            std::abort();                                                                     \
-        }                                                                                     \
+            std::abort();                                                                       \
+        }                                                                                       \
     } while (0)
 
-#define QVR_CHECK_MSG(cond, msg)                                                          \
-    do {                                                                                  \
-        if (!(cond)) {                                                                    \
+#define QVR_CHECK_MSG(cond, msg)                                                              \
+    do {                                                                                      \
+        if (!(cond)) {                                                                        \
             std::fprintf(stderr, "qvr: check failed: %s: %s (%s:%d)\n", #cond, msg, __FILE__, \
-                         __LINE__);                                                       \
-            std::abort();                                                                 \
-        }                                                                                 \
+                         __LINE__);                                                           \
+            std::abort();                                                                     \
+        }                                                                                     \
     } while (0)

@@ -26,8 +26,7 @@ public:
 
     // A number at a dotted path ("display.width_px"), within [min_value, max_value]. Returns the
     // default when absent; records an error when present but of the wrong type or out of range.
-    double number(std::string_view path, double default_value, double min_value,
-                  double max_value);
+    double number(std::string_view path, double default_value, double min_value, double max_value);
     int integer(std::string_view path, int default_value, int min_value, int max_value);
     std::string string(std::string_view path, std::string default_value);
     bool has(std::string_view path) const;

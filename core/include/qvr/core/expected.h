@@ -15,12 +15,14 @@ struct Error {
     std::string message;
 };
 
-inline Error makeError(std::string message) { return Error{std::move(message)}; }
+inline Error makeError(std::string message) {
+    return Error{std::move(message)};
+}
 
 template <typename T>
 class Expected {
 public:
-    Expected(T value) : m_state(std::move(value)) {}  // NOLINT: implicit by design
+    Expected(T value) : m_state(std::move(value)) {}      // NOLINT: implicit by design
     Expected(Error error) : m_state(std::move(error)) {}  // NOLINT: implicit by design
 
     bool ok() const { return std::holds_alternative<T>(m_state); }

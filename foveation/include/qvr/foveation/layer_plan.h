@@ -35,7 +35,7 @@ struct LayerPlan {
     double e2_deg = 0.0;
     double s1 = 1.0;
     double s2 = 1.0;
-    double cover_deg = 0.0;  // the eccentricity that covers the whole field from this gaze
+    double cover_deg = 0.0;         // the eccentricity that covers the whole field from this gaze
     std::array<EyeLayers, 2> eyes;  // left, right
 
     // Per eye (both eyes share one gaze, so their counts are equal).

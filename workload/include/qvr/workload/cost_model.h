@@ -15,7 +15,7 @@ struct GpuModel {
     double freq_mhz = 500.0;
     double triangles_per_ms_at_500 = 50'000.0;  // vertex shading + setup, both eyes counted
     double pixels_per_ms_at_500 = 150'000.0;    // shaded fragments
-    double setup_ms = 0.3;                       // per-frame fixed cost (state, clears)
+    double setup_ms = 0.3;                      // per-frame fixed cost (state, clears)
 
     double trianglesPerMs() const { return triangles_per_ms_at_500 * freq_mhz / 500.0; }
     double pixelsPerMs() const { return pixels_per_ms_at_500 * freq_mhz / 500.0; }

@@ -1,0 +1,198 @@
+// LIWC (paper §4.1, Eq. 2). The decision is a handful of table lookups and multiply-adds per
+// delta tag — the work the paper puts in a small accelerator; here it runs in well under a
+// microsecond on a CPU (bench/liwc_bench.cpp).
+#include "qvr/controller/liwc.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace qvr {
+
+LiwcPolicy::LiwcPolicy(const WorkloadHeader& header, LiwcConfig config)
+    : m_header(header),
+      m_config(config),
+      m_sizes(header.profile, std::min(90.0, config.e1_max_deg)),
+      m_gpu_theta{0.0, 1e5 / config.gpu_triangles_per_ms_initial,
+                  1e5 / config.gpu_pixels_per_ms_initial},
+      m_gpu_cov{1, 0, 0, 0, 1, 0, 0, 0, 1},
+      m_throughput_bps(config.throughput_bps_initial),
+      m_log_bits_at_1(std::log(config.bits_per_pixel_initial)),
+      m_bits_exponent(config.bits_scale_exponent_initial),
+      m_e1_deg(config.e1_initial_deg) {
+    QVR_CHECK(config.max_delta_deg == 5);  // the table's tags are −5…+5
+    QVR_CHECK(config.alpha > 0.0f && config.alpha <= 1.0f);
+    QVR_CHECK(config.rate_ema > 0.0 && config.rate_ema <= 1.0);
+}
+
+double LiwcPolicy::bitsPerPixelAt(double scale) const {
+    return std::exp(m_log_bits_at_1 + m_bits_exponent * std::log(std::max(1.0, scale)));
+}
+
+double LiwcPolicy::gpuTrianglesPerMs() const {
+    return 1e5 / std::max(1e-9, m_gpu_theta[1]);
+}
+double LiwcPolicy::gpuPixelsPerMs() const {
+    return 1e5 / std::max(1e-9, m_gpu_theta[2]);
+}
+
+double LiwcPolicy::predictLocalMs(const WorkloadFrame& frame, double e1_deg) const {
+    // Eq. 2: the fovea cone's work over the GPU's rate. The triangle count is the "hardware
+    // intermediate data" available after geometry setup, before rendering; the rate is split
+    // into a triangle rate and a fragment rate (plus a fixed cost) because a single
+    // triangles-per-millisecond figure mispredicts by a third whenever a saccade moves the
+    // fovea between dense geometry and plain surfaces (docs/LIWC.md).
+    const bool all = e1_deg >= m_sizes.coverDeg(frame.gaze);
+    const double tris = all ? sumTotal(frame.triangles_per_ring)
+                            : sumWithinDeg(frame.triangles_per_ring, m_header.ring_deg, e1_deg);
+    const double pixels = all ? sumTotal(frame.pixels_per_ring)
+                              : sumWithinDeg(frame.pixels_per_ring, m_header.ring_deg, e1_deg);
+    return std::max(0.0,
+                    m_gpu_theta[0] + m_gpu_theta[1] * tris * 1e-5 + m_gpu_theta[2] * pixels * 1e-5);
+}
+
+double LiwcPolicy::predictRemoteMs(const WorkloadFrame& frame, double e1_deg) const {
+    // Eq. 2: the periphery's bytes over the throughput measured from acknowledgements.
+    if (e1_deg >= m_sizes.coverDeg(frame.gaze))
+        return 0.0;
+    const PeripheryShape p = m_sizes.lookup(frame.gaze, e1_deg);
+    const double bits =
+        2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
+    return bits / m_throughput_bps * 1000.0;
+}
+
+Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
+    m_motion = m_have_previous ? encodeMotion(m_previous_head, frame.head, m_previous_gaze,
+                                              frame.gaze, m_config.motion)
+                               : 0;
+    m_previous_head = frame.head;
+    m_previous_gaze = frame.gaze;
+    m_have_previous = true;
+
+    const double hi = std::min(m_config.e1_max_deg, m_sizes.coverDeg(frame.gaze));
+    const double lo = m_config.e1_min_deg;
+    if (m_first_decision) {
+        // Nothing measured yet: the first frame runs at the initial e1 (Fig. 14 starts at 5°).
+        m_first_decision = false;
+        m_e1_deg = std::clamp(m_config.e1_initial_deg, lo, std::max(lo, hi));
+        Decision d{m_e1_deg, predictLocalMs(frame, m_e1_deg), predictRemoteMs(frame, m_e1_deg)};
+        m_pending_model_imbalance_ms = d.t_remote_pred_ms - d.t_local_pred_ms;
+        m_pending_bucket = LiwcTable::bucketOf(m_e1_deg);
+        m_pending = true;
+        return d;
+    }
+    // One candidate per delta tag; the table's offset is indexed by the candidate's
+    // eccentricity bucket under the current motion.
+    int best = 0;
+    for (int i = 0; i < 11; ++i) {
+        LiwcCandidate& c = m_candidates[static_cast<size_t>(i)];
+        c.delta_deg = i - 5;
+        c.e1_deg = std::clamp(m_e1_deg + c.delta_deg, lo, std::max(lo, hi));
+        c.t_local_pred_ms = predictLocalMs(frame, c.e1_deg);
+        c.t_remote_pred_ms = predictRemoteMs(frame, c.e1_deg);
+        c.offset_ms = m_table.offsetMs(m_motion, LiwcTable::bucketOf(c.e1_deg));
+        if (std::fabs(c.imbalanceMs()) <
+            std::fabs(m_candidates[static_cast<size_t>(best)].imbalanceMs()))
+            best = i;
+    }
+    double chosen = m_candidates[static_cast<size_t>(best)].e1_deg;
+    if (m_config.interpolate) {
+        // The balance point usually lies between two tags: interpolate linearly between the
+        // best tag and the neighbour on the other side of zero imbalance.
+        const double ib = m_candidates[static_cast<size_t>(best)].imbalanceMs();
+        for (int n : {best - 1, best + 1}) {
+            if (n < 0 || n > 10)
+                continue;
+            const LiwcCandidate& c = m_candidates[static_cast<size_t>(n)];
+            const double in = c.imbalanceMs();
+            if ((ib > 0) != (in > 0) && ib != in) {
+                const double t = ib / (ib - in);
+                chosen = m_candidates[static_cast<size_t>(best)].e1_deg +
+                         t * (c.e1_deg - m_candidates[static_cast<size_t>(best)].e1_deg);
+                break;
+            }
+        }
+    }
+    m_e1_deg = chosen;
+    Decision d;
+    d.e1_deg = chosen;
+    d.t_local_pred_ms = predictLocalMs(frame, chosen);
+    d.t_remote_pred_ms = predictRemoteMs(frame, chosen);
+    m_pending_model_imbalance_ms = d.t_remote_pred_ms - d.t_local_pred_ms;
+    m_pending_bucket = LiwcTable::bucketOf(chosen);
+    m_pending = true;
+    return d;
+}
+
+void LiwcPolicy::observe(const FrameMeasurement& m) {
+    // The table learns what the model mispredicted for this motion and eccentricity: the
+    // measured imbalance against the one Eq. 2 predicted with the pre-frame estimates. During
+    // warm-up the estimates are still far off and their error is not the motion's.
+    if (m_pending && m_observed >= m_config.table_warmup_frames) {
+        const double delta = (m.t_remote_ms - m.t_local_ms) - m_pending_model_imbalance_ms;
+        m_table.fold(m_motion, m_pending_bucket, static_cast<float>(delta), m_config.alpha);
+    }
+    m_pending = false;
+    ++m_observed;
+    const double b = m_config.rate_ema;
+    if (m.t_local_ms > 0.0)
+        updateGpuRates(m.triangles_local, m.pixels_local, m.t_local_ms);
+    if (m.throughput_bps > 0.0)
+        m_throughput_bps = (1.0 - b) * m_throughput_bps + b * m.throughput_bps;
+    // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
+    const bool have_mid = m.middle_pixels > 0 && m.middle_bytes > 0;
+    const bool have_out = m.outer_pixels > 0 && m.outer_bytes > 0;
+    if (have_mid && have_out && m.s2 > 1.05 * m.s1) {
+        const double lm = std::log(m.middle_bytes * 8.0 / m.middle_pixels);
+        const double lo = std::log(m.outer_bytes * 8.0 / m.outer_pixels);
+        const double gamma = std::clamp((lo - lm) / (std::log(m.s2) - std::log(m.s1)), 0.0, 2.0);
+        const double log_b1 = lm - gamma * std::log(m.s1);
+        m_bits_exponent = (1.0 - b) * m_bits_exponent + b * gamma;
+        m_log_bits_at_1 = (1.0 - b) * m_log_bits_at_1 + b * log_b1;
+    } else if (have_mid || have_out) {
+        const double bits = have_mid ? m.middle_bytes * 8.0 / m.middle_pixels
+                                     : m.outer_bytes * 8.0 / m.outer_pixels;
+        const double s = have_mid ? m.s1 : m.s2;
+        const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
+        m_log_bits_at_1 = (1.0 - b) * m_log_bits_at_1 + b * log_b1;
+    }
+    m_e1_deg = m.e1_deg;
+}
+
+void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {
+    // Recursive least squares with forgetting: x = [1, triangles, pixels]·(1, 1e-5, 1e-5).
+    const std::array<double, 3> x{1.0, triangles * 1e-5, pixels * 1e-5};
+    const double lambda = m_config.gpu_forgetting;
+    auto& P = m_gpu_cov;
+    std::array<double, 3> px{};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            px[i] += P[i * 3 + j] * x[j];
+    double denom = lambda;
+    for (int i = 0; i < 3; ++i)
+        denom += x[i] * px[i];
+    const std::array<double, 3> k{px[0] / denom, px[1] / denom, px[2] / denom};
+    const double err =
+        t_local_ms - (m_gpu_theta[0] + m_gpu_theta[1] * x[1] + m_gpu_theta[2] * x[2]);
+    for (int i = 0; i < 3; ++i)
+        m_gpu_theta[i] += k[i] * err;
+    // Rates are positive; the fixed cost is not negative.
+    m_gpu_theta[0] = std::max(0.0, m_gpu_theta[0]);
+    m_gpu_theta[1] = std::max(1e-6, m_gpu_theta[1]);
+    m_gpu_theta[2] = std::max(1e-6, m_gpu_theta[2]);
+    std::array<double, 9> next{};
+    double trace = 0.0;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            next[i * 3 + j] = (P[i * 3 + j] - k[i] * px[j]) / lambda;
+        }
+    for (int i = 0; i < 3; ++i)
+        trace += next[i * 4];
+    // Forgetting inflates the covariance along directions the data never excites; cap it so
+    // a sudden new direction cannot produce a wild step.
+    if (trace > 100.0)
+        for (double& v : next)
+            v *= 100.0 / trace;
+    P = next;
+}
+
+}  // namespace qvr
