@@ -35,29 +35,61 @@ double LiwcPolicy::gpuPixelsPerMs() const {
     return 1e5 / std::max(1e-9, m_gpu_theta[2]);
 }
 
-double LiwcPolicy::predictLocalMs(const WorkloadFrame& frame, double e1_deg) const {
+void LiwcPolicy::prepareFrame(const WorkloadFrame& frame) const {
+    m_cover_deg = m_sizes.coverDeg(frame.gaze);
+    auto prefix = [](const std::vector<double>& rings, std::vector<double>& out) {
+        out.resize(rings.size() + 1);
+        out[0] = 0.0;
+        for (size_t k = 0; k < rings.size(); ++k)
+            out[k + 1] = out[k] + rings[k];
+    };
+    prefix(frame.triangles_per_ring, m_prefix_tris);
+    prefix(frame.pixels_per_ring, m_prefix_pixels);
+}
+
+double LiwcPolicy::prefixAt(const std::vector<double>& prefix, double ring_deg, double e_deg) {
+    // The same sum as sumWithinDeg(), in O(1) from prefix sums.
+    const size_t rings = prefix.size() - 1;
+    if (e_deg <= 0.0 || rings == 0)
+        return 0.0;
+    const double r = e_deg / ring_deg;
+    const size_t whole = static_cast<size_t>(r);
+    if (whole >= rings)
+        return prefix[rings];
+    return prefix[whole] + (prefix[whole + 1] - prefix[whole]) * (r - static_cast<double>(whole));
+}
+
+double LiwcPolicy::localMs(double e1_deg) const {
     // Eq. 2: the fovea cone's work over the GPU's rate. The triangle count is the "hardware
     // intermediate data" available after geometry setup, before rendering; the rate is split
     // into a triangle rate and a fragment rate (plus a fixed cost) because a single
     // triangles-per-millisecond figure mispredicts by a third whenever a saccade moves the
     // fovea between dense geometry and plain surfaces (docs/LIWC.md).
-    const bool all = e1_deg >= m_sizes.coverDeg(frame.gaze);
-    const double tris = all ? sumTotal(frame.triangles_per_ring)
-                            : sumWithinDeg(frame.triangles_per_ring, m_header.ring_deg, e1_deg);
-    const double pixels = all ? sumTotal(frame.pixels_per_ring)
-                              : sumWithinDeg(frame.pixels_per_ring, m_header.ring_deg, e1_deg);
+    const double e = e1_deg >= m_cover_deg ? 1e9 : e1_deg;
+    const double tris = prefixAt(m_prefix_tris, m_header.ring_deg, e);
+    const double pixels = prefixAt(m_prefix_pixels, m_header.ring_deg, e);
     return std::max(0.0,
                     m_gpu_theta[0] + m_gpu_theta[1] * tris * 1e-5 + m_gpu_theta[2] * pixels * 1e-5);
 }
 
-double LiwcPolicy::predictRemoteMs(const WorkloadFrame& frame, double e1_deg) const {
+double LiwcPolicy::remoteMs(const Gaze& gaze, double e1_deg) const {
     // Eq. 2: the periphery's bytes over the throughput measured from acknowledgements.
-    if (e1_deg >= m_sizes.coverDeg(frame.gaze))
+    if (e1_deg >= m_cover_deg)
         return 0.0;
-    const PeripheryShape p = m_sizes.lookup(frame.gaze, e1_deg);
+    const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
     const double bits =
         2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
     return bits / m_throughput_bps * 1000.0;
+}
+
+double LiwcPolicy::predictLocalMs(const WorkloadFrame& frame, double e1_deg) const {
+    prepareFrame(frame);
+    return localMs(e1_deg);
+}
+
+double LiwcPolicy::predictRemoteMs(const WorkloadFrame& frame, double e1_deg) const {
+    prepareFrame(frame);
+    return remoteMs(frame.gaze, e1_deg);
 }
 
 Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
@@ -68,13 +100,14 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
     m_previous_gaze = frame.gaze;
     m_have_previous = true;
 
-    const double hi = std::min(m_config.e1_max_deg, m_sizes.coverDeg(frame.gaze));
+    prepareFrame(frame);
+    const double hi = std::min(m_config.e1_max_deg, m_cover_deg);
     const double lo = m_config.e1_min_deg;
     if (m_first_decision) {
         // Nothing measured yet: the first frame runs at the initial e1 (Fig. 14 starts at 5°).
         m_first_decision = false;
         m_e1_deg = std::clamp(m_config.e1_initial_deg, lo, std::max(lo, hi));
-        Decision d{m_e1_deg, predictLocalMs(frame, m_e1_deg), predictRemoteMs(frame, m_e1_deg)};
+        Decision d{m_e1_deg, localMs(m_e1_deg), remoteMs(frame.gaze, m_e1_deg)};
         m_pending_model_imbalance_ms = d.t_remote_pred_ms - d.t_local_pred_ms;
         m_pending_bucket = LiwcTable::bucketOf(m_e1_deg);
         m_pending = true;
@@ -87,8 +120,8 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
         LiwcCandidate& c = m_candidates[static_cast<size_t>(i)];
         c.delta_deg = i - 5;
         c.e1_deg = std::clamp(m_e1_deg + c.delta_deg, lo, std::max(lo, hi));
-        c.t_local_pred_ms = predictLocalMs(frame, c.e1_deg);
-        c.t_remote_pred_ms = predictRemoteMs(frame, c.e1_deg);
+        c.t_local_pred_ms = localMs(c.e1_deg);
+        c.t_remote_pred_ms = remoteMs(frame.gaze, c.e1_deg);
         c.offset_ms = m_table.offsetMs(m_motion, LiwcTable::bucketOf(c.e1_deg));
         if (std::fabs(c.imbalanceMs()) <
             std::fabs(m_candidates[static_cast<size_t>(best)].imbalanceMs()))
@@ -115,8 +148,8 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
     m_e1_deg = chosen;
     Decision d;
     d.e1_deg = chosen;
-    d.t_local_pred_ms = predictLocalMs(frame, chosen);
-    d.t_remote_pred_ms = predictRemoteMs(frame, chosen);
+    d.t_local_pred_ms = localMs(chosen);
+    d.t_remote_pred_ms = remoteMs(frame.gaze, chosen);
     m_pending_model_imbalance_ms = d.t_remote_pred_ms - d.t_local_pred_ms;
     m_pending_bucket = LiwcTable::bucketOf(chosen);
     m_pending = true;

@@ -68,6 +68,16 @@ public:
 
 private:
     void updateGpuRates(double triangles, double pixels, double t_local_ms);
+    // Per-frame quantities every candidate shares: computed once in decide().
+    void prepareFrame(const WorkloadFrame& frame) const;
+    double localMs(double e1_deg) const;
+    double remoteMs(const Gaze& gaze, double e1_deg) const;
+    static double prefixAt(const std::vector<double>& prefix, double ring_deg, double e_deg);
+
+    // A cache of the frame being decided, so mutable.
+    mutable double m_cover_deg = 90.0;
+    mutable std::vector<double> m_prefix_tris;  // [k] = triangles in rings < k
+    mutable std::vector<double> m_prefix_pixels;
 
     const WorkloadHeader& m_header;
     LiwcConfig m_config;
