@@ -1,0 +1,94 @@
+// `qvr eval`: the paper's evaluation (§6: Fig. 12–15, Table 4) over the Table 3 suite, with
+// CSV, gnuplot figures, summary.json and report.html in one folder.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "qvr/sim/evaluation.h"
+
+namespace qvr::cli {
+
+namespace {
+
+struct EvalCliOptions {
+    int frames = 400;
+    int jobs = 2;
+    std::string out;
+};
+
+std::string joinArgs(const EvalCliOptions& o) {
+    return fmt::format("qvr eval --frames {} --jobs {} --out {}", o.frames, o.jobs, o.out);
+}
+
+int runEval(const EvalCliOptions& o) {
+    if (o.frames < 30 || o.frames > 100'000) {
+        std::fprintf(stderr, "qvr eval: --frames must be within 30..100000, got %d\n", o.frames);
+        return 2;
+    }
+    if (o.jobs < 1 || o.jobs > 256) {
+        std::fprintf(stderr, "qvr eval: --jobs must be within 1..256, got %d\n", o.jobs);
+        return 2;
+    }
+    EvalOptions opts;
+    opts.frames = o.frames;
+    opts.jobs = o.jobs;
+    opts.out_dir = o.out;
+    opts.command_line = joinArgs(o);
+    const bool tty = isatty(fileno(stderr)) != 0;
+    if (tty) {
+        opts.progress = [](int done, int total) {
+            constexpr int kWidth = 40;
+            const int filled = total > 0 ? done * kWidth / total : kWidth;
+            std::fprintf(stderr, "\r[%s%s] %d/%d runs",
+                         std::string(static_cast<size_t>(filled), '#').c_str(),
+                         std::string(static_cast<size_t>(kWidth - filled), ' ').c_str(), done,
+                         total);
+            if (done == total)
+                std::fprintf(stderr, "\n");
+            std::fflush(stderr);
+        };
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    auto result = runEvaluation(opts);
+    if (!result) {
+        std::fprintf(stderr, "qvr eval: %s\n", result.error().c_str());
+        return 1;
+    }
+    const double secs =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    fmt::print("{} runs in {:.1f} s; {}\n", result->runs.size(), secs, result->plot_note);
+    fmt::print("{:<50} {:>8} {:>8}\n", "headline", "paper", "ours");
+    for (const auto& h : result->headlines)
+        fmt::print("{:<50} {:>7.2f}{} {:>7.2f}{}\n", h.metric, h.paper, h.unit, h.ours, h.unit);
+    for (const auto& f : result->findings)
+        fmt::print("[{}] {}: {}\n", f.holds ? "holds" : "FAILS", f.name, f.detail);
+    fmt::print("report: {}/report.html\n", o.out);
+    return 0;
+}
+
+}  // namespace
+
+static Registered registerEval(CLI::App& app) {
+    auto o = std::make_shared<EvalCliOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "eval", "Run the paper's experiments (Fig. 12-15, Table 4) on the synthetic suite");
+    cmd->add_option("--frames", o->frames,
+                    "Frames per run (30..100000); Fig. 14 always gets at least 300")
+        ->capture_default_str();
+    cmd->add_option("--jobs", o->jobs, "Runs simulated in parallel (threads)")
+        ->capture_default_str();
+    cmd->add_option("--out", o->out,
+                    "Output folder: CSV + PNG per experiment, summary.json, report.html")
+        ->required();
+    return {cmd, [o]() { return runEval(*o); }};
+}
+
+QVR_REGISTER_COMMAND(50, registerEval);
+
+}  // namespace qvr::cli

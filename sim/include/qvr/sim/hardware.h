@@ -1,0 +1,92 @@
+// The headset and server hardware the simulator times frames on (paper Table 2, §4.3, §5): a
+// mobile GPU whose rates scale with its clock, two UCA units, a video decoder, a CPU for the
+// control logic, and a multi-GPU render server. Every constant's source is in docs/MODEL.md.
+#pragma once
+
+#include "qvr/workload/cost_model.h"
+
+namespace qvr {
+
+// The mobile GPU beyond its render rates (GpuModel): the screen-space passes composition and
+// ATW run as, and its power. Table 2: 8 unified shaders, one texture unit each; a bilinear
+// texture unit returns one filtered sample per cycle, so a full-screen filtering pass is bound
+// by 8 samples per cycle.
+struct MobileGpuConfig {
+    GpuModel render;                          // freq_mhz lives here
+    double texture_units = 8.0;               // Table 2: 8 shaders × 1 texture unit
+    double samples_per_unit_per_cycle = 1.0;  // bilinear filter throughput of one unit
+    double pass_overhead_ms = 0.1;            // kernel launch + tile-buffer flush per pass
+    double preempt_overhead_ms = 0.05;        // context save/restore when a pass preempts LR
+    double atw_samples_per_px = 1.0;          // one distorted bilinear fetch per output pixel
+    double comp_samples_per_px = 1.0;         // foveated: each pixel reads the layer covering it
+    double static_comp_samples_per_px = 2.0;  // static: background colour + depth per pixel
+    // Power: P_dyn = P_dyn_ref · (f / f_ref) · (V(f) / V(f_ref))², V(f) = v0 + v_slope · f.
+    double dynamic_power_w_at_500 = 2.5;
+    double static_power_w_at_500 = 0.3;  // leakage, ∝ V
+    double v0 = 0.55;
+    double v_per_mhz = 0.0005;
+
+    double samplesPerMs() const;
+    // One full-screen pass over `pixels` output pixels at `samples_per_px` texture fetches each.
+    double passMs(double pixels, double samples_per_px) const;
+    double voltage(double freq_mhz) const { return v0 + v_per_mhz * freq_mhz; }
+    double dynamicPowerW() const;
+    double staticPowerW() const;
+};
+
+// The Unified Composition and ATW unit (§4.2–4.3): 532 cycles per 32×32 tile, two units at
+// 500 MHz, 94 mW each while busy.
+struct UcaConfig {
+    int units = 2;
+    double freq_mhz = 500.0;
+    double cycles_per_tile = 532.0;
+    int tile_px = 32;
+    double power_w = 0.094;
+
+    double tileMs() const { return cycles_per_tile / (freq_mhz * 1e3); }  // one tile, one unit
+    // Wall time for `tiles` tiles spread over all units.
+    double wallMs(double tiles) const { return tiles * tileMs() / units; }
+};
+
+// LIWC (§4.1, §4.3): a table lookup in nanoseconds, 25 mW.
+struct LiwcHwConfig {
+    double decision_ms = 100e-6;  // 100 ns
+    double power_w = 0.025;
+};
+
+// The headset's hardware video decoder and the server's render and encode rates. The server is
+// the chiplet multi-GPU of [64]; its render, the encode, the transfer and the decode stream in
+// parallel, so a frame's remote latency is the largest of them (§2.3).
+struct RemoteConfig {
+    double server_speedup = 64.0;          // 8 GPU modules × 8× one mobile GPU at 500 MHz
+    double encoder_px_per_ms = 1.0e6;      // per stream; each layer of each eye is its own stream
+    double decoder_px_per_ms = 531'000.0;  // 4096×2160 at 60 fps
+    double decode_overhead_ms = 0.2;
+};
+
+// The CPU's per-frame work (Fig. 4 CL and LS).
+struct CpuConfig {
+    double control_logic_ms = 1.0;     // application logic on the new pose
+    double local_setup_ms = 0.5;       // command buffers for the local layer, issue remote fetch
+    double software_control_ms = 0.3;  // sw design: read back GPU timers, pick e1 on the CPU
+};
+
+// Fixed latencies outside the pipeline (§5): sensor to engine, and display scan-out.
+struct FixedLatencies {
+    double sensor_ms = 2.0;
+    double display_ms = 5.0;
+};
+
+struct HardwareConfig {
+    MobileGpuConfig gpu;
+    UcaConfig uca;
+    LiwcHwConfig liwc;
+    RemoteConfig remote;
+    CpuConfig cpu;
+    FixedLatencies fixed;
+};
+
+// The defaults of docs/MODEL.md at a given GPU clock.
+HardwareConfig defaultHardware(double gpu_mhz = 500.0);
+
+}  // namespace qvr

@@ -1,0 +1,129 @@
+// The headset's downlink (paper §5, Table 2): constant-rate profiles (Wi-Fi 200 Mbps, 4G LTE
+// 100 Mbps, early 5G 500 Mbps) with 20 dB SNR white noise on the throughput, and trace-driven
+// links replaying Mahimahi capacity traces. One calibration, from Table 1, turns nominal
+// capacity into the goodput a frame sees. Models and sources: docs/MODEL.md.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "qvr/core/expected.h"
+
+namespace qvr {
+
+// One row of Table 1: the static design's background size and its measured T_remote on Wi-Fi.
+struct Table1Row {
+    const char* app;
+    double background_bytes;  // KB as printed, taken as 1000 bytes
+    double t_remote_ms;
+};
+const std::vector<Table1Row>& table1Rows();
+
+// The share of nominal capacity a frame's payload gets (protocol headers, MAC contention,
+// codec framing), fitted by least squares over Table 1 at Wi-Fi's 200 Mbps: T = bits / (η·C).
+double calibratedLinkEfficiency();
+
+// Radio energy as Huang et al. (MobiSys 2012) model an active interface: P = α·R + β, so a
+// transfer of b bits at goodput R costs b·(α + β/R).
+struct RadioPower {
+    double alpha_mw_per_mbps = 0.0;
+    double beta_mw = 0.0;
+    double energyPerBitNj(double goodput_bps) const;
+};
+
+struct LinkTransfer {
+    double duration_ms = 0.0;
+    double goodput_bps = 0.0;  // payload bits / duration, what acknowledgements measure
+};
+
+// A downlink the simulator sends frames over. A transfer is timed from its start, so
+// trace-driven links see the capacity of that moment.
+class Link {
+public:
+    virtual ~Link() = default;
+    virtual std::string_view name() const = 0;
+    virtual double meanGoodputBps() const = 0;
+    virtual double nominalBps() const = 0;
+    virtual LinkTransfer transfer(double start_ms, double payload_bytes) = 0;
+    virtual const RadioPower& radio() const = 0;
+};
+
+// Constant capacity C with white noise: each transfer sees goodput η·C·(1 + σ·n), n ~ N(0,1),
+// σ = 10^(−SNR/20) (noise amplitude relative to the signal for the given power ratio), floored
+// at 5% of the mean so a deep fade stalls rather than reverses. snr_db = +inf turns it off.
+class NoisyLink final : public Link {
+public:
+    NoisyLink(std::string name, double nominal_bps, double efficiency, double snr_db,
+              RadioPower radio, uint64_t seed);
+    std::string_view name() const override { return m_name; }
+    double meanGoodputBps() const override { return m_nominal_bps * m_efficiency; }
+    double nominalBps() const override { return m_nominal_bps; }
+    LinkTransfer transfer(double start_ms, double payload_bytes) override;
+    const RadioPower& radio() const override { return m_radio; }
+    double noiseSigma() const { return m_sigma; }
+
+private:
+    std::string m_name;
+    double m_nominal_bps;
+    double m_efficiency;
+    double m_sigma;
+    RadioPower m_radio;
+    std::mt19937_64 m_rng;
+    std::normal_distribution<double> m_normal{0.0, 1.0};
+};
+
+// A Mahimahi capacity trace: one integer a line, the millisecond at which one 1500-byte packet
+// may leave; repeated stamps are several packets in that millisecond; the trace loops.
+struct MahimahiTrace {
+    std::vector<double> opportunities_ms;  // non-decreasing
+    double period_ms = 0.0;                // the last stamp: the loop length
+    double meanBps() const;
+};
+inline constexpr double kMahimahiPacketBytes = 1500.0;
+inline constexpr int64_t kMaxMahimahiLines = 50'000'000;
+
+// Grammar (untrusted): lines of decimal digits (optional surrounding spaces, optional CR),
+// values ≤ 1e9 and non-decreasing; empty lines skipped; at least one line, last stamp > 0.
+Expected<MahimahiTrace> parseMahimahiTrace(std::string_view text, const std::string& source);
+Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path);
+
+// Replays a trace rescaled to a target mean capacity: every stamp divided by
+// target_mean / trace_mean. A payload of B bytes occupies ceil(B / (η·1500)) opportunities.
+class TraceLink final : public Link {
+public:
+    TraceLink(std::string name, MahimahiTrace trace, double target_mean_bps, double efficiency,
+              RadioPower radio);
+    std::string_view name() const override { return m_name; }
+    double meanGoodputBps() const override { return m_target_mean_bps * m_efficiency; }
+    double nominalBps() const override { return m_target_mean_bps; }
+    LinkTransfer transfer(double start_ms, double payload_bytes) override;
+    const RadioPower& radio() const override { return m_radio; }
+    double timeScale() const { return m_time_scale; }
+
+private:
+    std::string m_name;
+    MahimahiTrace m_trace;  // rescaled stamps
+    double m_target_mean_bps;
+    double m_efficiency;
+    double m_time_scale;
+    RadioPower m_radio;
+};
+
+// Network profiles by name: "wifi", "lte", "5g", or "trace:PATH[@MBPS]" (a Mahimahi file
+// rescaled to MBPS, by default the LTE profile's 100 Mbps; cellular radio power).
+struct NetworkSpec {
+    std::string name;
+    double nominal_bps = 0.0;
+    double snr_db = 20.0;
+    RadioPower radio;
+    std::string trace_path;  // empty for constant-rate profiles
+};
+Expected<NetworkSpec> networkSpecByName(const std::string& name);
+const std::vector<std::string>& networkNames();  // the built-in profiles
+Expected<std::unique_ptr<Link>> makeLink(const NetworkSpec& spec, uint64_t seed);
+
+}  // namespace qvr

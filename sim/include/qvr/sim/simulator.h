@@ -1,0 +1,114 @@
+// The trace-driven pipeline simulator (paper §2.3 Fig. 4, §5): each frame of a workload trace
+// becomes timed tasks on the headset's units (CPU, mobile GPU, LIWC, UCA, video decoder,
+// display), the link and the server, with the overlaps of Fig. 4; the design decides what runs
+// where and which policy sizes the fovea. Metrics follow §6's definitions.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "qvr/controller/policy.h"
+#include "qvr/sim/design.h"
+#include "qvr/sim/hardware.h"
+#include "qvr/sim/network.h"
+#include "qvr/workload/workload.h"
+
+namespace qvr {
+
+struct SimConfig {
+    std::string bench;  // a label for the records
+    Design design = Design::Qvr;
+    HardwareConfig hardware = defaultHardware(500.0);
+    int frames = 300;  // clamped to the trace's length
+};
+
+// Energy of one frame (Fig. 15), millijoules; total() is their sum and nothing else.
+struct FrameEnergy {
+    double gpu_dynamic_mj = 0.0;  // dynamic power × GPU busy time
+    double gpu_static_mj = 0.0;   // leakage × frame period
+    double radio_mj = 0.0;        // received bits × energy per bit at the measured goodput
+    double uca_mj = 0.0;          // 94 mW × unit-busy time
+    double liwc_mj = 0.0;         // 25 mW × frame period
+    double total() const { return gpu_dynamic_mj + gpu_static_mj + radio_mj + uca_mj + liwc_mj; }
+};
+
+struct FrameRecord {
+    int64_t index = 0;
+    double e1_deg = 0.0;  // 0 for designs without a fovea
+    double e2_deg = 0.0;
+    // Event times, ms from the first frame's control logic.
+    double start_ms = 0.0;  // control logic begins (the pose has arrived)
+    double request_ms = 0.0;
+    double render_start_ms = 0.0;
+    double render_end_ms = 0.0;
+    double remote_ready_ms = 0.0;
+    double display_ready_ms = 0.0;  // composition + ATW done
+    // Durations.
+    double render_work_ms = 0.0;  // local render at the GPU's rate, no interruptions
+    double t_local_ms = 0.0;      // render start → end as measured, preemptions included
+    double t_remote_ms = 0.0;     // request → remote layers decoded
+    double net_ms = 0.0;          // transmission alone
+    double server_render_ms = 0.0;
+    double encode_ms = 0.0;
+    double decode_ms = 0.0;
+    double comp_ms = 0.0;  // on the GPU
+    double atw_ms = 0.0;   // on the GPU
+    double uca_ms = 0.0;   // UCA wall time (both units)
+    double gpu_ms = 0.0;   // T_GPU: GPU busy time this frame
+    int preemptions = 0;
+    double bytes = 0.0;
+    double goodput_bps = 0.0;
+    double shaded_pixels = 0.0;  // both eyes, every layer at its own resolution
+    double mtp_ms = 0.0;         // 2 ms sensor + pipeline + 5 ms display
+    double fps = 0.0;            // min(1/T_GPU, 1/T_network)
+    double latency_ratio = 0.0;  // T_remote / T_local, 0 when either is absent
+    FrameEnergy energy;
+};
+
+struct RunSummary {
+    std::string bench;
+    std::string design;
+    double gpu_mhz = 0.0;
+    std::string net;
+    int frames = 0;
+    double mtp_ms_mean = 0.0;
+    double mtp_ms_p99 = 0.0;
+    double fps_mean = 0.0;      // 1000 / mean(max(T_GPU, T_network))
+    double fps_pipeline = 0.0;  // frames displayed per second in the event timeline
+    double bytes_per_frame_mean = 0.0;
+    double pixels_per_frame_mean = 0.0;
+    double energy_mj_per_frame = 0.0;
+    FrameEnergy energy_mean;
+    double e1_deg_mean = 0.0;
+    double e1_deg_steady = 0.0;        // mean over frames after the warm-up
+    double latency_ratio_final = 0.0;  // median over the last 30 frames
+    double t_local_ms_mean = 0.0;
+    double t_remote_ms_mean = 0.0;
+    double gpu_ms_mean = 0.0;
+    double net_ms_mean = 0.0;
+    double preemptions_per_frame = 0.0;
+    bool meets_refresh = false;  // fps_mean ≥ the HMD's refresh rate
+};
+
+struct RunResult {
+    std::vector<FrameRecord> frames;
+    RunSummary summary;
+};
+
+// The first frame from which a run counts as steady (Table 4 averages after it).
+int steadyStateStart(int frames);
+
+// The policy a design uses, built by name; nullptr for designs without a fovea.
+Expected<std::unique_ptr<FoveaPolicy>> makeDesignPolicy(Design design, const WorkloadHeader& header,
+                                                        const CostModel& truth,
+                                                        double link_nominal_bps);
+
+// Runs one design over a trace on a link. The trace must outlive the call.
+RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& link);
+
+RunSummary summarize(const std::vector<FrameRecord>& frames, const SimConfig& config,
+                     const std::string& net_name, double refresh_hz);
+
+}  // namespace qvr

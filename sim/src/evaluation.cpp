@@ -1,0 +1,656 @@
+// The experiments of the paper's §6 (Fig. 12–15, Table 4) over the Table 3 suite: run grid,
+// CSV, gnuplot figures, report.html and summary.json.
+#include "qvr/sim/evaluation.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "qvr/sim/benches.h"
+
+namespace qvr {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kDefaultMhz = 500.0;
+const std::vector<double> kFreqsMhz = {500.0, 400.0, 300.0};
+const std::vector<std::string> kNets = {"wifi", "lte", "5g"};
+constexpr int kFig14Frames = 300;
+
+struct Job {
+    size_t bench = 0;
+    Design design = Design::Qvr;
+    double gpu_mhz = kDefaultMhz;
+    std::string net = "wifi";
+    bool keep_frames = false;
+};
+
+struct JobResult {
+    RunSummary summary;
+    std::vector<FrameRecord> frames;  // only when kept
+};
+
+std::string key(const std::string& bench, std::string_view design, double mhz,
+                const std::string& net) {
+    return fmt::format("{}|{}|{}|{}", bench, design, static_cast<int>(mhz), net);
+}
+
+double mean(const std::vector<double>& v) {
+    if (v.empty())
+        return 0.0;
+    double s = 0.0;
+    for (double x : v)
+        s += x;
+    return s / static_cast<double>(v.size());
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) {
+        if (c == '\'')
+            out += "'\\''";
+        else
+            out += c;
+    }
+    return out + "'";
+}
+
+Status writeText(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out)
+        return makeError(fmt::format("cannot write '{}'", path.string()));
+    out << text;
+    if (!out)
+        return makeError(fmt::format("error writing '{}'", path.string()));
+    return Status::success();
+}
+
+nlohmann::json runJson(const RunSummary& s) {
+    return {{"bench", s.bench},
+            {"design", s.design},
+            {"gpu_mhz", s.gpu_mhz},
+            {"net", s.net},
+            {"frames", s.frames},
+            {"mtp_ms_mean", s.mtp_ms_mean},
+            {"mtp_ms_p99", s.mtp_ms_p99},
+            {"fps_mean", s.fps_mean},
+            {"fps_pipeline", s.fps_pipeline},
+            {"bytes_per_frame_mean", s.bytes_per_frame_mean},
+            {"pixels_per_frame_mean", s.pixels_per_frame_mean},
+            {"energy_mj_per_frame", s.energy_mj_per_frame},
+            {"energy_mj_breakdown",
+             {{"gpu_dynamic", s.energy_mean.gpu_dynamic_mj},
+              {"gpu_static", s.energy_mean.gpu_static_mj},
+              {"radio", s.energy_mean.radio_mj},
+              {"uca", s.energy_mean.uca_mj},
+              {"liwc", s.energy_mean.liwc_mj}}},
+            {"e1_deg_mean", s.e1_deg_mean},
+            {"e1_deg_steady", s.e1_deg_steady},
+            {"latency_ratio_final", s.latency_ratio_final},
+            {"t_local_ms_mean", s.t_local_ms_mean},
+            {"t_remote_ms_mean", s.t_remote_ms_mean},
+            {"gpu_ms_mean", s.gpu_ms_mean},
+            {"net_ms_mean", s.net_ms_mean},
+            {"preemptions_per_frame", s.preemptions_per_frame},
+            {"meets_refresh", s.meets_refresh}};
+}
+
+// Runs gnuplot on a script; tries pngcairo, then the libgd png terminal.
+bool runGnuplot(const fs::path& script_path, const std::string& body, std::string& terminal) {
+    for (const char* term : {"pngcairo", "png"}) {
+        const std::string script =
+            fmt::format("set terminal {} size 1100,520 {}\n{}", term,
+                        std::string(term) == "pngcairo" ? "font 'sans,10'" : "", body);
+        if (!writeText(script_path, script))
+            return false;
+        // Scripts name their CSV files relative to the output folder.
+        const std::string cmd = "cd " + shellQuote(script_path.parent_path().string()) +
+                                " && gnuplot " + shellQuote(script_path.filename().string()) +
+                                " 2>/dev/null";
+        if (std::system(cmd.c_str()) == 0) {
+            terminal = term;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool gnuplotAvailable() {
+    return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+}
+
+std::string fmtNum(double v, int prec = 2) {
+    return fmt::format("{:.{}f}", v, prec);
+}
+
+}  // namespace
+
+Status writeSummaryJson(const std::string& path, const std::vector<RunSummary>& runs) {
+    nlohmann::json j;
+    j["runs"] = nlohmann::json::array();
+    for (const auto& r : runs)
+        j["runs"].push_back(runJson(r));
+    j["notes"] = {
+        {"mtp_ms", "2 ms sensor + control logic to end of composition/ATW + 5 ms display"},
+        {"fps", "1000 / mean over frames of max(T_GPU, T_network) (paper: min(1/T_GPU, 1/T_net))"},
+        {"bytes", "downlink payload per frame"},
+        {"pixels", "shaded pixels per frame, both eyes, each layer at its own resolution"},
+        {"latency_ratio_final", "median T_remote/T_local over the last 30 frames"},
+        {"e1_deg_steady", "mean e1 after the warm-up (Table 4)"}};
+    return writeText(path, j.dump(2) + "\n");
+}
+
+Status writeFramesCsv(const std::string& path, const std::vector<FrameRecord>& frames) {
+    std::string s =
+        "frame,e1_deg,e2_deg,start_ms,render_start_ms,render_end_ms,remote_ready_ms,"
+        "display_ready_ms,render_work_ms,t_local_ms,t_remote_ms,net_ms,server_render_ms,"
+        "encode_ms,decode_ms,comp_ms,atw_ms,uca_ms,gpu_ms,preemptions,bytes,goodput_bps,"
+        "shaded_pixels,mtp_ms,fps,latency_ratio,energy_gpu_dynamic_mj,energy_gpu_static_mj,"
+        "energy_radio_mj,energy_uca_mj,energy_liwc_mj,energy_total_mj\n";
+    for (const FrameRecord& r : frames) {
+        s += fmt::format(
+            "{},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},"
+            "{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.0f},{:.0f},{:.0f},{:.4f},"
+            "{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}\n",
+            r.index, r.e1_deg, r.e2_deg, r.start_ms, r.render_start_ms, r.render_end_ms,
+            r.remote_ready_ms, r.display_ready_ms, r.render_work_ms, r.t_local_ms, r.t_remote_ms,
+            r.net_ms, r.server_render_ms, r.encode_ms, r.decode_ms, r.comp_ms, r.atw_ms, r.uca_ms,
+            r.gpu_ms, r.preemptions, r.bytes, r.goodput_bps, r.shaded_pixels, r.mtp_ms, r.fps,
+            r.latency_ratio, r.energy.gpu_dynamic_mj, r.energy.gpu_static_mj, r.energy.radio_mj,
+            r.energy.uca_mj, r.energy.liwc_mj, r.energy.total());
+    }
+    return writeText(path, s);
+}
+
+Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
+    if (options.frames < 30 || options.frames > 100'000)
+        return makeError(fmt::format("--frames must be in 30..100000, got {}", options.frames));
+    if (options.jobs < 1 || options.jobs > 256)
+        return makeError(fmt::format("--jobs must be in 1..256, got {}", options.jobs));
+    std::error_code ec;
+    fs::create_directories(options.out_dir, ec);
+    if (ec)
+        return makeError(fmt::format("cannot create '{}': {}", options.out_dir, ec.message()));
+    const fs::path out(options.out_dir);
+
+    const std::vector<BenchInfo> benches = suiteBenches();
+    const int frames = std::max(options.frames, kFig14Frames);
+    std::vector<WorkloadTrace> traces(benches.size());
+    for (size_t i = 0; i < benches.size(); ++i) {
+        auto t = makeSuiteBench(benches[i].name, frames);
+        if (!t)
+            return makeError(t.error());
+        traces[i] = std::move(*t);
+    }
+
+    // The grid: every design at the default point (Fig. 12–14); Q-VR at every frequency ×
+    // network (Table 4, Fig. 15); the local baseline at every frequency (Fig. 15's reference).
+    std::vector<Job> jobs;
+    for (size_t b = 0; b < benches.size(); ++b) {
+        for (Design d : allDesigns())
+            jobs.push_back({b, d, kDefaultMhz, "wifi", d == Design::Qvr});
+        for (double mhz : kFreqsMhz) {
+            for (const auto& net : kNets) {
+                if (mhz == kDefaultMhz && net == "wifi")
+                    continue;
+                jobs.push_back({b, Design::Qvr, mhz, net, false});
+            }
+            if (mhz != kDefaultMhz)
+                jobs.push_back({b, Design::Local, mhz, "wifi", false});
+        }
+    }
+
+    std::vector<JobResult> results(jobs.size());
+    std::atomic<size_t> next{0};
+    std::atomic<int> done{0};
+    std::mutex progress_mutex;
+    std::mutex error_mutex;
+    std::string first_error;
+    auto worker = [&]() {
+        for (;;) {
+            const size_t i = next.fetch_add(1);
+            if (i >= jobs.size())
+                return;
+            const Job& job = jobs[i];
+            auto spec = networkSpecByName(job.net);
+            std::unique_ptr<Link> link;
+            if (spec) {
+                // One noise sequence per bench × network, shared by every design.
+                auto l =
+                    makeLink(*spec, 1000 * (job.bench + 1) + static_cast<uint64_t>(job.net.size()));
+                if (l)
+                    link = std::move(*l);
+            }
+            if (!link) {
+                std::lock_guard<std::mutex> lock(error_mutex);
+                if (first_error.empty())
+                    first_error = "cannot build network " + job.net;
+                continue;
+            }
+            SimConfig cfg;
+            cfg.bench = benches[job.bench].name;
+            cfg.design = job.design;
+            cfg.hardware = defaultHardware(job.gpu_mhz);
+            cfg.frames = options.frames;
+            if (job.keep_frames)
+                cfg.frames = frames;
+            RunResult run = simulate(traces[job.bench], cfg, *link);
+            results[i].summary = run.summary;
+            if (job.keep_frames)
+                results[i].frames = std::move(run.frames);
+            const int d = done.fetch_add(1) + 1;
+            if (options.progress) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                options.progress(d, static_cast<int>(jobs.size()));
+            }
+        }
+    };
+    {
+        std::vector<std::thread> pool;
+        const int n_threads = std::min<int>(options.jobs, static_cast<int>(jobs.size()));
+        for (int t = 0; t < n_threads; ++t)
+            pool.emplace_back(worker);
+        for (auto& t : pool)
+            t.join();
+    }
+    if (!first_error.empty())
+        return makeError(first_error);
+
+    EvalOutput output;
+    std::map<std::string, const JobResult*> by_key;
+    for (size_t i = 0; i < jobs.size(); ++i) {
+        output.runs.push_back(results[i].summary);
+        by_key[key(benches[jobs[i].bench].name, traitsOf(jobs[i].design).name, jobs[i].gpu_mhz,
+                   jobs[i].net)] = &results[i];
+    }
+    auto get = [&](size_t b, Design d, double mhz = kDefaultMhz,
+                   const std::string& net = "wifi") -> const RunSummary& {
+        return by_key.at(key(benches[b].name, traitsOf(d).name, mhz, net))->summary;
+    };
+    const size_t nb = benches.size();
+    const std::vector<Design> compared = {Design::Remote, Design::Static, Design::Ffr,
+                                          Design::Dfr,    Design::Sw,     Design::Qvr};
+    const bool have_gnuplot = gnuplotAvailable();
+    std::string terminal;
+    int plots_ok = 0, plots_tried = 0;
+    auto plot = [&](const std::string& name, const std::string& body) {
+        if (!have_gnuplot)
+            return;
+        ++plots_tried;
+        const std::string full = fmt::format("set output '{}.png'\n{}", name, body);
+        if (runGnuplot(out / (name + ".gp"), full, terminal)) {
+            ++plots_ok;
+            output.files.push_back(name + ".png");
+        }
+        output.files.push_back(name + ".gp");
+    };
+    auto csv = [&](const std::string& name, const std::string& text) -> Status {
+        output.files.push_back(name);
+        return writeText(out / name, text);
+    };
+
+    // Fig. 12: end-to-end speedup over local; FPS of sw and qvr over local.
+    std::string fig12 = "bench,label";
+    for (Design d : compared)
+        fig12 += fmt::format(",{}", traitsOf(d).name);
+    fig12 += ",fps_sw_over_local,fps_qvr_over_local\n";
+    std::map<Design, std::vector<double>> speedups;
+    std::vector<double> fps_sw, fps_qvr, fps_qvr_over_static, fps_qvr_over_sw;
+    for (size_t b = 0; b < nb; ++b) {
+        const RunSummary& local = get(b, Design::Local);
+        fig12 += fmt::format("{},{}", benches[b].name, benches[b].label);
+        for (Design d : compared) {
+            const double s = local.mtp_ms_mean / get(b, d).mtp_ms_mean;
+            speedups[d].push_back(s);
+            fig12 += "," + fmtNum(s, 4);
+        }
+        const double fs = get(b, Design::Sw).fps_mean / local.fps_mean;
+        const double fq = get(b, Design::Qvr).fps_mean / local.fps_mean;
+        fps_sw.push_back(fs);
+        fps_qvr.push_back(fq);
+        fps_qvr_over_static.push_back(get(b, Design::Qvr).fps_mean /
+                                      get(b, Design::Static).fps_mean);
+        fps_qvr_over_sw.push_back(get(b, Design::Qvr).fps_mean / get(b, Design::Sw).fps_mean);
+        fig12 += fmt::format(",{},{}\n", fmtNum(fs, 4), fmtNum(fq, 4));
+    }
+    if (auto st = csv("fig12_speedup.csv", fig12); !st)
+        return makeError(st.error());
+    plot("fig12",
+         "set datafile separator ','\nset title 'Fig. 12: end-to-end speedup over local (500 MHz, "
+         "Wi-Fi)'\nset style data histogram\nset style histogram clustered gap 1\n"
+         "set style fill solid 0.8 border -1\nset key outside right\nset ylabel 'speedup (x)'\n"
+         "set y2label 'FPS over local (x)'\nset y2tics\nset ytics nomirror\nset grid ytics\n"
+         "plot for [i=3:8] 'fig12_speedup.csv' using i:xtic(2) title columnheader(i), "
+         "'' using 0:9 with linespoints lw 2 axes x1y2 title 'SW-FPS', "
+         "'' using 0:10 with linespoints lw 2 axes x1y2 title 'Q-VR-FPS'\n");
+
+    // Fig. 13: transmitted data and shaded resolution normalised to remote.
+    std::string fig13 = "bench,label";
+    for (Design d : compared)
+        fig13 += fmt::format(",data_{}", traitsOf(d).name);
+    for (Design d : compared)
+        fig13 += fmt::format(",pixels_{}", traitsOf(d).name);
+    fig13 += "\n";
+    std::vector<double> data_qvr_over_static, pixels_qvr;
+    for (size_t b = 0; b < nb; ++b) {
+        const RunSummary& remote = get(b, Design::Remote);
+        fig13 += fmt::format("{},{}", benches[b].name, benches[b].label);
+        for (Design d : compared)
+            fig13 += "," + fmtNum(get(b, d).bytes_per_frame_mean / remote.bytes_per_frame_mean, 4);
+        for (Design d : compared)
+            fig13 +=
+                "," + fmtNum(get(b, d).pixels_per_frame_mean / remote.pixels_per_frame_mean, 4);
+        fig13 += "\n";
+        data_qvr_over_static.push_back(get(b, Design::Qvr).bytes_per_frame_mean /
+                                       get(b, Design::Static).bytes_per_frame_mean);
+        pixels_qvr.push_back(get(b, Design::Qvr).pixels_per_frame_mean /
+                             remote.pixels_per_frame_mean);
+    }
+    if (auto st = csv("fig13_data_resolution.csv", fig13); !st)
+        return makeError(st.error());
+    plot("fig13",
+         "set datafile separator ','\nset multiplot layout 1,2 title 'Fig. 13: normalised to "
+         "remote (500 MHz, Wi-Fi)'\nset style data histogram\nset style histogram clustered gap "
+         "1\nset style fill solid 0.8 border -1\nset key top left font ',8'\nset grid ytics\n"
+         "set title 'transmitted data'\nplot for [i=3:8] 'fig13_data_resolution.csv' using "
+         "i:xtic(2) title columnheader(i)\nset title 'shaded resolution'\nplot for [i=9:14] "
+         "'fig13_data_resolution.csv' using i:xtic(2) title columnheader(i)\nunset multiplot\n");
+
+    // Fig. 14: latency ratio and FPS over 300 frames from e1 = 5°.
+    {
+        std::string ratio = "frame", fpsf = "frame";
+        for (const auto& b : benches) {
+            ratio += "," + b.label;
+            fpsf += "," + b.label;
+        }
+        ratio += "\n";
+        fpsf += "\n";
+        for (int f = 0; f < kFig14Frames; ++f) {
+            ratio += std::to_string(f);
+            fpsf += std::to_string(f);
+            for (size_t b = 0; b < nb; ++b) {
+                const auto& fr =
+                    by_key.at(key(benches[b].name, "qvr", kDefaultMhz, "wifi"))->frames;
+                const FrameRecord* r =
+                    f < static_cast<int>(fr.size()) ? &fr[static_cast<size_t>(f)] : nullptr;
+                ratio += "," + (r ? fmtNum(r->latency_ratio, 4) : std::string());
+                fpsf += "," + (r ? fmtNum(r->fps, 2) : std::string());
+            }
+            ratio += "\n";
+            fpsf += "\n";
+        }
+        if (auto st = csv("fig14_latency_ratio.csv", ratio); !st)
+            return makeError(st.error());
+        if (auto st = csv("fig14_fps.csv", fpsf); !st)
+            return makeError(st.error());
+        plot("fig14",
+             fmt::format("set datafile separator ','\nset multiplot layout 1,2 title 'Fig. 14: "
+                         "Q-VR over {} frames from e1 = 5 deg (500 MHz, Wi-Fi)'\nset key top "
+                         "right font ',8'\nset grid\nset xlabel 'frame'\nset title '(a) latency "
+                         "ratio T_{{remote}}/T_{{local}}'\nset logscale y\nplot for [i=2:{}] "
+                         "'fig14_latency_ratio.csv' using 1:i with lines title columnheader(i)\n"
+                         "unset logscale y\nset title '(b) FPS'\nplot for [i=2:{}] "
+                         "'fig14_fps.csv' using 1:i with lines title columnheader(i), 90 with "
+                         "lines dt 2 lc rgb 'black' title '90 Hz'\nunset multiplot\n",
+                         kFig14Frames, nb + 1, nb + 1));
+    }
+
+    // Table 4: steady-state e1 per bench × frequency × network; '*' marks < 90 FPS.
+    std::string t4 = "gpu_mhz,net";
+    for (const auto& b : benches)
+        t4 += "," + b.label;
+    for (const auto& b : benches)
+        t4 += "," + b.label + "_meets_90hz";
+    t4 += "\n";
+    std::string t4_plot = "config";
+    for (const auto& b : benches)
+        t4_plot += "," + b.label;
+    t4_plot += "\n";
+    for (double mhz : kFreqsMhz) {
+        for (const auto& net : kNets) {
+            t4 += fmt::format("{},{}", static_cast<int>(mhz), net);
+            t4_plot += fmt::format("{}MHz-{}", static_cast<int>(mhz), net);
+            for (size_t b = 0; b < nb; ++b) {
+                t4 += "," + fmtNum(get(b, Design::Qvr, mhz, net).e1_deg_steady, 1);
+                t4_plot += "," + fmtNum(get(b, Design::Qvr, mhz, net).e1_deg_steady, 1);
+            }
+            for (size_t b = 0; b < nb; ++b)
+                t4 += get(b, Design::Qvr, mhz, net).meets_refresh ? ",1" : ",0";
+            t4 += "\n";
+            t4_plot += "\n";
+        }
+    }
+    if (auto st = csv("table4_e1.csv", t4); !st)
+        return makeError(st.error());
+    if (auto st = csv("table4_plot.csv", t4_plot); !st)
+        return makeError(st.error());
+    plot("table4",
+         fmt::format("set datafile separator ','\nset title 'Table 4: steady-state e1 (deg) of "
+                     "Q-VR'\nset style data histogram\nset style histogram clustered gap 1\n"
+                     "set style fill solid 0.8 border -1\nset key outside right\nset xtics "
+                     "rotate by -30\nset grid ytics\nset ylabel 'e1 (deg)'\nplot for [i=2:{}] "
+                     "'table4_plot.csv' using i:xtic(1) title columnheader(i)\n",
+                     nb + 1));
+
+    // Fig. 15: Q-VR energy normalised to local at the same frequency, per network.
+    std::string f15 = "config";
+    for (const auto& b : benches)
+        f15 += "," + b.label;
+    f15 += ",mean\n";
+    std::vector<double> energy_ratios;
+    for (double mhz : kFreqsMhz) {
+        for (const auto& net : kNets) {
+            f15 += fmt::format("{}MHz-{}", static_cast<int>(mhz), net);
+            std::vector<double> row;
+            for (size_t b = 0; b < nb; ++b) {
+                const double e = get(b, Design::Qvr, mhz, net).energy_mj_per_frame /
+                                 get(b, Design::Local, mhz, "wifi").energy_mj_per_frame;
+                row.push_back(e);
+                energy_ratios.push_back(e);
+                f15 += "," + fmtNum(e, 4);
+            }
+            f15 += "," + fmtNum(mean(row), 4) + "\n";
+        }
+    }
+    if (auto st = csv("fig15_energy.csv", f15); !st)
+        return makeError(st.error());
+    plot("fig15",
+         fmt::format("set datafile separator ','\nset title 'Fig. 15: Q-VR energy per frame "
+                     "normalised to local'\nset style data histogram\nset style histogram "
+                     "clustered gap 1\nset style fill solid 0.8 border -1\nset key outside "
+                     "right\nset xtics rotate by -30\nset grid ytics\nplot for [i=2:{}] "
+                     "'fig15_energy.csv' using i:xtic(1) title columnheader(i)\n",
+                     nb + 2));
+
+    // Headlines.
+    output.headlines = {
+        {"Q-VR end-to-end speedup over local (mean)", 3.4, mean(speedups[Design::Qvr]), "x"},
+        {"Q-VR FPS over static (mean)", 4.1, mean(fps_qvr_over_static), "x"},
+        {"Q-VR FPS over software Q-VR (mean)", 2.8, mean(fps_qvr_over_sw), "x"},
+        {"Q-VR data reduction vs static", 85.0, 100.0 * (1.0 - mean(data_qvr_over_static)), "%"},
+        {"Q-VR shaded-pixel reduction vs full frame", 41.0, 100.0 * (1.0 - mean(pixels_qvr)), "%"},
+        {"Q-VR energy reduction vs local (all freq x net)", 73.0,
+         100.0 * (1.0 - mean(energy_ratios)), "%"},
+        {"FFR end-to-end speedup over local (mean)", 1.75, mean(speedups[Design::Ffr]), "x"},
+        {"DFR speedup over FFR (mean)", 1.1,
+         mean(speedups[Design::Dfr]) / mean(speedups[Design::Ffr]), "x"},
+    };
+
+    // Qualitative findings (§6), per bench, counted.
+    {
+        int ok = 0;
+        std::string bad;
+        for (size_t b = 0; b < nb; ++b) {
+            const double q = speedups[Design::Qvr][b], d = speedups[Design::Dfr][b],
+                         f = speedups[Design::Ffr][b];
+            if (q >= d && d >= f)
+                ++ok;
+            else
+                bad += fmt::format(" {} (qvr {:.2f}, dfr {:.2f}, ffr {:.2f});", benches[b].label, q,
+                                   d, f);
+        }
+        output.findings.push_back(
+            {"qvr >= dfr >= ffr in end-to-end speedup", ok == static_cast<int>(nb),
+             fmt::format("holds for {}/{} benches; means qvr {:.2f}x, dfr {:.2f}x, ffr {:.2f}x.{}",
+                         ok, nb, mean(speedups[Design::Qvr]), mean(speedups[Design::Dfr]),
+                         mean(speedups[Design::Ffr]), bad.empty() ? "" : " Fails:" + bad)});
+    }
+    {
+        int ok = 0, total = 0;
+        std::string bad;
+        for (double mhz : kFreqsMhz) {
+            for (size_t b = 0; b < nb; ++b) {
+                const double w = get(b, Design::Qvr, mhz, "wifi").e1_deg_steady;
+                const double l = get(b, Design::Qvr, mhz, "lte").e1_deg_steady;
+                const double g = get(b, Design::Qvr, mhz, "5g").e1_deg_steady;
+                ++total;
+                if (l >= w && w >= g)
+                    ++ok;
+                else
+                    bad += fmt::format(" {}@{} (lte {:.1f}, wifi {:.1f}, 5g {:.1f});",
+                                       benches[b].label, static_cast<int>(mhz), l, w, g);
+            }
+        }
+        output.findings.push_back({"steady e1: LTE >= Wi-Fi >= 5G", ok == total,
+                                   fmt::format("holds for {}/{} bench x frequency cells.{}", ok,
+                                               total, bad.empty() ? "" : " Fails:" + bad)});
+    }
+    {
+        int ok = 0, total = 0;
+        std::string bad;
+        for (const auto& net : kNets) {
+            for (size_t b = 0; b < nb; ++b) {
+                const double e5 = get(b, Design::Qvr, 500, net).e1_deg_steady;
+                const double e4 = get(b, Design::Qvr, 400, net).e1_deg_steady;
+                const double e3 = get(b, Design::Qvr, 300, net).e1_deg_steady;
+                ++total;
+                if (e5 >= e4 && e4 >= e3)
+                    ++ok;
+                else
+                    bad += fmt::format(" {}@{} (500: {:.1f}, 400: {:.1f}, 300: {:.1f});",
+                                       benches[b].label, net, e5, e4, e3);
+            }
+        }
+        output.findings.push_back({"lower GPU frequency gives a smaller e1", ok == total,
+                                   fmt::format("holds for {}/{} bench x network cells.{}", ok,
+                                               total, bad.empty() ? "" : " Fails:" + bad)});
+    }
+    {
+        const double r = mean(data_qvr_over_static);
+        output.findings.push_back(
+            {"qvr sends far fewer bytes than static (< 50%)", r < 0.5,
+             fmt::format(
+                 "qvr/static bytes = {:.3f} on average (max {:.3f})", r,
+                 *std::max_element(data_qvr_over_static.begin(), data_qvr_over_static.end()))});
+    }
+
+    if (auto st = writeSummaryJson((out / "summary.json").string(), output.runs); !st)
+        return makeError(st.error());
+    output.files.push_back("summary.json");
+
+    if (!have_gnuplot)
+        output.plot_note = "gnuplot not found: CSV written, no figures";
+    else
+        output.plot_note = fmt::format("{}/{} figures drawn by gnuplot ({} terminal)", plots_ok,
+                                       plots_tried, terminal.empty() ? "none" : terminal);
+
+    // report.html
+    std::string html = fmt::format(
+        "<!doctype html><html><head><meta charset='utf-8'><title>qvr eval</title><style>"
+        "body{{font-family:sans-serif;max-width:1150px;margin:auto}}table{{border-collapse:"
+        "collapse}}td,th{{border:1px solid #999;padding:3px 7px;text-align:right}}"
+        ".bad{{text-decoration:underline;color:#b00}}.no{{color:#b00}}.yes{{color:#070}}"
+        "</style></head><body><h1>Q-VR simulator evaluation</h1><p>Command: <code>{}</code>"
+        "<br>Frames per run: {} (Fig. 14: {}); runs: {}; {}.<br>Workloads are the seeded "
+        "<b>synthetic</b> stand-ins for Table 3's games, not the games. Models and constants: "
+        "docs/MODEL.md.</p>",
+        options.command_line, options.frames, frames, output.runs.size(), output.plot_note);
+    html +=
+        "<h2>Headline figures: paper vs. this simulator</h2><table><tr><th>metric</th>"
+        "<th>paper</th><th>ours</th></tr>";
+    for (const auto& h : output.headlines)
+        html += fmt::format(
+            "<tr><td style='text-align:left'>{}</td><td>{}{}</td><td>{}{}</td>"
+            "</tr>",
+            h.metric, fmtNum(h.paper, 2), h.unit, fmtNum(h.ours, 2), h.unit);
+    html += "</table><h2>Qualitative findings</h2><ul>";
+    for (const auto& f : output.findings)
+        html += fmt::format("<li><b>{}</b>: <span class='{}'>{}</span> — {}</li>", f.name,
+                            f.holds ? "yes" : "no", f.holds ? "holds" : "does not hold", f.detail);
+    html +=
+        "</ul><p>Why a finding can fail here, and where the model departs from the paper: "
+        "see the 'Where we differ' section of docs/MODEL.md.</p>";
+    auto figure = [&](const std::string& title, const std::string& png, const std::string& csvs) {
+        html += fmt::format("<h2>{}</h2>", title);
+        if (std::find(output.files.begin(), output.files.end(), png) != output.files.end())
+            html += fmt::format("<img src='{}' width='1100'>", png);
+        html += "<p>Data: " + csvs + "</p>";
+    };
+    auto table = [&](const std::string& csv_text, bool flag_table4) {
+        html += "<table>";
+        size_t pos = 0;
+        bool head = true;
+        while (pos < csv_text.size()) {
+            size_t end = csv_text.find('\n', pos);
+            if (end == std::string::npos)
+                end = csv_text.size();
+            const std::string line = csv_text.substr(pos, end - pos);
+            pos = end + 1;
+            std::vector<std::string> cells;
+            size_t p = 0;
+            while (true) {
+                const size_t c = line.find(',', p);
+                cells.push_back(line.substr(p, c == std::string::npos ? std::string::npos : c - p));
+                if (c == std::string::npos)
+                    break;
+                p = c + 1;
+            }
+            size_t shown = cells.size();
+            if (flag_table4)
+                shown = 2 + nb;
+            html += "<tr>";
+            for (size_t i = 0; i < shown && i < cells.size(); ++i) {
+                const bool miss = flag_table4 && !head && i >= 2 &&
+                                  2 + nb + (i - 2) < cells.size() && cells[2 + nb + (i - 2)] == "0";
+                html += fmt::format("<{0}{1}>{2}</{0}>", head ? "th" : "td",
+                                    miss ? " class='bad'" : "", cells[i]);
+            }
+            html += "</tr>";
+            head = false;
+        }
+        html += "</table>";
+    };
+    figure("Fig. 12: end-to-end speedup over local, FPS over local", "fig12.png",
+           "<a href='fig12_speedup.csv'>fig12_speedup.csv</a>");
+    table(fig12, false);
+    figure("Fig. 13: transmitted data and shaded resolution, normalised to remote", "fig13.png",
+           "<a href='fig13_data_resolution.csv'>fig13_data_resolution.csv</a>");
+    table(fig13, false);
+    figure("Fig. 14: latency ratio and FPS over 300 frames from e1 = 5&deg;", "fig14.png",
+           "<a href='fig14_latency_ratio.csv'>fig14_latency_ratio.csv</a>, "
+           "<a href='fig14_fps.csv'>fig14_fps.csv</a>");
+    figure("Table 4: steady-state e1 (deg); underlined red = misses 90 FPS", "table4.png",
+           "<a href='table4_e1.csv'>table4_e1.csv</a>");
+    table(t4, true);
+    figure("Fig. 15: Q-VR energy per frame normalised to local", "fig15.png",
+           "<a href='fig15_energy.csv'>fig15_energy.csv</a>");
+    table(f15, false);
+    html += "<h2>All runs</h2><p><a href='summary.json'>summary.json</a></p></body></html>\n";
+    if (auto st = writeText(out / "report.html", html); !st)
+        return makeError(st.error());
+    output.files.push_back("report.html");
+    return output;
+}
+
+}  // namespace qvr
