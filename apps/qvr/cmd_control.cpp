@@ -21,7 +21,7 @@ namespace {
 
 // Table 1 of the paper gives background sizes and their Wi-Fi transfer times: 646 KB in 38 ms,
 // 530 KB in 31 ms, … — about 137.6 Mbit/s of the link's nominal 200, an efficiency of 0.688
-// that the same factor applies to every nominal rate (docs/MODEL.md).
+// applied to every nominal rate (docs/COST_MODEL.md).
 constexpr double kLinkEfficiency = 0.688;
 
 struct ControlOptions {

@@ -10,7 +10,7 @@ namespace qvr {
 
 // A mobile GPU as throughput rates (paper Table 2: 8 unified shaders of 8 SIMD4 ALUs at
 // 500 MHz). Rates are given at 500 MHz and scale linearly with the clock. Defaults and their
-// calibration: docs/MODEL.md.
+// calibration: docs/COST_MODEL.md.
 struct GpuModel {
     double freq_mhz = 500.0;
     double triangles_per_ms_at_500 = 50'000.0;  // vertex shading + setup, both eyes counted
