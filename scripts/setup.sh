@@ -7,4 +7,4 @@ source scripts/deps.sh
 qvr_install_deps
 cmake --preset release -DQVR_BUILD_TESTS=OFF -DQVR_BUILD_BENCH=OFF
 cmake --build --preset release --target qvr
-./build/release/apps/qvr/qvr control --policy liwc --frames 300
+./build/release/apps/qvr/qvr control --policy liwc --frames 300 --compare
