@@ -6,9 +6,10 @@ set -euo pipefail
 QVR_PACKAGES=(
     build-essential cmake ninja-build pkg-config git
     libfmt-dev libspdlog-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libglm-dev
-    libtbb-dev libhwy-dev
+    libtbb-dev libhwy-dev libpng-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     gnuplot-nox
+    # compose: libopencv-dev only for the optional QVR_WITH_OPENCV benchmark anchor, not listed
 )
 
 qvr_install_deps() {

@@ -1,0 +1,524 @@
+// UCA orchestration (paper §4.2, Eq. 3–4): validates a layer frame, turns plan and poses into
+// kernel parameters, classifies the 32×32 tiles once per frame, runs them in parallel; frame
+// reuse for late layers; the two-pass reference built from the same kernel.
+#include "qvr/compose/uca.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
+
+#include "qvr/compose/warp.h"
+#include "qvr/foveation/eye_geometry.h"
+#include "uca_kernel.h"
+
+namespace qvr {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegPerRad = 180.0 / kPi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// A hard layer edge still gets a ramp this wide so the weights stay finite.
+constexpr double kMinBandDeg = 1e-3;
+
+const char* kLayerNames[3] = {"fovea", "middle", "outer"};
+
+const ImageRgba8& layerImage(const EyeLayerImages& e, int k) {
+    return k == 0 ? e.fovea : (k == 1 ? e.middle : e.outer);
+}
+const LayerRect& layerRect(const EyeLayers& e, int k) {
+    return k == 0 ? e.fovea : (k == 1 ? e.middle : e.outer);
+}
+
+// The present layers of one eye from the inside out, with the eccentricity where each ends and
+// the width of the blend band just inside that end.
+struct SlotInfo {
+    int count = 0;
+    int layer[3] = {0, 0, 0};
+    double radius_deg[3] = {kInf, kInf, kInf};
+    double band_deg[3] = {0, 0, 0};
+};
+
+SlotInfo slotsOf(const HmdProfile& profile, const LayerPlan& plan, int eye, double band_texels) {
+    SlotInfo s;
+    const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+    const double radius[3] = {plan.e1_deg, plan.e2_deg, kInf};
+    for (int k = 0; k < 3; ++k) {
+        if (layerRect(layers, k).empty())
+            continue;
+        s.layer[s.count] = k;
+        s.radius_deg[s.count] = radius[k];
+        ++s.count;
+    }
+    s.radius_deg[s.count - 1] = kInf;  // the outermost present layer covers the rest
+    for (int k = 0; k + 1 < s.count; ++k) {
+        // Eq. 4's blend band: a few texels of the coarser layer, inside the finer one's disc
+        // (where both layers hold rendered pixels) and never reaching the previous border.
+        const double coarse_scale = layerRect(layers, s.layer[k + 1]).scale;
+        double band = band_texels * coarse_scale * profile.pixelAngleDeg();
+        const double inner = k == 0 ? 0.0 : s.radius_deg[k - 1];
+        band = std::min(band, s.radius_deg[k] - inner);
+        s.band_deg[k] = std::max(band, kMinBandDeg);
+    }
+    return s;
+}
+
+detail::KernelLayer kernelLayer(const ImageRgba8& image, const LayerRect& rect) {
+    detail::KernelLayer l;
+    l.texels = image.data();
+    l.width = image.width();
+    l.height = image.height();
+    const double inv = 1.0 / rect.scale;
+    l.inv_scale = static_cast<float>(inv);
+    l.offset_x = static_cast<float>(-rect.rect.x0 * inv - 0.5);
+    l.offset_y = static_cast<float>(-rect.rect.y0 * inv - 0.5);
+    return l;
+}
+
+void setWarpParams(detail::KernelParams& p, const EyeWarp& warp, const Gaze& gaze,
+                   bool chroma_enabled) {
+    p.ax = static_cast<float>(1.0 / warp.fx());
+    p.bx = static_cast<float>((0.5 - warp.cx()) / warp.fx());
+    p.ay = static_cast<float>(-1.0 / warp.fy());
+    p.by = static_cast<float>(-(0.5 - warp.cy()) / warp.fy());
+    p.k1 = static_cast<float>(warp.lens().k1);
+    p.k2 = static_cast<float>(warp.lens().k2);
+    p.chroma_red = static_cast<float>(warp.lens().chroma_red_scale);
+    p.chroma_blue = static_cast<float>(warp.lens().chroma_blue_scale);
+    p.chroma = chroma_enabled && (p.chroma_red != 1.0f || p.chroma_blue != 1.0f);
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c)
+            p.m[r * 3 + c] = static_cast<float>(warp.rotation()[c][r]);
+    }
+    p.fx = static_cast<float>(warp.fx());
+    p.fy = static_cast<float>(warp.fy());
+    p.cx = static_cast<float>(warp.cx());
+    p.cy = static_cast<float>(warp.cy());
+    p.width = static_cast<float>(warp.width());
+    p.height = static_cast<float>(warp.height());
+    const glm::dvec3 g = glm::normalize(
+        glm::dvec3(std::tan(gaze.x_deg / kDegPerRad), std::tan(gaze.y_deg / kDegPerRad), -1.0));
+    p.gaze[0] = static_cast<float>(g.x);
+    p.gaze[1] = static_cast<float>(g.y);
+    p.gaze[2] = static_cast<float>(g.z);
+}
+
+void setBorders(detail::KernelParams& p, const SlotInfo& s) {
+    for (int k = 0; k < 2; ++k) {
+        p.border_c_hi[k] = 2.0f;
+        p.border_inv[k] = 0.0f;
+        if (k + 1 >= s.count)
+            continue;
+        const double c_hi = std::cos((s.radius_deg[k] - s.band_deg[k]) / kDegPerRad);
+        const double c_lo = std::cos(s.radius_deg[k] / kDegPerRad);
+        p.border_c_hi[k] = static_cast<float>(c_hi);
+        p.border_inv[k] = static_cast<float>(1.0 / (c_hi - c_lo));
+    }
+}
+
+// One eye of one pass: the map, the kernel parameters and the slots for classification.
+struct EyeJob {
+    EyeWarp warp;
+    Gaze gaze;
+    SlotInfo slots;
+    detail::KernelParams params;
+    ImageRgba8* out = nullptr;
+    std::vector<TileKind>* kinds = nullptr;
+    std::vector<uint8_t>* masks = nullptr;
+};
+
+double angleRad(const glm::dvec3& a, const glm::dvec3& b) {
+    // atan2 of |a×b| and a·b stays accurate for the tiny angles across a tile.
+    return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+}
+
+// Which slots may carry weight somewhere in the eccentricity range [lo, hi].
+uint8_t slotMaskFor(const SlotInfo& s, double lo_deg, double hi_deg) {
+    uint8_t mask = 0;
+    for (int k = 0; k < s.count; ++k) {
+        const double starts = k == 0 ? -kInf : s.radius_deg[k - 1] - s.band_deg[k - 1];
+        const double ends = s.radius_deg[k];
+        if (hi_deg > starts && lo_deg < ends)
+            mask = static_cast<uint8_t>(mask | (1u << k));
+    }
+    return mask;
+}
+
+// Tile classification, once per frame: the map at the tile centre and corners bounds where
+// the tile's pixels land (the map is smooth at tile scale; the factors below leave slack for
+// its curvature). Empty: every pixel lands off the rendered image. Single: one slot's weight
+// is 1 over the whole eccentricity range. Border: anything else.
+void classifyTile(const EyeJob& job, int tile, int tile_cols, int width, int height,
+                  double chroma_scales[3], int chroma_count) {
+    const int tx = tile % tile_cols;
+    const int ty = tile / tile_cols;
+    const double x0 = tx * kTilePx;
+    const double y0 = ty * kTilePx;
+    const double x1 = std::min(x0 + kTilePx, static_cast<double>(width));
+    const double y1 = std::min(y0 + kTilePx, static_cast<double>(height));
+    const double corners[4][2] = {{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
+    const glm::dvec3 gaze_dir = glm::normalize(glm::dvec3(
+        std::tan(job.gaze.x_deg / kDegPerRad), std::tan(job.gaze.y_deg / kDegPerRad), -1.0));
+    bool empty = true;
+    double lo_deg = kInf, hi_deg = -kInf;
+    for (int c = 0; c < chroma_count; ++c) {
+        const WarpSample centre = job.warp.map(0.5 * (x0 + x1), 0.5 * (y0 + y1), chroma_scales[c]);
+        WarpSample corner[4];
+        bool all_front = centre.in_front;
+        bool none_front = !centre.in_front;
+        double reach_px = 0.0, reach_rad = 0.0;
+        for (int i = 0; i < 4; ++i) {
+            corner[i] = job.warp.map(corners[i][0], corners[i][1], chroma_scales[c]);
+            all_front = all_front && corner[i].in_front;
+            none_front = none_front && !corner[i].in_front;
+            reach_rad = std::max(reach_rad, angleRad(centre.dir, corner[i].dir));
+            if (centre.in_front && corner[i].in_front) {
+                reach_px = std::max(reach_px,
+                                    std::hypot(corner[i].px - centre.px, corner[i].py - centre.py));
+            }
+        }
+        bool channel_empty = none_front;
+        if (all_front) {
+            const double margin = 1.25 * reach_px + 2.0;
+            channel_empty = centre.px < -margin || centre.px > width + margin ||
+                            centre.py < -margin || centre.py > height + margin;
+        }
+        empty = empty && channel_empty;
+        const double e_centre = angleRad(centre.dir, gaze_dir) * kDegPerRad;
+        const double reach_deg = 1.25 * reach_rad * kDegPerRad + 0.01;
+        lo_deg = std::min(lo_deg, e_centre - reach_deg);
+        hi_deg = std::max(hi_deg, e_centre + reach_deg);
+    }
+    uint8_t mask = 0;
+    TileKind kind = TileKind::kEmpty;
+    if (!empty) {
+        mask = slotMaskFor(job.slots, lo_deg, hi_deg);
+        kind = (mask & (mask - 1)) == 0 ? TileKind::kSingle : TileKind::kBorder;
+    }
+    (*job.kinds)[static_cast<size_t>(tile)] = kind;
+    (*job.masks)[static_cast<size_t>(tile)] = mask;
+}
+
+// Classify then shade every tile of every job, in parallel over tiles of both eyes.
+void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options, tbb::task_arena& arena,
+             TileStats& stats) {
+    const bool simd = options.simd;
+    const int width = jobs[0].warp.width();
+    const int height = jobs[0].warp.height();
+    const int cols = (width + kTilePx - 1) / kTilePx;
+    const int rows = (height + kTilePx - 1) / kTilePx;
+    const int per_eye = cols * rows;
+    const int total = per_eye * static_cast<int>(jobs.size());
+    for (auto& j : jobs) {
+        j.kinds->assign(static_cast<size_t>(per_eye), TileKind::kEmpty);
+        j.masks->assign(static_cast<size_t>(per_eye), 0);
+    }
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, total, 16), [&](const tbb::blocked_range<int>& r) {
+                for (int i = r.begin(); i < r.end(); ++i) {
+                    const EyeJob& j = jobs[static_cast<size_t>(i / per_eye)];
+                    double scales[3] = {1.0, j.params.chroma_red, j.params.chroma_blue};
+                    if (options.classify_tiles) {
+                        classifyTile(j, i % per_eye, cols, width, height, scales,
+                                     j.params.chroma ? 3 : 1);
+                    } else {
+                        (*j.kinds)[static_cast<size_t>(i % per_eye)] = TileKind::kBorder;
+                        (*j.masks)[static_cast<size_t>(i % per_eye)] =
+                            static_cast<uint8_t>((1u << j.slots.count) - 1);
+                    }
+                }
+            });
+        tbb::parallel_for(tbb::blocked_range<int>(0, total, 4),
+                          [&](const tbb::blocked_range<int>& r) {
+                              for (int i = r.begin(); i < r.end(); ++i) {
+                                  const EyeJob& j = jobs[static_cast<size_t>(i / per_eye)];
+                                  const int tile = i % per_eye;
+                                  detail::TileJob t;
+                                  t.x0 = (tile % cols) * kTilePx;
+                                  t.y0 = (tile / cols) * kTilePx;
+                                  t.x1 = std::min(t.x0 + kTilePx, width);
+                                  t.y1 = std::min(t.y0 + kTilePx, height);
+                                  t.slot_mask = (*j.masks)[static_cast<size_t>(tile)];
+                                  t.out = j.out->data();
+                                  t.out_stride_px = static_cast<size_t>(j.out->width());
+                                  if (simd) {
+                                      detail::ucaTileSimd(j.params, t);
+                                  } else {
+                                      detail::ucaTileScalar(j.params, t);
+                                  }
+                              }
+                          });
+    });
+    for (const auto& j : jobs) {
+        for (TileKind k : *j.kinds) {
+            if (k == TileKind::kEmpty)
+                ++stats.empty;
+            if (k == TileKind::kSingle)
+                ++stats.single;
+            if (k == TileKind::kBorder)
+                ++stats.border;
+        }
+    }
+}
+
+void ensureSize(ImageRgba8& image, int width, int height) {
+    if (image.width() != width || image.height() != height)
+        image.resize(width, height);
+}
+
+HmdProfile withoutLens(const HmdProfile& profile) {
+    HmdProfile p = profile;
+    p.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
+    return p;
+}
+
+}  // namespace
+
+Status validateFrame(const HmdProfile& profile, const LayerFrame& frame) {
+    const LayerPlan& plan = frame.plan;
+    const int width = profile.width_px;
+    const int height = profile.height_px;
+    if (width <= 0 || height <= 0)
+        return makeError("compose: the HMD profile has no pixels");
+    if (plan.full_pixels != static_cast<int64_t>(width) * height) {
+        return makeError(fmt::format(
+            "compose: the layer plan is for {} pixels per eye but the display has {}x{}",
+            plan.full_pixels, width, height));
+    }
+    if (!std::isfinite(plan.e1_deg) || !std::isfinite(plan.e2_deg) || plan.e1_deg < 0.0 ||
+        plan.e2_deg < plan.e1_deg) {
+        return makeError(
+            fmt::format("compose: the plan's radii e1 = {} and e2 = {} are not "
+                        "0 <= e1 <= e2",
+                        plan.e1_deg, plan.e2_deg));
+    }
+    if (!std::isfinite(plan.gaze.x_deg) || !std::isfinite(plan.gaze.y_deg) ||
+        std::fabs(plan.gaze.x_deg) >= 89.0 || std::fabs(plan.gaze.y_deg) >= 89.0) {
+        return makeError("compose: the plan's gaze is not a finite angle within ±89°");
+    }
+    const PixelRect full{0, 0, width, height};
+    for (int eye = 0; eye < 2; ++eye) {
+        const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+        const EyeLayerImages& images = frame.eyes[static_cast<size_t>(eye)];
+        int last = -1;
+        for (int k = 0; k < 3; ++k) {
+            const LayerRect& r = layerRect(layers, k);
+            const ImageRgba8& img = layerImage(images, k);
+            const char* eye_name = eye == 0 ? "left" : "right";
+            if (r.empty()) {
+                if (!img.empty()) {
+                    return makeError(
+                        fmt::format("compose: {} {} layer has an image but the plan "
+                                    "leaves that layer out",
+                                    eye_name, kLayerNames[k]));
+                }
+                continue;
+            }
+            if (!std::isfinite(r.scale) || r.scale < 1.0 || r.scale > 1024.0) {
+                return makeError(fmt::format("compose: {} {} layer scale {} is outside [1, 1024]",
+                                             eye_name, kLayerNames[k], r.scale));
+            }
+            if (r.rect.empty() || !full.contains(r.rect)) {
+                return makeError(fmt::format(
+                    "compose: {} {} layer rect [{},{})x[{},{}) is empty or outside the {}x{} "
+                    "eye image",
+                    eye_name, kLayerNames[k], r.rect.x0, r.rect.x1, r.rect.y0, r.rect.y1, width,
+                    height));
+            }
+            if (img.width() != r.width_px || img.height() != r.height_px) {
+                return makeError(fmt::format(
+                    "compose: {} {} layer image is {}x{} but the plan says {}x{}", eye_name,
+                    kLayerNames[k], img.width(), img.height(), r.width_px, r.height_px));
+            }
+            if (r.width_px * r.scale < r.rect.width() - 1e-6 ||
+                r.height_px * r.scale < r.rect.height() - 1e-6) {
+                return makeError(fmt::format(
+                    "compose: {} {} layer of {}x{} texels at scale {} does not cover its rect",
+                    eye_name, kLayerNames[k], r.width_px, r.height_px, r.scale));
+            }
+            if (r.pixels() >= (int64_t{1} << 29)) {
+                return makeError(
+                    fmt::format("compose: {} {} layer is too large", eye_name, kLayerNames[k]));
+            }
+            last = k;
+        }
+        if (last < 0)
+            return makeError("compose: the plan has no layer for an eye");
+        if (!(layerRect(layers, last).rect == full)) {
+            return makeError(
+                fmt::format("compose: the outermost {} layer does not cover the whole eye image",
+                            kLayerNames[last]));
+        }
+    }
+    return Status::success();
+}
+
+Compositor::Compositor(const HmdProfile& profile, ComposeOptions options)
+    : m_profile(profile), m_options(options) {
+    m_arena = options.threads > 0 ? std::make_unique<tbb::task_arena>(options.threads)
+                                  : std::make_unique<tbb::task_arena>();
+}
+
+Compositor::~Compositor() = default;
+
+int Compositor::tileColumns() const {
+    return (m_profile.width_px + kTilePx - 1) / kTilePx;
+}
+int Compositor::tileRows() const {
+    return (m_profile.height_px + kTilePx - 1) / kTilePx;
+}
+
+Expected<ComposeReport> Compositor::compose(const LayerFrame& frame, const Pose& display_pose,
+                                            std::array<ImageRgba8, 2>& out) {
+    if (Status st = validateFrame(m_profile, frame); !st)
+        return makeError(st.error());
+    std::vector<EyeJob> jobs;
+    jobs.reserve(2);
+    for (int eye = 0; eye < 2; ++eye) {
+        EyeJob j{EyeWarp(m_profile, frame.render_pose.orientation, display_pose.orientation),
+                 frame.plan.gaze,
+                 slotsOf(m_profile, frame.plan, eye, m_options.blend_band_texels),
+                 {},
+                 &out[static_cast<size_t>(eye)],
+                 &m_tile_kinds[static_cast<size_t>(eye)],
+                 &m_tile_masks[static_cast<size_t>(eye)]};
+        setWarpParams(j.params, j.warp, frame.plan.gaze, m_options.chromatic_aberration);
+        j.params.slot_count = j.slots.count;
+        for (int k = 0; k < j.slots.count; ++k) {
+            const int layer = j.slots.layer[k];
+            j.params.slots[k] =
+                kernelLayer(layerImage(frame.eyes[static_cast<size_t>(eye)], layer),
+                            layerRect(frame.plan.eyes[static_cast<size_t>(eye)], layer));
+        }
+        setBorders(j.params, j.slots);
+        ensureSize(out[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
+        jobs.push_back(std::move(j));
+    }
+    ComposeReport report;
+    report.frame_index = frame.frame_index;
+    report.warp_deg = angleBetweenDeg(frame.render_pose.orientation, display_pose.orientation);
+    runJobs(jobs, m_options, *m_arena, report.tiles);
+    return report;
+}
+
+Expected<ComposeReport> Compositor::present(std::shared_ptr<const LayerFrame> arrived,
+                                            const Pose& display_pose,
+                                            std::array<ImageRgba8, 2>& out) {
+    if (arrived) {
+        if (Status st = validateFrame(m_profile, *arrived); !st)
+            return makeError(st.error());
+        m_newest = std::move(arrived);
+        m_reused_in_a_row = 0;
+        return compose(*m_newest, display_pose, out);
+    }
+    if (!m_newest) {
+        return makeError("compose: the layers are late and no earlier frame exists to reuse");
+    }
+    auto report = compose(*m_newest, display_pose, out);
+    if (!report)
+        return report;
+    report->reused = true;
+    report->reused_in_a_row = ++m_reused_in_a_row;
+    return report;
+}
+
+Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
+                                                   const Pose& display_pose,
+                                                   std::array<ImageRgba8, 2>& out,
+                                                   std::array<ImageRgba8, 2>* eye_buffers) {
+    if (Status st = validateFrame(m_profile, frame); !st)
+        return makeError(st.error());
+    std::array<ImageRgba8, 2>& buffers = eye_buffers ? *eye_buffers : m_two_pass_buffers;
+    ComposeReport report;
+    report.frame_index = frame.frame_index;
+    report.warp_deg = angleBetweenDeg(frame.render_pose.orientation, display_pose.orientation);
+    // Pass 1: composition at full resolution in the render pose — the identity map, the same
+    // layer filter and blend band.
+    const HmdProfile flat = withoutLens(m_profile);
+    std::vector<EyeJob> compose_jobs;
+    for (int eye = 0; eye < 2; ++eye) {
+        EyeJob j{EyeWarp(flat, frame.render_pose.orientation, frame.render_pose.orientation),
+                 frame.plan.gaze,
+                 slotsOf(m_profile, frame.plan, eye, m_options.blend_band_texels),
+                 {},
+                 &buffers[static_cast<size_t>(eye)],
+                 &m_tile_kinds[static_cast<size_t>(eye)],
+                 &m_tile_masks[static_cast<size_t>(eye)]};
+        setWarpParams(j.params, j.warp, frame.plan.gaze, false);
+        j.params.identity_map = true;
+        j.params.slot_count = j.slots.count;
+        for (int k = 0; k < j.slots.count; ++k) {
+            const int layer = j.slots.layer[k];
+            j.params.slots[k] =
+                kernelLayer(layerImage(frame.eyes[static_cast<size_t>(eye)], layer),
+                            layerRect(frame.plan.eyes[static_cast<size_t>(eye)], layer));
+        }
+        setBorders(j.params, j.slots);
+        ensureSize(buffers[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
+        compose_jobs.push_back(std::move(j));
+    }
+    TileStats pass1;
+    runJobs(compose_jobs, m_options, *m_arena, pass1);
+    // Pass 2: timewarp + lens of the composed buffer, one full-resolution layer.
+    LayerRect full_rect;
+    full_rect.rect = {0, 0, m_profile.width_px, m_profile.height_px};
+    full_rect.scale = 1.0;
+    std::vector<EyeJob> warp_jobs;
+    for (int eye = 0; eye < 2; ++eye) {
+        EyeJob j{EyeWarp(m_profile, frame.render_pose.orientation, display_pose.orientation),
+                 frame.plan.gaze,
+                 SlotInfo{},
+                 {},
+                 &out[static_cast<size_t>(eye)],
+                 &m_tile_kinds[static_cast<size_t>(eye)],
+                 &m_tile_masks[static_cast<size_t>(eye)]};
+        j.slots.count = 1;
+        setWarpParams(j.params, j.warp, frame.plan.gaze, m_options.chromatic_aberration);
+        j.params.slot_count = 1;
+        j.params.slots[0] = kernelLayer(buffers[static_cast<size_t>(eye)], full_rect);
+        setBorders(j.params, j.slots);
+        ensureSize(out[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
+        warp_jobs.push_back(std::move(j));
+    }
+    runJobs(warp_jobs, m_options, *m_arena, report.tiles);
+    return report;
+}
+
+}  // namespace qvr
+
+namespace qvr::detail {
+
+KernelParams composeParams(const HmdProfile& profile, const LayerFrame& frame, int eye,
+                           double blend_band_texels) {
+    const EyeWarp warp(withoutLens(profile), frame.render_pose.orientation,
+                       frame.render_pose.orientation);
+    const SlotInfo slots = slotsOf(profile, frame.plan, eye, blend_band_texels);
+    KernelParams p;
+    setWarpParams(p, warp, frame.plan.gaze, false);
+    p.identity_map = true;
+    p.slot_count = slots.count;
+    for (int k = 0; k < slots.count; ++k) {
+        p.slots[k] =
+            kernelLayer(layerImage(frame.eyes[static_cast<size_t>(eye)], slots.layer[k]),
+                        layerRect(frame.plan.eyes[static_cast<size_t>(eye)], slots.layer[k]));
+    }
+    setBorders(p, slots);
+    return p;
+}
+
+void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count) {
+    slot_count = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (!layerRect(plan.eyes[static_cast<size_t>(eye)], k).empty()) {
+            layer_of_slot[slot_count++] = k;
+        }
+    }
+}
+
+}  // namespace qvr::detail

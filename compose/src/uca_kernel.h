@@ -1,0 +1,74 @@
+// The per-tile UCA kernel (paper §4.2, Eq. 4) in two builds that must agree: a Highway kernel
+// that maps and filters a vector of pixels at a time, and its scalar twin. Private to compose.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "qvr/compose/uca.h"
+#include "qvr/foveation/hmd_profile.h"
+
+namespace qvr::detail {
+
+// One layer as the kernel sees it: packed RGBA8 texels and the affine map from full-resolution
+// rendered-image coordinates to texel coordinates, lx = px·inv_scale + offset_x.
+struct KernelLayer {
+    const uint8_t* texels = nullptr;  // RGBA8, rows of `width` texels
+    int width = 0;
+    int height = 0;
+    float inv_scale = 1.0f;
+    float offset_x = 0.0f;
+    float offset_y = 0.0f;
+};
+
+// Everything the kernel needs for one eye of one frame, in float. Slots are the present layers
+// from the inside out; slot k+1 takes over from slot k across a blend band.
+struct KernelParams {
+    // Display pixel (u, v) → tangent coordinates: xt = u·ax + bx, yt = v·ay + by.
+    float ax = 0, bx = 0, ay = 0, by = 0;
+    float k1 = 0, k2 = 0;
+    float chroma_red = 1, chroma_blue = 1;
+    bool chroma = false;  // per-channel maps when the red or blue scale differs from 1
+    // When set, the display pixel is the rendered pixel (no lens, no rotation): the composition
+    // pass of the two-pass reference.
+    bool identity_map = false;
+    // Display → rendered eye space, row-major; R = xd·col0 + yd·col1 − col2.
+    float m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    float fx = 1, fy = 1, cx = 0, cy = 0;
+    float width = 0, height = 0;  // the rendered image, in full-resolution pixels
+    float gaze[3] = {0, 0, -1};   // unit gaze in rendered eye space
+    int slot_count = 0;
+    KernelLayer slots[3];
+    // Blend ramps in cos(eccentricity): t = clamp((c_hi − cos e)·inv, 0, 1) is the share of the
+    // outer layer of a border. inv = 0 disables a border.
+    float border_c_hi[2] = {2, 2};
+    float border_inv[2] = {0, 0};
+};
+
+// The output window of one tile: rows y0..y1, columns x0..x1 (half-open), written into `out`
+// (RGBA8, `out_stride_px` pixels a row). slot_mask: bit k set when slot k may contribute; a
+// single bit takes the single-layer path.
+struct TileJob {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    uint8_t slot_mask = 0;
+    uint8_t* out = nullptr;
+    size_t out_stride_px = 0;
+};
+
+inline constexpr uint32_t kOpaqueBlack = 0xFF000000u;
+
+void ucaTileScalar(const KernelParams& p, const TileJob& job);
+// The kernel parameters of the composition pass (identity map) for one eye of a validated frame:
+// its slots and blend ramps, shared with the OpenCV anchor so that all paths blend alike.
+KernelParams composeParams(const HmdProfile& profile, const LayerFrame& frame, int eye,
+                           double blend_band_texels);
+// Which plan layer (0 fovea, 1 middle, 2 outer) each kernel slot holds.
+void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count);
+void ucaTileSimd(const KernelParams& p, const TileJob& job);
+
+}  // namespace qvr::detail
+
+namespace qvr::detail {
+// The Highway target the dispatcher picked on this CPU, e.g. "AVX3" or "AVX2".
+const char* ucaSimdTarget();
+}  // namespace qvr::detail

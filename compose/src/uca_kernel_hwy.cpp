@@ -1,0 +1,249 @@
+// The vectorised UCA tile kernel (paper §4.2, Eq. 4) with Highway: a vector of display pixels is
+// mapped through lens and rotation at once, each layer's four texels are fetched with gathers,
+// and Eq. 4's weighted sum runs lane-wise. Dispatches to the best target the CPU has at run time.
+#include <cstring>
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "uca_kernel_hwy.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include "uca_kernel.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace qvr::detail {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+namespace {
+
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DU = hn::RebindToUnsigned<DF>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using VU = hn::Vec<DU>;
+using MF = hn::Mask<DF>;
+
+struct MapV {
+    VF px, py, cos_e;
+    MF valid;
+};
+
+struct Rgb {
+    VF r, g, b;
+};
+
+HWY_INLINE MapV mapPixels(const KernelParams& p, VF u, VF v, float chroma) {
+    const DF df;
+    const VF xt = hn::MulAdd(u, hn::Set(df, p.ax), hn::Set(df, p.bx));
+    const VF yt = hn::MulAdd(v, hn::Set(df, p.ay), hn::Set(df, p.by));
+    VF rx, ry, rz;
+    MapV m;
+    if (p.identity_map) {
+        rx = xt;
+        ry = yt;
+        rz = hn::Set(df, -1.0f);
+        m.px = hn::Add(u, hn::Set(df, 0.5f));
+        m.py = hn::Add(v, hn::Set(df, 0.5f));
+        m.valid = hn::Eq(u, u);
+    } else {
+        const VF r2 = hn::MulAdd(xt, xt, hn::Mul(yt, yt));
+        const VF poly = hn::MulAdd(hn::Set(df, p.k2), r2, hn::Set(df, p.k1));
+        const VF f = hn::Mul(hn::MulAdd(poly, r2, hn::Set(df, 1.0f)), hn::Set(df, chroma));
+        const VF xd = hn::Mul(xt, f);
+        const VF yd = hn::Mul(yt, f);
+        rx = hn::MulAdd(hn::Set(df, p.m[0]), xd,
+                        hn::MulSub(hn::Set(df, p.m[1]), yd, hn::Set(df, p.m[2])));
+        ry = hn::MulAdd(hn::Set(df, p.m[3]), xd,
+                        hn::MulSub(hn::Set(df, p.m[4]), yd, hn::Set(df, p.m[5])));
+        rz = hn::MulAdd(hn::Set(df, p.m[6]), xd,
+                        hn::MulSub(hn::Set(df, p.m[7]), yd, hn::Set(df, p.m[8])));
+        const VF depth = hn::Neg(rz);
+        const MF front = hn::Gt(depth, hn::Set(df, 1e-6f));
+        const VF iz = hn::Div(hn::Set(df, 1.0f), hn::IfThenElse(front, depth, hn::Set(df, 1.0f)));
+        const VF px = hn::MulAdd(rx, hn::Mul(hn::Set(df, p.fx), iz), hn::Set(df, p.cx));
+        const VF py = hn::MulAdd(ry, hn::Mul(hn::Set(df, -p.fy), iz), hn::Set(df, p.cy));
+        const VF zero = hn::Zero(df);
+        const MF in_x = hn::And(hn::Ge(px, zero), hn::Le(px, hn::Set(df, p.width)));
+        const MF in_y = hn::And(hn::Ge(py, zero), hn::Le(py, hn::Set(df, p.height)));
+        m.valid = hn::And(front, hn::And(in_x, in_y));
+        // Invalid lanes sample a harmless point; their colour is replaced by black below.
+        m.px = hn::IfThenElseZero(m.valid, px);
+        m.py = hn::IfThenElseZero(m.valid, py);
+    }
+    const VF n2 = hn::MulAdd(rx, rx, hn::MulAdd(ry, ry, hn::Mul(rz, rz)));
+    const VF dot =
+        hn::MulAdd(hn::Set(df, p.gaze[0]), rx,
+                   hn::MulAdd(hn::Set(df, p.gaze[1]), ry, hn::Mul(hn::Set(df, p.gaze[2]), rz)));
+    m.cos_e = hn::Div(dot, hn::Sqrt(n2));
+    return m;
+}
+
+template <int kShift>
+HWY_INLINE VF channel(VU texel) {
+    const DF df;
+    const DI di;
+    const DU du;
+    return hn::ConvertTo(
+        df, hn::BitCast(di, hn::And(hn::ShiftRight<kShift>(texel), hn::Set(du, 0xFFu))));
+}
+
+HWY_INLINE VF lerp(VF w, VF a, VF b) {
+    return hn::MulAdd(w, hn::Sub(b, a), a);
+}
+
+HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
+    const DF df;
+    const DI di;
+    const DU du;
+    VF lx = hn::MulAdd(px, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_x));
+    VF ly = hn::MulAdd(py, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_y));
+    lx = hn::Min(hn::Max(lx, hn::Set(df, -1.0f)), hn::Set(df, static_cast<float>(l.width)));
+    ly = hn::Min(hn::Max(ly, hn::Set(df, -1.0f)), hn::Set(df, static_cast<float>(l.height)));
+    const VF flx = hn::Floor(lx);
+    const VF fly = hn::Floor(ly);
+    const VF wx = hn::Sub(lx, flx);
+    const VF wy = hn::Sub(ly, fly);
+    const VI ix = hn::ConvertTo(di, flx);
+    const VI iy = hn::ConvertTo(di, fly);
+    const VI zero = hn::Zero(di);
+    const VI one = hn::Set(di, 1);
+    const VI max_x = hn::Set(di, l.width - 1);
+    const VI max_y = hn::Set(di, l.height - 1);
+    const VI x0 = hn::Min(hn::Max(ix, zero), max_x);
+    const VI x1 = hn::Min(hn::Max(hn::Add(ix, one), zero), max_x);
+    const VI row0 = hn::Mul(hn::Min(hn::Max(iy, zero), max_y), hn::Set(di, l.width));
+    const VI row1 = hn::Mul(hn::Min(hn::Max(hn::Add(iy, one), zero), max_y), hn::Set(di, l.width));
+    const auto* base = reinterpret_cast<const uint32_t*>(l.texels);
+    const VU t00 = hn::GatherIndex(du, base, hn::Add(row0, x0));
+    const VU t10 = hn::GatherIndex(du, base, hn::Add(row0, x1));
+    const VU t01 = hn::GatherIndex(du, base, hn::Add(row1, x0));
+    const VU t11 = hn::GatherIndex(du, base, hn::Add(row1, x1));
+    Rgb out;
+    out.r = lerp(wy, lerp(wx, channel<0>(t00), channel<0>(t10)),
+                 lerp(wx, channel<0>(t01), channel<0>(t11)));
+    out.g = lerp(wy, lerp(wx, channel<8>(t00), channel<8>(t10)),
+                 lerp(wx, channel<8>(t01), channel<8>(t11)));
+    out.b = lerp(wy, lerp(wx, channel<16>(t00), channel<16>(t10)),
+                 lerp(wx, channel<16>(t01), channel<16>(t11)));
+    return out;
+}
+
+HWY_INLINE Rgb shade(const KernelParams& p, VF u, VF v, float chroma, uint8_t slot_mask) {
+    const DF df;
+    const MapV m = mapPixels(p, u, v, chroma);
+    Rgb rgb;
+    if ((slot_mask & (slot_mask - 1)) == 0) {
+        const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
+        rgb = sampleLayer(p.slots[k], m.px, m.py);
+    } else {
+        const VF zero = hn::Zero(df);
+        const VF one = hn::Set(df, 1.0f);
+        const VF t1 = hn::Min(hn::Max(hn::Mul(hn::Sub(hn::Set(df, p.border_c_hi[0]), m.cos_e),
+                                              hn::Set(df, p.border_inv[0])),
+                                      zero),
+                              one);
+        const VF t2 = hn::Min(hn::Max(hn::Mul(hn::Sub(hn::Set(df, p.border_c_hi[1]), m.cos_e),
+                                              hn::Set(df, p.border_inv[1])),
+                                      zero),
+                              one);
+        const VF t12 = hn::Mul(t1, t2);
+        const VF w[3] = {hn::Sub(one, t1), hn::Sub(t1, t12), t12};
+        rgb = {zero, zero, zero};
+        for (int k = 0; k < p.slot_count; ++k) {
+            if ((slot_mask & (1u << k)) == 0)
+                continue;
+            // Lanes outside this layer's ramp have weight 0; skip the gathers when all do.
+            if (hn::AllFalse(df, hn::Gt(w[k], zero)))
+                continue;
+            const Rgb s = sampleLayer(p.slots[k], m.px, m.py);
+            rgb.r = hn::MulAdd(w[k], s.r, rgb.r);
+            rgb.g = hn::MulAdd(w[k], s.g, rgb.g);
+            rgb.b = hn::MulAdd(w[k], s.b, rgb.b);
+        }
+    }
+    rgb.r = hn::IfThenElseZero(m.valid, rgb.r);
+    rgb.g = hn::IfThenElseZero(m.valid, rgb.g);
+    rgb.b = hn::IfThenElseZero(m.valid, rgb.b);
+    return rgb;
+}
+
+HWY_INLINE VU quantize(VF value) {
+    const DF df;
+    const DI di;
+    const DU du;
+    return hn::BitCast(
+        du, hn::ConvertTo(di, hn::Min(hn::Add(value, hn::Set(df, 0.5f)), hn::Set(df, 255.0f))));
+}
+
+HWY_INLINE VU shadePacked(const KernelParams& p, VF u, VF v, uint8_t slot_mask) {
+    const DU du;
+    VF r, g, b;
+    if (!p.chroma) {
+        const Rgb c = shade(p, u, v, 1.0f, slot_mask);
+        r = c.r;
+        g = c.g;
+        b = c.b;
+    } else {
+        r = shade(p, u, v, p.chroma_red, slot_mask).r;
+        g = shade(p, u, v, 1.0f, slot_mask).g;
+        b = shade(p, u, v, p.chroma_blue, slot_mask).b;
+    }
+    VU packed = hn::Or(quantize(r), hn::ShiftLeft<8>(quantize(g)));
+    packed = hn::Or(packed, hn::ShiftLeft<16>(quantize(b)));
+    return hn::Or(packed, hn::Set(du, kOpaqueBlack));
+}
+
+}  // namespace
+
+void UcaTile(const KernelParams& p, const TileJob& job) {
+    const DF df;
+    const DU du;
+    const int lanes = static_cast<int>(hn::Lanes(df));
+    const VF iota = hn::Iota(df, 0.0f);
+    HWY_ALIGN uint32_t tail[HWY_MAX_BYTES / sizeof(uint32_t)];
+    for (int y = job.y0; y < job.y1; ++y) {
+        auto* row =
+            reinterpret_cast<uint32_t*>(job.out) + static_cast<size_t>(y) * job.out_stride_px;
+        const VF v = hn::Set(df, static_cast<float>(y));
+        for (int x = job.x0; x < job.x1; x += lanes) {
+            VU packed;
+            if (job.slot_mask == 0) {
+                packed = hn::Set(du, kOpaqueBlack);
+            } else {
+                const VF u = hn::Add(iota, hn::Set(df, static_cast<float>(x)));
+                packed = shadePacked(p, u, v, job.slot_mask);
+            }
+            if (x + lanes <= job.x1) {
+                hn::StoreU(packed, du, row + x);
+            } else {
+                hn::Store(packed, du, tail);
+                std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
+            }
+        }
+    }
+}
+
+const char* TargetName() {
+    return hwy::TargetName(HWY_TARGET);
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace qvr::detail
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace qvr::detail {
+HWY_EXPORT(UcaTile);
+HWY_EXPORT(TargetName);
+
+const char* ucaSimdTarget() {
+    return HWY_DYNAMIC_DISPATCH(TargetName)();
+}
+
+void ucaTileSimd(const KernelParams& p, const TileJob& job) {
+    HWY_DYNAMIC_DISPATCH(UcaTile)(p, job);
+}
+}  // namespace qvr::detail
+#endif

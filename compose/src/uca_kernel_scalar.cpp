@@ -1,0 +1,162 @@
+// The scalar twin of the UCA tile kernel (paper §4.2, Eq. 4): one pixel at a time, the same
+// float operations in the same order as the Highway kernel, so tests can hold one to the other.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "uca_kernel.h"
+
+namespace qvr::detail {
+
+namespace {
+
+struct Mapped {
+    float px = 0, py = 0;  // rendered-image point, full-resolution pixels
+    float cos_e = 1;       // cosine of the eccentricity from the gaze
+    bool valid = false;
+};
+
+Mapped mapPixel(const KernelParams& p, float u, float v, float chroma) {
+    Mapped m;
+    const float xt = u * p.ax + p.bx;
+    const float yt = v * p.ay + p.by;
+    float rx, ry, rz;
+    if (p.identity_map) {
+        rx = xt;
+        ry = yt;
+        rz = -1.0f;
+        m.px = u + 0.5f;
+        m.py = v + 0.5f;
+        m.valid = true;
+    } else {
+        const float r2 = xt * xt + yt * yt;
+        const float f = ((p.k2 * r2 + p.k1) * r2 + 1.0f) * chroma;
+        const float xd = xt * f;
+        const float yd = yt * f;
+        rx = p.m[0] * xd + (p.m[1] * yd - p.m[2]);
+        ry = p.m[3] * xd + (p.m[4] * yd - p.m[5]);
+        rz = p.m[6] * xd + (p.m[7] * yd - p.m[8]);
+        const float depth = -rz;
+        if (depth > 1e-6f) {
+            const float iz = 1.0f / depth;
+            m.px = rx * (p.fx * iz) + p.cx;
+            m.py = ry * (-p.fy * iz) + p.cy;
+            m.valid = m.px >= 0.0f && m.px <= p.width && m.py >= 0.0f && m.py <= p.height;
+        }
+        if (!m.valid) {
+            m.px = 0.0f;
+            m.py = 0.0f;
+        }
+    }
+    const float n2 = rx * rx + ry * ry + rz * rz;
+    m.cos_e = (p.gaze[0] * rx + p.gaze[1] * ry + p.gaze[2] * rz) / std::sqrt(n2);
+    return m;
+}
+
+uint32_t loadTexel(const KernelLayer& l, int x, int y) {
+    uint32_t t;
+    std::memcpy(
+        &t,
+        l.texels +
+            (static_cast<size_t>(y) * static_cast<size_t>(l.width) + static_cast<size_t>(x)) * 4,
+        sizeof t);
+    return t;
+}
+
+float channelOf(uint32_t texel, int c) {
+    return static_cast<float>((texel >> (8 * c)) & 0xFFu);
+}
+
+// Bilinear, clamp-to-edge, RGB of one layer at a rendered-image point.
+void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
+    float lx = px * l.inv_scale + l.offset_x;
+    float ly = py * l.inv_scale + l.offset_y;
+    // Far-away points only need to land beyond the edge; the clamp also keeps the int
+    // conversion defined.
+    lx = std::min(std::max(lx, -1.0f), static_cast<float>(l.width));
+    ly = std::min(std::max(ly, -1.0f), static_cast<float>(l.height));
+    const float flx = std::floor(lx);
+    const float fly = std::floor(ly);
+    const float wx = lx - flx;
+    const float wy = ly - fly;
+    const int ix = static_cast<int>(flx);
+    const int iy = static_cast<int>(fly);
+    const int x0 = std::clamp(ix, 0, l.width - 1);
+    const int x1 = std::clamp(ix + 1, 0, l.width - 1);
+    const int y0 = std::clamp(iy, 0, l.height - 1);
+    const int y1 = std::clamp(iy + 1, 0, l.height - 1);
+    const uint32_t t00 = loadTexel(l, x0, y0);
+    const uint32_t t10 = loadTexel(l, x1, y0);
+    const uint32_t t01 = loadTexel(l, x0, y1);
+    const uint32_t t11 = loadTexel(l, x1, y1);
+    for (int c = 0; c < 3; ++c) {
+        const float a = channelOf(t00, c);
+        const float b = channelOf(t10, c);
+        const float d = channelOf(t01, c);
+        const float e = channelOf(t11, c);
+        const float top = wx * (b - a) + a;
+        const float bot = wx * (e - d) + d;
+        rgb[c] = wy * (bot - top) + top;
+    }
+}
+
+// Eq. 4 for one pixel: the slots the tile may touch, weighted by the blend ramps.
+bool shade(const KernelParams& p, float u, float v, float chroma, uint8_t slot_mask, float rgb[3]) {
+    const Mapped m = mapPixel(p, u, v, chroma);
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!m.valid)
+        return false;
+    if ((slot_mask & (slot_mask - 1)) == 0) {
+        const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
+        sampleLayer(p.slots[k], m.px, m.py, rgb);
+        return true;
+    }
+    const float t1 = std::min(std::max((p.border_c_hi[0] - m.cos_e) * p.border_inv[0], 0.0f), 1.0f);
+    const float t2 = std::min(std::max((p.border_c_hi[1] - m.cos_e) * p.border_inv[1], 0.0f), 1.0f);
+    const float w[3] = {1.0f - t1, t1 - t1 * t2, t1 * t2};
+    for (int k = 0; k < p.slot_count; ++k) {
+        if ((slot_mask & (1u << k)) == 0 || w[k] == 0.0f)
+            continue;
+        float s[3];
+        sampleLayer(p.slots[k], m.px, m.py, s);
+        for (int c = 0; c < 3; ++c)
+            rgb[c] = w[k] * s[c] + rgb[c];
+    }
+    return true;
+}
+
+uint32_t quantize(float value) {
+    return static_cast<uint32_t>(static_cast<int>(std::min(value + 0.5f, 255.0f)));
+}
+
+}  // namespace
+
+void ucaTileScalar(const KernelParams& p, const TileJob& job) {
+    for (int y = job.y0; y < job.y1; ++y) {
+        uint8_t* row = job.out + static_cast<size_t>(y) * job.out_stride_px * 4;
+        const float v = static_cast<float>(y);
+        for (int x = job.x0; x < job.x1; ++x) {
+            const float u = static_cast<float>(x);
+            uint32_t packed = kOpaqueBlack;
+            if (job.slot_mask != 0) {
+                float rgb[3];
+                if (!p.chroma) {
+                    shade(p, u, v, 1.0f, job.slot_mask, rgb);
+                } else {
+                    // Lateral chromatic aberration: each channel has its own radial scale.
+                    float tmp[3];
+                    shade(p, u, v, p.chroma_red, job.slot_mask, tmp);
+                    rgb[0] = tmp[0];
+                    shade(p, u, v, 1.0f, job.slot_mask, tmp);
+                    rgb[1] = tmp[1];
+                    shade(p, u, v, p.chroma_blue, job.slot_mask, tmp);
+                    rgb[2] = tmp[2];
+                }
+                packed |= quantize(rgb[0]) | (quantize(rgb[1]) << 8) | (quantize(rgb[2]) << 16);
+            }
+            std::memcpy(row + static_cast<size_t>(x) * 4, &packed, sizeof packed);
+        }
+    }
+}
+
+}  // namespace qvr::detail
