@@ -25,6 +25,8 @@ constexpr double kDegPerRad = 180.0 / kPi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // A hard layer edge still gets a ramp this wide so the weights stay finite.
 constexpr double kMinBandDeg = 1e-3;
+// The kernel forms texel indices in float, exact below 2^24.
+constexpr int64_t kMaxTexels = int64_t{1} << 24;
 
 const char* kLayerNames[3] = {"fovea", "middle", "outer"};
 
@@ -302,6 +304,10 @@ Status validateFrame(const HmdProfile& profile, const LayerFrame& frame) {
         std::fabs(plan.gaze.x_deg) >= 89.0 || std::fabs(plan.gaze.y_deg) >= 89.0) {
         return makeError("compose: the plan's gaze is not a finite angle within ±89°");
     }
+    if (int64_t{width} * height >= kMaxTexels) {
+        return makeError(fmt::format("compose: a {}x{} eye has more than the kernel's 2^24 pixels",
+                                     width, height));
+    }
     const PixelRect full{0, 0, width, height};
     for (int eye = 0; eye < 2; ++eye) {
         const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
@@ -342,9 +348,11 @@ Status validateFrame(const HmdProfile& profile, const LayerFrame& frame) {
                     "compose: {} {} layer of {}x{} texels at scale {} does not cover its rect",
                     eye_name, kLayerNames[k], r.width_px, r.height_px, r.scale));
             }
-            if (r.pixels() >= (int64_t{1} << 29)) {
+            if (r.pixels() >= kMaxTexels) {
                 return makeError(
-                    fmt::format("compose: {} {} layer is too large", eye_name, kLayerNames[k]));
+                    fmt::format("compose: {} {} layer has {} texels, more than the "
+                                "kernel's 2^24",
+                                eye_name, kLayerNames[k], r.pixels()));
             }
             last = k;
         }

@@ -34,7 +34,9 @@ struct Rgb {
     VF r, g, b;
 };
 
-HWY_INLINE MapV mapPixels(const KernelParams& p, VF u, VF v, float chroma) {
+// need_cos: only border tiles blend by eccentricity; single-layer tiles skip its sqrt and
+// division, the most expensive lanes of the map.
+HWY_INLINE MapV mapPixels(const KernelParams& p, VF u, VF v, float chroma, bool need_cos) {
     const DF df;
     const VF xt = hn::MulAdd(u, hn::Set(df, p.ax), hn::Set(df, p.bx));
     const VF yt = hn::MulAdd(v, hn::Set(df, p.ay), hn::Set(df, p.by));
@@ -72,6 +74,10 @@ HWY_INLINE MapV mapPixels(const KernelParams& p, VF u, VF v, float chroma) {
         m.px = hn::IfThenElseZero(m.valid, px);
         m.py = hn::IfThenElseZero(m.valid, py);
     }
+    if (!need_cos) {
+        m.cos_e = hn::Zero(df);
+        return m;
+    }
     const VF n2 = hn::MulAdd(rx, rx, hn::MulAdd(ry, ry, hn::Mul(rz, rz)));
     const VF dot =
         hn::MulAdd(hn::Set(df, p.gaze[0]), rx,
@@ -97,29 +103,31 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
     const DF df;
     const DI di;
     const DU du;
-    VF lx = hn::MulAdd(px, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_x));
-    VF ly = hn::MulAdd(py, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_y));
-    lx = hn::Min(hn::Max(lx, hn::Set(df, -1.0f)), hn::Set(df, static_cast<float>(l.width)));
-    ly = hn::Min(hn::Max(ly, hn::Set(df, -1.0f)), hn::Set(df, static_cast<float>(l.height)));
+    // Clamping the texel coordinate to [0, size − 1] is clamp-to-edge: at the edge the weight
+    // of the tap beyond it is 0, and that tap is redirected onto the edge texel.
+    const VF max_x = hn::Set(df, static_cast<float>(l.width - 1));
+    const VF max_y = hn::Set(df, static_cast<float>(l.height - 1));
+    const VF zero = hn::Zero(df);
+    const VF lx = hn::Min(
+        hn::Max(hn::MulAdd(px, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_x)), zero), max_x);
+    const VF ly = hn::Min(
+        hn::Max(hn::MulAdd(py, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_y)), zero), max_y);
     const VF flx = hn::Floor(lx);
     const VF fly = hn::Floor(ly);
     const VF wx = hn::Sub(lx, flx);
     const VF wy = hn::Sub(ly, fly);
-    const VI ix = hn::ConvertTo(di, flx);
-    const VI iy = hn::ConvertTo(di, fly);
-    const VI zero = hn::Zero(di);
-    const VI one = hn::Set(di, 1);
-    const VI max_x = hn::Set(di, l.width - 1);
-    const VI max_y = hn::Set(di, l.height - 1);
-    const VI x0 = hn::Min(hn::Max(ix, zero), max_x);
-    const VI x1 = hn::Min(hn::Max(hn::Add(ix, one), zero), max_x);
-    const VI row0 = hn::Mul(hn::Min(hn::Max(iy, zero), max_y), hn::Set(di, l.width));
-    const VI row1 = hn::Mul(hn::Min(hn::Max(hn::Add(iy, one), zero), max_y), hn::Set(di, l.width));
+    // Texel index in float is exact: layers hold fewer than 2^24 texels (validateFrame).
+    const VI i00 =
+        hn::ConvertTo(di, hn::MulAdd(fly, hn::Set(df, static_cast<float>(l.width)), flx));
+    const VI step_x = hn::IfThenElseZero(hn::RebindMask(di, hn::Lt(flx, max_x)), hn::Set(di, 1));
+    const VI step_y =
+        hn::IfThenElseZero(hn::RebindMask(di, hn::Lt(fly, max_y)), hn::Set(di, l.width));
     const auto* base = reinterpret_cast<const uint32_t*>(l.texels);
-    const VU t00 = hn::GatherIndex(du, base, hn::Add(row0, x0));
-    const VU t10 = hn::GatherIndex(du, base, hn::Add(row0, x1));
-    const VU t01 = hn::GatherIndex(du, base, hn::Add(row1, x0));
-    const VU t11 = hn::GatherIndex(du, base, hn::Add(row1, x1));
+    const VI i01 = hn::Add(i00, step_y);
+    const VU t00 = hn::GatherIndex(du, base, i00);
+    const VU t10 = hn::GatherIndex(du, base, hn::Add(i00, step_x));
+    const VU t01 = hn::GatherIndex(du, base, i01);
+    const VU t11 = hn::GatherIndex(du, base, hn::Add(i01, step_x));
     Rgb out;
     out.r = lerp(wy, lerp(wx, channel<0>(t00), channel<0>(t10)),
                  lerp(wx, channel<0>(t01), channel<0>(t11)));
@@ -132,9 +140,10 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
 
 HWY_INLINE Rgb shade(const KernelParams& p, VF u, VF v, float chroma, uint8_t slot_mask) {
     const DF df;
-    const MapV m = mapPixels(p, u, v, chroma);
+    const bool single = (slot_mask & (slot_mask - 1)) == 0;
+    const MapV m = mapPixels(p, u, v, chroma, !single);
     Rgb rgb;
-    if ((slot_mask & (slot_mask - 1)) == 0) {
+    if (single) {
         const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
         rgb = sampleLayer(p.slots[k], m.px, m.py);
     } else {

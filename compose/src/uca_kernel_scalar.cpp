@@ -69,22 +69,20 @@ float channelOf(uint32_t texel, int c) {
 
 // Bilinear, clamp-to-edge, RGB of one layer at a rendered-image point.
 void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
-    float lx = px * l.inv_scale + l.offset_x;
-    float ly = py * l.inv_scale + l.offset_y;
-    // Far-away points only need to land beyond the edge; the clamp also keeps the int
-    // conversion defined.
-    lx = std::min(std::max(lx, -1.0f), static_cast<float>(l.width));
-    ly = std::min(std::max(ly, -1.0f), static_cast<float>(l.height));
+    // Clamping the texel coordinate to [0, size − 1] is clamp-to-edge: at the edge the weight
+    // of the tap beyond it is 0, and that tap is redirected onto the edge texel.
+    const float max_x = static_cast<float>(l.width - 1);
+    const float max_y = static_cast<float>(l.height - 1);
+    const float lx = std::min(std::max(px * l.inv_scale + l.offset_x, 0.0f), max_x);
+    const float ly = std::min(std::max(py * l.inv_scale + l.offset_y, 0.0f), max_y);
     const float flx = std::floor(lx);
     const float fly = std::floor(ly);
     const float wx = lx - flx;
     const float wy = ly - fly;
-    const int ix = static_cast<int>(flx);
-    const int iy = static_cast<int>(fly);
-    const int x0 = std::clamp(ix, 0, l.width - 1);
-    const int x1 = std::clamp(ix + 1, 0, l.width - 1);
-    const int y0 = std::clamp(iy, 0, l.height - 1);
-    const int y1 = std::clamp(iy + 1, 0, l.height - 1);
+    const int x0 = static_cast<int>(flx);
+    const int y0 = static_cast<int>(fly);
+    const int x1 = flx < max_x ? x0 + 1 : x0;
+    const int y1 = fly < max_y ? y0 + 1 : y0;
     const uint32_t t00 = loadTexel(l, x0, y0);
     const uint32_t t10 = loadTexel(l, x1, y0);
     const uint32_t t01 = loadTexel(l, x0, y1);
@@ -126,7 +124,8 @@ bool shade(const KernelParams& p, float u, float v, float chroma, uint8_t slot_m
 }
 
 uint32_t quantize(float value) {
-    return static_cast<uint32_t>(static_cast<int>(std::min(value + 0.5f, 255.0f)));
+    // A convex combination of bytes stays within [0, 255], so +0.5 and truncation round it.
+    return static_cast<uint32_t>(static_cast<int>(value + 0.5f));
 }
 
 }  // namespace
