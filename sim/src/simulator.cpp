@@ -257,7 +257,9 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
         r.render_start_ms = slot.start_ms;
         r.render_end_ms = slot.end_ms;
         r.render_work_ms = render_work_ms;
-        r.t_local_ms = slot.end_ms - slot.start_ms;
+        // What the headset measures: submission to completion, so time spent behind or
+        // preempted by composition and ATW passes counts (Fig. 4-③).
+        r.t_local_ms = render_work_ms > 0.0 ? slot.end_ms - ls_end : 0.0;
         r.preemptions = slot.preemptions;
 
         if (remote.valid) {

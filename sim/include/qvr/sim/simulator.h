@@ -47,7 +47,7 @@ struct FrameRecord {
     double display_ready_ms = 0.0;  // composition + ATW done
     // Durations.
     double render_work_ms = 0.0;  // local render at the GPU's rate, no interruptions
-    double t_local_ms = 0.0;      // render start → end as measured, preemptions included
+    double t_local_ms = 0.0;      // submission → render end: waits and preemptions included
     double t_remote_ms = 0.0;     // request → remote layers decoded
     double net_ms = 0.0;          // transmission alone
     double server_render_ms = 0.0;

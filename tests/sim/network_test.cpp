@@ -1,0 +1,134 @@
+// The downlink models (paper §5, Table 2): the Table 1 calibration, white noise at 20 dB SNR,
+// Mahimahi traces (parser on malformed input, rescaling, transfer timing) and profile names.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "qvr/sim/network.h"
+
+namespace qvr {
+namespace {
+
+TEST(Network, CalibrationReproducesTable1WithinAFewPercent) {
+    const double eta = calibratedLinkEfficiency();
+    EXPECT_GT(eta, 0.66);
+    EXPECT_LT(eta, 0.71);
+    for (const Table1Row& r : table1Rows()) {
+        const double t_ms = r.background_bytes * 8.0 / (eta * 200e6) * 1e3;
+        EXPECT_NEAR(t_ms, r.t_remote_ms, 0.03 * r.t_remote_ms) << r.app;
+    }
+    // The brief's example: 646 KB in 38 ms is about 136 Mbps.
+    EXPECT_NEAR(646e3 * 8 / 0.038 / 1e6, 136.0, 0.1);
+}
+
+TEST(Network, NoiseFreeTransferIsBytesOverGoodput) {
+    NoisyLink link("x", 100e6, 0.5, std::numeric_limits<double>::infinity(), {}, 1);
+    EXPECT_EQ(link.noiseSigma(), 0.0);
+    const LinkTransfer t = link.transfer(12.0, 1e6);
+    EXPECT_NEAR(t.duration_ms, 1e6 * 8 / 50e6 * 1e3, 1e-12);
+    EXPECT_NEAR(t.goodput_bps, 50e6, 1e-6);
+}
+
+TEST(Network, TwentyDbWhiteNoiseHasTenPercentSpreadAndNoBias) {
+    NoisyLink link("x", 200e6, calibratedLinkEfficiency(), 20.0, {}, 42);
+    EXPECT_NEAR(link.noiseSigma(), 0.1, 1e-12);
+    double sum = 0.0, sum2 = 0.0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+        const double g = link.transfer(0.0, 1e5).goodput_bps / link.meanGoodputBps();
+        sum += g;
+        sum2 += g * g;
+    }
+    const double mean = sum / n;
+    EXPECT_NEAR(mean, 1.0, 0.005);
+    EXPECT_NEAR(std::sqrt(sum2 / n - mean * mean), 0.1, 0.005);
+}
+
+TEST(Mahimahi, ParsesStampsAndRejectsMalformedTraces) {
+    auto ok = parseMahimahiTrace("0\n1\n1\r\n 5 \n\n10\n", "t");
+    ASSERT_TRUE(ok.ok()) << ok.error();
+    EXPECT_EQ(ok->opportunities_ms.size(), 5u);
+    EXPECT_EQ(ok->period_ms, 10.0);
+    EXPECT_NEAR(ok->meanBps(), 5 * 1500 * 8 / 0.010, 1e-6);
+    for (const char* bad : {"", "\n\n", "0\n", "1\nx\n", "5\n3\n", "-1\n2\n", "1.5\n",
+                            "99999999999999999999\n", "2000000000\n", "12abc\n"}) {
+        auto r = parseMahimahiTrace(bad, "bad.down");
+        EXPECT_FALSE(r.ok()) << "accepted: '" << bad << "'";
+        if (!r.ok()) {
+            EXPECT_NE(r.error().find("bad.down"), std::string::npos);
+        }
+    }
+    EXPECT_FALSE(loadMahimahiTrace("/nonexistent/trace.down").ok());
+}
+
+TEST(Mahimahi, TraceLinkRescalesAndTimesTransfersByOpportunity) {
+    // One packet opportunity per millisecond: 12 Mbps. Rescaled to 24 Mbps every stamp halves.
+    std::string text;
+    for (int t = 1; t <= 1000; ++t)
+        text += std::to_string(t) + "\n";
+    auto trace = parseMahimahiTrace(text, "uniform");
+    ASSERT_TRUE(trace.ok());
+    EXPECT_NEAR(trace->meanBps(), 12e6, 1e-6);
+    TraceLink link("uniform", *trace, 24e6, 1.0, {});
+    EXPECT_NEAR(link.timeScale(), 0.5, 1e-12);
+    // 30 packets from t = 0 leave at 0.5, 1.0, …, 15.0 ms.
+    const LinkTransfer t = link.transfer(0.0, 30 * 1500.0);
+    EXPECT_NEAR(t.duration_ms, 15.0, 1e-9);
+    // The trace loops: starting near its end, the last stamp (500) then the next loop's 0.5
+    // and 1.0 carry three packets.
+    const LinkTransfer w = link.transfer(499.9, 3 * 1500.0);
+    EXPECT_NEAR(w.duration_ms, 501.0 - 499.9, 1e-9);
+    // Payload efficiency inflates the packet count.
+    TraceLink half("uniform", *trace, 24e6, 0.5, {});
+    EXPECT_NEAR(half.transfer(0.0, 30 * 1500.0).duration_ms, 30.0, 1e-9);
+    // A payload many loops long costs whole loops.
+    EXPECT_NEAR(link.transfer(0.0, 2000.0 * 1500.0 * 3).duration_ms, 3000.0, 1e-9);
+}
+
+TEST(Mahimahi, SharedVerizonTraceHasItsDocumentedMeanAndRescales) {
+    const std::string path = std::string(QVR_SHARED_DIR) + "/data/network/Verizon-LTE-short.down";
+    if (!std::filesystem::exists(path))
+        GTEST_SKIP() << "no " << path;
+    auto trace = loadMahimahiTrace(path);
+    ASSERT_TRUE(trace.ok()) << trace.error();
+    EXPECT_EQ(trace->opportunities_ms.size(), 58655u);
+    EXPECT_NEAR(trace->meanBps() / 1e6, 5.0, 0.1);
+    TraceLink link("verizon", *trace, 100e6, 1.0, {});
+    // Over the whole (rescaled) loop the goodput is the target mean.
+    const double loop_bytes = 58655 * 1500.0;
+    const LinkTransfer t = link.transfer(0.0, loop_bytes);
+    EXPECT_NEAR(t.goodput_bps / 1e6, 100.0, 2.0);
+}
+
+TEST(Network, ProfilesByNameAndClearErrors) {
+    auto wifi = networkSpecByName("wifi");
+    ASSERT_TRUE(wifi.ok());
+    EXPECT_EQ(wifi->nominal_bps, 200e6);
+    EXPECT_EQ(networkSpecByName("lte")->nominal_bps, 100e6);
+    EXPECT_EQ(networkSpecByName("5g")->nominal_bps, 500e6);
+    auto tr = networkSpecByName("trace:/x/y.down@50");
+    ASSERT_TRUE(tr.ok());
+    EXPECT_EQ(tr->trace_path, "/x/y.down");
+    EXPECT_EQ(tr->nominal_bps, 50e6);
+    EXPECT_EQ(networkSpecByName("trace:/x/y.down")->nominal_bps, 100e6);
+    for (const char* bad :
+         {"wlan", "", "trace:", "trace:/a@", "trace:/a@-3", "trace:/a@x", "trace:/a@nan"}) {
+        auto r = networkSpecByName(bad);
+        EXPECT_FALSE(r.ok()) << bad;
+    }
+    auto missing = networkSpecByName("trace:/nonexistent.down");
+    ASSERT_TRUE(missing.ok());
+    EXPECT_FALSE(makeLink(*missing, 1).ok());
+}
+
+TEST(Network, RadioEnergyPerBitFollowsTheActivePowerModel) {
+    const RadioPower lte{51.97, 1288.04};
+    // At 100 Mbps: α + β/R = 51.97 + 12.88 nJ/bit.
+    EXPECT_NEAR(lte.energyPerBitNj(100e6), 51.97 + 12.8804, 1e-9);
+    EXPECT_EQ(lte.energyPerBitNj(0.0), 0.0);
+}
+
+}  // namespace
+}  // namespace qvr
