@@ -25,21 +25,7 @@ struct Fixture {
         for (const auto& f : trace.frames) {
             const LayerPlan plan = truth.planner().plan(f.gaze, 12.0);
             const FrameCost c = truth.cost(f, plan);
-            FrameMeasurement m;
-            m.index = f.index;
-            m.e1_deg = 12.0;
-            m.t_local_ms = c.local_ms;
-            m.t_remote_ms = c.remote_ms;
-            m.triangles_local = c.triangles_local;
-            m.pixels_local = c.pixels_local;
-            m.middle_bytes = c.bytes.middle;
-            m.outer_bytes = c.bytes.outer;
-            m.middle_pixels = 2.0 * static_cast<double>(plan.middle_pixels);
-            m.outer_pixels = 2.0 * static_cast<double>(plan.outer_pixels);
-            m.s1 = plan.s1;
-            m.s2 = plan.s2;
-            m.throughput_bps = truth.throughputBps();
-            measurements.push_back(m);
+            measurements.push_back(measureFrame(f.index, plan, c, truth.throughputBps()));
         }
     }
 };

@@ -24,20 +24,7 @@ ControlRun runPolicy(FoveaPolicy& policy, const WorkloadTrace& trace, const Cost
             motion = liwc->lastMotion();
         const LayerPlan plan = truth.planner().plan(f.gaze, d.e1_deg);
         const FrameCost c = truth.cost(f, plan);
-        FrameMeasurement m;
-        m.index = i;
-        m.e1_deg = plan.e1_deg;
-        m.t_local_ms = c.local_ms;
-        m.t_remote_ms = c.remote_ms;
-        m.triangles_local = c.triangles_local;
-        m.pixels_local = c.pixels_local;
-        m.middle_bytes = c.bytes.middle;
-        m.outer_bytes = c.bytes.outer;
-        m.middle_pixels = 2.0 * static_cast<double>(plan.middle_pixels);
-        m.outer_pixels = 2.0 * static_cast<double>(plan.outer_pixels);
-        m.s1 = plan.s1;
-        m.s2 = plan.s2;
-        m.throughput_bps = c.remote_ms > 0 ? truth.throughputBps() : 0.0;
+        const FrameMeasurement m = measureFrame(i, plan, c, truth.throughputBps());
         policy.observe(m);
 
         ControlFrame cf;

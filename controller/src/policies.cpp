@@ -7,8 +7,29 @@
 
 #include "qvr/controller/policy.h"
 #include "qvr/controller/remote_size_table.h"
+#include "qvr/core/minimize.h"
 
 namespace qvr {
+
+FrameMeasurement measureFrame(int64_t index, const LayerPlan& plan, const FrameCost& cost,
+                              double throughput_bps) {
+    FrameMeasurement m;
+    m.index = index;
+    m.e1_deg = plan.e1_deg;
+    m.t_local_ms = cost.local_ms;
+    m.t_remote_ms = cost.remote_ms;
+    m.triangles_local = cost.triangles_local;
+    m.pixels_local = cost.pixels_local;
+    m.middle_bytes = cost.bytes.middle;
+    m.outer_bytes = cost.bytes.outer;
+    // Plans count pixels per eye; both eyes are rendered and sent.
+    m.middle_pixels = 2.0 * static_cast<double>(plan.middle_pixels);
+    m.outer_pixels = 2.0 * static_cast<double>(plan.outer_pixels);
+    m.s1 = plan.s1;
+    m.s2 = plan.s2;
+    m.throughput_bps = cost.remote_ms > 0 ? throughput_bps : 0.0;
+    return m;
+}
 
 Decision FixedPolicy::decide(const WorkloadFrame&) {
     return {m_e1_deg, std::numeric_limits<double>::quiet_NaN(),
@@ -109,26 +130,8 @@ public:
             consider(e);
         consider(hi);
         // max(T_local, T_remote) is unimodal near its minimum: refine by golden section.
-        double lo = std::max(m_e1_min, best_e - 1.0), up = std::min(hi, best_e + 1.0);
-        constexpr double kInvPhi = 0.6180339887498949;
-        double a = up - kInvPhi * (up - lo), b = lo + kInvPhi * (up - lo);
-        double fa = cost(a), fb = cost(b);
-        for (int i = 0; i < 24; ++i) {
-            if (fa < fb) {
-                up = b;
-                b = a;
-                fb = fa;
-                a = up - kInvPhi * (up - lo);
-                fa = cost(a);
-            } else {
-                lo = a;
-                a = b;
-                fa = fb;
-                b = lo + kInvPhi * (up - lo);
-                fb = cost(b);
-            }
-        }
-        consider(0.5 * (lo + up));
+        consider(goldenSectionMin(cost, std::max(m_e1_min, best_e - 1.0),
+                                  std::min(hi, best_e + 1.0), 24));
         const FrameCost c = m_truth.cost(frame, best_e);
         return {best_e, c.local_ms, c.remote_ms};
     }

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "qvr/core/minimize.h"
+
 namespace qvr {
 
 namespace {
@@ -65,29 +67,9 @@ double LayerPlanner::optimalE2Deg(const Gaze& gaze, double e1_deg) const {
         consider(e2);
     consider(cover);
     // Refine inside the scan cell on either side of the best point.
-    double lo = std::max(e1_deg, best_e2 - kScanStepDeg);
-    double hi = std::min(cover, best_e2 + kScanStepDeg);
-    constexpr double kInvPhi = 0.6180339887498949;
-    double a = hi - kInvPhi * (hi - lo);
-    double b = lo + kInvPhi * (hi - lo);
-    double fa = cost(a);
-    double fb = cost(b);
-    for (int i = 0; i < 30 && hi - lo > 1e-4; ++i) {
-        if (fa < fb) {
-            hi = b;
-            b = a;
-            fb = fa;
-            a = hi - kInvPhi * (hi - lo);
-            fa = cost(a);
-        } else {
-            lo = a;
-            a = b;
-            fa = fb;
-            b = lo + kInvPhi * (hi - lo);
-            fb = cost(b);
-        }
-    }
-    consider(0.5 * (lo + hi));
+    const double lo = std::max(e1_deg, best_e2 - kScanStepDeg);
+    const double hi = std::min(cover, best_e2 + kScanStepDeg);
+    consider(goldenSectionMin(cost, lo, hi, 30, 1e-4));
     return best_e2;
 }
 

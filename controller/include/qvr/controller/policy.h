@@ -38,6 +38,11 @@ struct FrameMeasurement {
     double throughput_bps = 0.0;  // measured from acknowledgements; 0 if nothing was sent
 };
 
+// What the headset would measure of a frame rendered with `plan` at cost `cost`, the remote part
+// having crossed a link of throughput_bps (0 if nothing was sent).
+FrameMeasurement measureFrame(int64_t index, const LayerPlan& plan, const FrameCost& cost,
+                              double throughput_bps);
+
 class FoveaPolicy {
 public:
     virtual ~FoveaPolicy() = default;
