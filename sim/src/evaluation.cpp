@@ -110,7 +110,7 @@ nlohmann::json runJson(const RunSummary& s) {
 bool runGnuplot(const fs::path& script_path, const std::string& body, std::string& terminal) {
     for (const char* term : {"pngcairo", "png"}) {
         const std::string script =
-            fmt::format("set terminal {} size 1100,520 {}\n{}", term,
+            fmt::format("set terminal {} size 1100,520 noenhanced {}\n{}", term,
                         std::string(term) == "pngcairo" ? "font 'sans,10'" : "", body);
         if (!writeText(script_path, script))
             return false;
@@ -327,7 +327,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     if (auto st = csv("fig12_speedup.csv", fig12); !st)
         return makeError(st.error());
     plot("fig12",
-         "set datafile separator ','\nset title 'Fig. 12: end-to-end speedup over local (500 MHz, "
+         "set datafile separator ','\nset key autotitle columnheader\nset title 'Fig. 12: end-to-end speedup over local (500 MHz, "
          "Wi-Fi)'\nset style data histogram\nset style histogram clustered gap 1\n"
          "set style fill solid 0.8 border -1\nset key outside right\nset ylabel 'speedup (x)'\n"
          "set y2label 'FPS over local (x)'\nset y2tics\nset ytics nomirror\nset grid ytics\n"
@@ -398,7 +398,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
              fmt::format("set datafile separator ','\nset multiplot layout 1,2 title 'Fig. 14: "
                          "Q-VR over {} frames from e1 = 5 deg (500 MHz, Wi-Fi)'\nset key top "
                          "right font ',8'\nset grid\nset xlabel 'frame'\nset title '(a) latency "
-                         "ratio T_{{remote}}/T_{{local}}'\nset logscale y\nplot for [i=2:{}] "
+                         "ratio T_remote/T_local'\nset logscale y\nplot for [i=2:{}] "
                          "'fig14_latency_ratio.csv' using 1:i with lines title columnheader(i)\n"
                          "unset logscale y\nset title '(b) FPS'\nplot for [i=2:{}] "
                          "'fig14_fps.csv' using 1:i with lines title columnheader(i), 90 with "
