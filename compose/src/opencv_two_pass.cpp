@@ -12,7 +12,6 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "qvr/compose/warp.h"
 #include "uca_kernel.h"
 #endif
 
@@ -58,7 +57,6 @@ Status OpenCvTwoPass::run(const LayerFrame& frame, const Pose& display_pose,
     Scratch& s = *m_scratch;
     const int width = m_profile.width_px;
     const int height = m_profile.height_px;
-    const EyeWarp warp(m_profile, frame.render_pose.orientation, display_pose.orientation);
     for (int eye = 0; eye < 2; ++eye) {
         const detail::KernelParams p =
             detail::composeParams(m_profile, frame, eye, m_options.blend_band_texels);
@@ -121,20 +119,34 @@ Status OpenCvTwoPass::run(const LayerFrame& frame, const Pose& display_pose,
                 s.blended.copyTo(dst);
             }
         }
-        // Pass 2: lens + timewarp maps for this display pose, then remap the eye buffer.
+        // Pass 2: lens + timewarp maps for this display pose (float, the loop vectorises),
+        // then remap the eye buffer.
         s.disp_x.create(height, width, CV_32FC1);
         s.disp_y.create(height, width, CV_32FC1);
-        const double chroma_free = 1.0;
+        const detail::KernelParams w =
+            detail::timewarpParams(m_profile, frame.render_pose, display_pose, frame.plan.gaze);
         s.arena.execute([&] {
             tbb::parallel_for(
                 tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
                     for (int y = rows.begin(); y < rows.end(); ++y) {
-                        float* mx = s.disp_x.ptr<float>(y);
-                        float* my = s.disp_y.ptr<float>(y);
+                        float* __restrict mx = s.disp_x.ptr<float>(y);
+                        float* __restrict my = s.disp_y.ptr<float>(y);
+                        const float yt = static_cast<float>(y) * w.ay + w.by;
                         for (int x = 0; x < width; ++x) {
-                            const WarpSample w = warp.map(x + 0.5, y + 0.5, chroma_free);
-                            mx[x] = w.inside ? static_cast<float>(w.px - 0.5) : -10.0f;
-                            my[x] = w.inside ? static_cast<float>(w.py - 0.5) : -10.0f;
+                            const float xt = static_cast<float>(x) * w.ax + w.bx;
+                            const float f =
+                                (w.k2 * (xt * xt + yt * yt) + w.k1) * (xt * xt + yt * yt) + 1.0f;
+                            const float xd = xt * f, yd = yt * f;
+                            const float rx = w.m[0] * xd + w.m[1] * yd - w.m[2];
+                            const float ry = w.m[3] * xd + w.m[4] * yd - w.m[5];
+                            const float depth = -(w.m[6] * xd + w.m[7] * yd - w.m[8]);
+                            const float iz = 1.0f / std::max(depth, 1e-6f);
+                            const float px = rx * (w.fx * iz) + w.cx;
+                            const float py = ry * (-w.fy * iz) + w.cy;
+                            const bool inside = depth > 1e-6f && px >= 0.0f && px <= w.width &&
+                                                py >= 0.0f && py <= w.height;
+                            mx[x] = inside ? px - 0.5f : -10.0f;
+                            my[x] = inside ? py - 0.5f : -10.0f;
                         }
                     }
                 });

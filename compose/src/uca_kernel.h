@@ -62,6 +62,9 @@ void ucaTileScalar(const KernelParams& p, const TileJob& job);
 // its slots and blend ramps, shared with the OpenCV anchor so that all paths blend alike.
 KernelParams composeParams(const HmdProfile& profile, const LayerFrame& frame, int eye,
                            double blend_band_texels);
+// The lens + timewarp map of one eye (no slots): what a remap-based path needs to build its maps.
+KernelParams timewarpParams(const HmdProfile& profile, const Pose& render_pose,
+                            const Pose& display_pose, const Gaze& gaze);
 // Which plan layer (0 fovea, 1 middle, 2 outer) each kernel slot holds.
 void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count);
 void ucaTileSimd(const KernelParams& p, const TileJob& job);
