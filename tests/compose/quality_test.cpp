@@ -21,7 +21,7 @@ HmdProfile midProfile() {
     return p;
 }
 
-TEST(Quality, IdenticalImageHasInfinitePsnrAndUnitSsim) {
+TEST(ComposeQuality, IdenticalImageHasInfinitePsnrAndUnitSsim) {
     HmdProfile profile = midProfile();
     profile.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 15.0);
@@ -45,7 +45,7 @@ TEST(Quality, IdenticalImageHasInfinitePsnrAndUnitSsim) {
     EXPECT_LT(s.all.ssim, 0.95);
 }
 
-TEST(Quality, UcaIsAtLeastAsGoodAsTwoPassInFoveaAndPeriphery) {
+TEST(ComposeQuality, UcaIsAtLeastAsGoodAsTwoPassInFoveaAndPeriphery) {
     const HmdProfile profile = midProfile();
     const LayerPlanner planner(profile);
     const LayerPlan plan = planner.plan({4.0, -2.0}, 15.0);

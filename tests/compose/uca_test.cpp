@@ -79,7 +79,7 @@ Diff compare(const ImageRgba8& a, const ImageRgba8& b) {
     return d;
 }
 
-TEST(Uca, FastPathMatchesScalarTwinOnRandomInputs) {
+TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
     std::mt19937 rng(std::random_device{}());
     std::uniform_real_distribution<double> angle(-3.0, 3.0);
     std::uniform_real_distribution<double> gaze(-15.0, 15.0);
@@ -121,7 +121,7 @@ TEST(Uca, FastPathMatchesScalarTwinOnRandomInputs) {
     }
 }
 
-TEST(Uca, TileClassificationNeverChangesAPixel) {
+TEST(ComposeUca, TileClassificationNeverChangesAPixel) {
     std::mt19937 rng(std::random_device{}());
     std::uniform_real_distribution<double> angle(-3.0, 3.0);
     std::uniform_real_distribution<double> gaze(-20.0, 20.0);
@@ -149,7 +149,7 @@ TEST(Uca, TileClassificationNeverChangesAPixel) {
     }
 }
 
-TEST(Uca, IdentityPoseNoLensAllFoveaReproducesInput) {
+TEST(ComposeUca, IdentityPoseNoLensAllFoveaReproducesInput) {
     std::mt19937 rng(std::random_device{}());
     const HmdProfile profile = noLens(smallProfile(300, 260));
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 180.0);
@@ -194,7 +194,7 @@ void brightCentroid(const ImageRgba8& img, double& cx, double& cy) {
     cy = sy / sw;
 }
 
-TEST(Uca, KnownYawAndPitchMoveAMarkerByThePredictedPixels) {
+TEST(ComposeUca, KnownYawAndPitchMoveAMarkerByThePredictedPixels) {
     const HmdProfile profile = noLens(smallProfile(640, 720));
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 180.0);
     LayerFrame frame;
@@ -264,7 +264,7 @@ int maxStep(const ImageRgba8& img, int row, int x0, int x1) {
     return m;
 }
 
-TEST(Uca, BorderBlendHasNoStepLargerThanItsNeighbours) {
+TEST(ComposeUca, BorderBlendHasNoStepLargerThanItsNeighbours) {
     const HmdProfile profile = noLens(defaultHmdProfile());
     const LayerPlanner planner(profile);
     const LayerPlan plan = planner.plan({0.0, 0.0}, 15.0);
@@ -301,7 +301,7 @@ TEST(Uca, BorderBlendHasNoStepLargerThanItsNeighbours) {
     EXPECT_GE(border, 6);
 }
 
-TEST(Uca, ReuseRewarpsTheNewestLayersToTheNewPoseAndSaysSo) {
+TEST(ComposeUca, ReuseRewarpsTheNewestLayersToTheNewPoseAndSaysSo) {
     const HmdProfile profile = smallProfile(320, 360);
     const LayerPlanner planner(profile);
     const ImageRgba8 full = renderTestPattern(profile.width_px, profile.height_px);
@@ -339,7 +339,7 @@ TEST(Uca, ReuseRewarpsTheNewestLayersToTheNewPoseAndSaysSo) {
     EXPECT_EQ(c.present(nullptr, later, late)->frame_index, 8u);
 }
 
-TEST(Uca, ReuseWithoutAnyFrameIsAnError) {
+TEST(ComposeUca, ReuseWithoutAnyFrameIsAnError) {
     Compositor c(smallProfile());
     std::array<ImageRgba8, 2> out;
     auto r = c.present(nullptr, Pose{}, out);
@@ -347,7 +347,7 @@ TEST(Uca, ReuseWithoutAnyFrameIsAnError) {
     EXPECT_NE(r.error().find("late"), std::string::npos);
 }
 
-TEST(Uca, MismatchedSizesOrPlansGiveErrorsNotCrashes) {
+TEST(ComposeUca, MismatchedSizesOrPlansGiveErrorsNotCrashes) {
     std::mt19937 rng(1234);
     const HmdProfile profile = smallProfile(256, 288);
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 15.0);
