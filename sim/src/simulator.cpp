@@ -388,6 +388,7 @@ RunSummary summarize(const std::vector<FrameRecord>& frames, const SimConfig& co
         s.e1_deg_mean += r.e1_deg / n;
         s.t_local_ms_mean += r.t_local_ms / n;
         s.t_remote_ms_mean += r.t_remote_ms / n;
+        s.render_wait_ms_mean += (r.t_local_ms - r.render_work_ms) / n;
         s.gpu_ms_mean += r.gpu_ms / n;
         s.net_ms_mean += r.net_ms / n;
         s.preemptions_per_frame += r.preemptions / n;

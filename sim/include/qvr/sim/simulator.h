@@ -86,6 +86,7 @@ struct RunSummary {
     double latency_ratio_final = 0.0;  // median over the last 30 frames
     double t_local_ms_mean = 0.0;
     double t_remote_ms_mean = 0.0;
+    double render_wait_ms_mean = 0.0;  // T_local − render work: time behind/preempted by passes
     double gpu_ms_mean = 0.0;
     double net_ms_mean = 0.0;
     double preemptions_per_frame = 0.0;
