@@ -1,0 +1,51 @@
+// The OpenGL 4.5 core renderer, headless through EGL's surfaceless platform (Mesa llvmpipe on a
+// CPU, a vendor driver on a GPU): textured, lightmapped triangles into an off-screen framebuffer
+// per layer size, with GPU time and primitive counts from GL queries.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "qvr/core/expected.h"
+#include "qvr/render/renderer.h"
+
+namespace qvr {
+
+struct GlRendererOptions {
+    // Multiplies the lightmap before shading; Quake III levels are authored for an overbright
+    // factor of 2 (r_mapOverBrightBits 1 on a gamma-ramped display).
+    float lightmap_gain = 1.0f;
+};
+
+struct GlInfo {
+    std::string egl_platform;  // "surfaceless" or "default"
+    std::string vendor;
+    std::string renderer;
+    std::string version;
+    bool pipeline_statistics = false;  // GL_ARB_pipeline_statistics_query
+    int max_framebuffer_px = 0;        // the larger of the renderbuffer and viewport limits
+};
+
+class GlRenderer final : public Renderer {
+public:
+    // Creates an EGL display, a core 4.5 context and the shaders, and makes the context current
+    // on the calling thread; the renderer must then be used from that thread only. Errors (no
+    // EGL, no GL 4.5) are reported with what to install, never a crash.
+    static Expected<std::unique_ptr<GlRenderer>> create(const GlRendererOptions& options = {});
+    ~GlRenderer() override;
+    GlRenderer(const GlRenderer&) = delete;
+    GlRenderer& operator=(const GlRenderer&) = delete;
+
+    const GlInfo& info() const;
+    std::string name() const override;
+    Status upload(const Scene& scene) override;
+    Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) override;
+
+    struct Impl;
+
+private:
+    explicit GlRenderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace qvr

@@ -1,0 +1,62 @@
+// The renderer seam (paper §3.2: the headset renders the fovea layer, the server the middle and
+// outer layers, each into its own framebuffer): upload a scene once, then render views of it.
+// A null implementation serves tests that need no pixels; the OpenGL one lives in gl_renderer.h.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "qvr/core/expected.h"
+#include "qvr/core/image.h"
+#include "qvr/render/camera.h"
+#include "qvr/scene/scene.h"
+
+namespace qvr {
+
+struct RenderStats {
+    // Time the GPU spent on the draws (GL_TIME_ELAPSED); on llvmpipe this is CPU rasterizer time.
+    double gpu_ms = 0.0;
+    // Wall-clock time from the first command to the finished frame, before the read-back.
+    double render_ms = 0.0;
+    // Wall-clock time of copying the framebuffer into the image.
+    double readback_ms = 0.0;
+    // Triangles submitted after the CPU's per-batch frustum culling (GL_PRIMITIVES_GENERATED).
+    uint64_t primitives_generated = 0;
+    // Triangles that reached the clipper and that left it (ARB_pipeline_statistics_query);
+    // 0 when the driver does not offer the statistics.
+    uint64_t clipping_input_primitives = 0;
+    uint64_t clipping_output_primitives = 0;
+    uint32_t batches_drawn = 0;
+    uint32_t batches_culled = 0;
+};
+
+class Renderer {
+public:
+    virtual ~Renderer() = default;
+
+    virtual std::string name() const = 0;
+    // Copies the scene's geometry and textures to the device; replaces any earlier scene.
+    virtual Status upload(const Scene& scene) = 0;
+    // Renders the uploaded scene as `view` sees it into `out`, resized to the view's size, row 0
+    // at the top, alpha 255. Errors only for a failing device, never for an empty view.
+    virtual Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) = 0;
+};
+
+// Renders nothing: fills the image with the clear colour and reports the triangles the batches
+// that survive frustum culling hold — the same count the OpenGL renderer submits.
+std::unique_ptr<Renderer> makeNullRenderer();
+
+// The batches of `scene` a view draws after per-batch frustum culling, and their triangles.
+struct BatchSelection {
+    std::vector<uint32_t> batches;
+    uint64_t triangles = 0;
+    uint32_t culled = 0;
+};
+BatchSelection selectBatches(const std::vector<SceneBatch>& batches, const RenderView& view);
+
+// The colour of pixels no triangle covers: a dark blue that no test texture uses.
+inline constexpr uint8_t kClearRgba[4] = {20, 24, 40, 255};
+
+}  // namespace qvr

@@ -1,0 +1,244 @@
+// The OpenGL renderer on Mesa's surfaceless EGL: context creation, geometry landing where the
+// pinhole projection puts it, layers that are pieces of the full frame at their own scale, and
+// primitive counts that match what the CPU submitted.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+#include "hand_made_scene.h"
+#include "qvr/foveation/eye_geometry.h"
+#include "qvr/render/gl_renderer.h"
+#include "render_test_util.h"
+
+namespace qvr {
+namespace {
+
+bool isRed(const uint8_t* p) {
+    return p[0] > 200 && p[1] < 60 && p[2] < 60;
+}
+
+// One 6 cm red square facing the eye, `distance_m` along the eye-space direction `dir`.
+Scene redMarker(const Pose& eye_pose, const glm::dvec3& dir, double distance_m) {
+    Scene s;
+    s.name = "test:marker";
+    const glm::vec3 d = glm::normalize(eye_pose.orientation * glm::vec3(dir));
+    const glm::vec3 c = eye_pose.position_m + d * static_cast<float>(distance_m);
+    const glm::vec3 right =
+        glm::normalize(glm::cross(d, eye_pose.orientation * glm::vec3(0, 1, 0)));
+    const glm::vec3 up = glm::cross(right, d);
+    const float h = 0.03f;
+    test::addQuad(s, c - right * h - up * h, c + right * h - up * h, c + right * h + up * h,
+                  c - right * h + up * h, -1, -1, {255, 0, 0, 255});
+    return s;
+}
+
+TEST(GlRenderer, CreatesAnOpenGl45CoreContextThroughEgl) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    const GlInfo& info = gl->info();
+    int major = 0, minor = 0;
+    ASSERT_EQ(std::sscanf(info.version.c_str(), "%d.%d", &major, &minor), 2) << info.version;
+    EXPECT_GE(major * 10 + minor, 45) << info.version;
+    EXPECT_FALSE(info.renderer.empty());
+    EXPECT_GE(info.max_framebuffer_px, 2160);
+    std::printf("EGL platform %s, GL %s on %s, pipeline statistics %s\n", info.egl_platform.c_str(),
+                info.version.c_str(), info.renderer.c_str(),
+                info.pipeline_statistics ? "yes" : "no");
+}
+
+TEST(GlRenderer, QuadLandsAtThePixelTheProjectionPredicts) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    const HmdProfile profile = test::smallProfile();
+    const EyeGeometry geometry(profile);
+    Pose head;
+    head.orientation = quatFromEulerDeg({20.0, 5.0, 3.0});
+    head.position_m = {1.0f, 2.0f, 3.0f};
+    const double px = 210.0, py = 95.0;
+    const Pose ep = eyePose(head, Eye::kLeft, 0.064);
+    ASSERT_TRUE(gl->upload(redMarker(ep, geometry.directionAt(px, py), 2.0)));
+
+    ImageRgba8 full;
+    auto stats = gl->render(fullFrameView(profile, head, Eye::kLeft), full);
+    ASSERT_TRUE(stats) << stats.error();
+    const test::Centroid c = test::centroidOf(full, isRed);
+    ASSERT_GT(c.count, 4);
+    EXPECT_NEAR(c.x, px, 0.75);
+    EXPECT_NEAR(c.y, py, 0.75);
+    EXPECT_EQ(full.at(10, 10, 0), kClearRgba[0]);
+
+    // The same marker in a layer at scale 2.5 whose rect holds it, off the image centre.
+    LayerRect l;
+    l.rect = {150, 40, 290, 200};
+    l.scale = 2.5;
+    l.width_px = 56;
+    l.height_px = 64;
+    ImageRgba8 layer;
+    ASSERT_TRUE(gl->render(layerView(profile, head, Eye::kLeft, l), layer));
+    const test::Centroid lc = test::centroidOf(layer, isRed);
+    ASSERT_GT(lc.count, 0);
+    EXPECT_NEAR(l.rect.x0 + lc.x * l.scale, px, 0.75 * l.scale);
+    EXPECT_NEAR(l.rect.y0 + lc.y * l.scale, py, 0.75 * l.scale);
+}
+
+TEST(GlRenderer, EyesSeeANearObjectWithTheDisparityOfTheIpd) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    const HmdProfile profile = test::smallProfile();
+    const Pose head;
+    // Straight ahead of the head centre at 1 m: each eye sees it fx·(ipd/2)/1 px off centre.
+    Pose centre = head;
+    ASSERT_TRUE(gl->upload(redMarker(centre, {0, 0, -1}, 1.0)));
+    ImageRgba8 left, right;
+    ASSERT_TRUE(gl->render(fullFrameView(profile, head, Eye::kLeft), left));
+    ASSERT_TRUE(gl->render(fullFrameView(profile, head, Eye::kRight), right));
+    const double offset = profile.focalXPx() * 0.032;
+    const test::Centroid cl = test::centroidOf(left, isRed);
+    const test::Centroid cr = test::centroidOf(right, isRed);
+    EXPECT_NEAR(cl.x, 160.0 + offset, 0.75);
+    EXPECT_NEAR(cr.x, 160.0 - offset, 0.75);
+    EXPECT_NEAR(cl.y, 180.0, 0.75);
+    EXPECT_NEAR(cr.y, 180.0, 0.75);
+}
+
+class GlLayers : public ::testing::Test {
+protected:
+    void render(GlRenderer* gl) {
+        ASSERT_TRUE(gl->upload(test::texturedRoom()));
+        head.orientation = quatFromEulerDeg({12.0, -8.0, 0.0});
+        head.position_m = {0.3f, 0.2f, 0.5f};
+        plan = LayerPlanner(profile).plan({6.0, -4.0}, 12.0);
+        auto s = gl->render(fullFrameView(profile, head, Eye::kRight), full);
+        ASSERT_TRUE(s) << s.error();
+    }
+    HmdProfile profile = test::smallProfile();
+    Pose head;
+    LayerPlan plan;
+    ImageRgba8 full;
+};
+
+TEST_F(GlLayers, FoveaLayerIsTheFullFramesRectAtFullResolution) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    render(gl);
+    const LayerRect& fovea = plan.eyes[1].fovea;
+    ASSERT_EQ(fovea.scale, 1.0);
+    ImageRgba8 layer;
+    ASSERT_TRUE(gl->render(layerView(profile, head, Eye::kRight, fovea), layer));
+    // Same pixel centres through a different (off-axis) matrix: equal up to rounding of the
+    // interpolants.
+    const double psnr = test::psnrDb(
+        layer, test::crop(full, fovea.rect.x0, fovea.rect.y0, layer.width(), layer.height()));
+    EXPECT_GT(psnr, 40.0);
+    std::printf("fovea %dx%d vs full-frame crop: PSNR %.1f dB\n", layer.width(), layer.height(),
+                psnr);
+}
+
+TEST_F(GlLayers, MiddleAndOuterLayersAreTheFullFrameDownsampledAndLineUp) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    render(gl);
+    for (LayerKind kind : {LayerKind::kMiddle, LayerKind::kOuter}) {
+        const LayerRect& l = layerOf(plan.eyes[1], kind);
+        ASSERT_GT(l.scale, 1.5) << layerName(kind);
+        ImageRgba8 layer;
+        ASSERT_TRUE(gl->render(layerView(profile, head, Eye::kRight, l), layer));
+        ASSERT_EQ(layer.width(), l.width_px);
+        const double aligned = test::psnrDb(
+            layer,
+            test::areaDownsample(full, l.rect.x0, l.rect.y0, l.scale, l.width_px, l.height_px));
+        // A layer shifted by one texel against the reference must match worse in every
+        // direction: the rect's edges map onto the frame where UCA expects them.
+        double best_shifted = 0.0;
+        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+            const double shifted =
+                test::psnrDb(layer, test::areaDownsample(full, l.rect.x0 + dx * l.scale,
+                                                         l.rect.y0 + dy * l.scale, l.scale,
+                                                         l.width_px, l.height_px));
+            best_shifted = std::max(best_shifted, shifted);
+        }
+        std::printf("%s %dx%d at scale %.2f: PSNR %.1f dB aligned, %.1f dB best one-texel shift\n",
+                    layerName(kind), l.width_px, l.height_px, l.scale, aligned, best_shifted);
+        EXPECT_GT(aligned, 25.0) << layerName(kind);
+        EXPECT_GT(aligned, best_shifted + 3.0) << layerName(kind);
+    }
+}
+
+TEST(GlRenderer, PrimitivesGeneratedEqualTheTrianglesSubmitted) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    const Scene room = test::texturedRoom();
+    const HmdProfile profile = test::smallProfile();
+    auto null_renderer = makeNullRenderer();
+    ASSERT_TRUE(gl->upload(room));
+    ASSERT_TRUE(null_renderer->upload(room));
+    ImageRgba8 a, b;
+    for (double yaw : {0.0, 60.0, 180.0, 250.0}) {
+        Pose head;
+        head.orientation = quatFromEulerDeg({yaw, 10.0, 0.0});
+        const RenderView v = fullFrameView(profile, head, Eye::kLeft);
+        auto g = gl->render(v, a);
+        auto n = null_renderer->render(v, b);
+        ASSERT_TRUE(g) << g.error();
+        ASSERT_TRUE(n);
+        EXPECT_EQ(g->primitives_generated, n->primitives_generated) << "yaw " << yaw;
+        EXPECT_EQ(g->batches_drawn, n->batches_drawn);
+        if (gl->info().pipeline_statistics) {
+            EXPECT_EQ(g->clipping_input_primitives, g->primitives_generated);
+        }
+        EXPECT_GE(g->gpu_ms, 0.0);
+    }
+}
+
+TEST(GlRenderer, MalformedScenesAreErrorsNotCrashes) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    Scene bad_index = test::texturedRoom();
+    bad_index.indices[4] = 100000;
+    auto s1 = gl->upload(bad_index);
+    ASSERT_FALSE(s1);
+    EXPECT_NE(s1.error().find("vertex index"), std::string::npos) << s1.error();
+
+    Scene bad_texture = test::texturedRoom();
+    bad_texture.textures[1].rgba.resize(10);
+    EXPECT_FALSE(gl->upload(bad_texture));
+
+    Scene bad_batch = test::texturedRoom();
+    bad_batch.batches[2].first_index = static_cast<uint32_t>(bad_batch.indices.size());
+    EXPECT_FALSE(gl->upload(bad_batch));
+
+    Scene bad_lightmap = test::texturedRoom();
+    bad_lightmap.batches[0].lightmap = 5;
+    EXPECT_FALSE(gl->upload(bad_lightmap));
+
+    // The renderer stays usable, and an empty view is no error.
+    ASSERT_TRUE(gl->upload(test::texturedRoom()));
+    ImageRgba8 img;
+    EXPECT_TRUE(gl->render(RenderView{}, img));
+    EXPECT_TRUE(gl->render(fullFrameView(test::smallProfile(), Pose{}, Eye::kLeft), img));
+}
+
+TEST(GlRenderer, ShadingIsTextureTimesLightmapTimesVertexColour) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    // A flat grey texture under a flat half-bright lightmap and a blue-ish vertex colour,
+    // filling the whole view.
+    Scene s;
+    SceneTexture tex;
+    tex.name = "grey";
+    tex.width = tex.height = 4;
+    tex.rgba.assign(64, 200);
+    SceneTexture lm = tex;
+    lm.name = "half";
+    std::fill(lm.rgba.begin(), lm.rgba.end(), uint8_t{128});
+    s.textures.push_back(tex);
+    s.lightmaps.push_back(lm);
+    test::addQuad(s, {-10, -10, -1}, {10, -10, -1}, {10, 10, -1}, {-10, 10, -1}, 0, 0,
+                  {255, 128, 64, 255});
+    ASSERT_TRUE(gl->upload(s));
+    ImageRgba8 img;
+    ASSERT_TRUE(gl->render(fullFrameView(test::smallProfile(), Pose{}, Eye::kLeft), img));
+    const double expect[3] = {200.0 * 128 / 255, 200.0 * 128 / 255 * 128 / 255,
+                              200.0 * 128 / 255 * 64 / 255};
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(img.at(160, 180, c), expect[c], 2.0) << "channel " << c;
+    EXPECT_EQ(img.at(160, 180, 3), 255);
+}
+
+}  // namespace
+}  // namespace qvr
