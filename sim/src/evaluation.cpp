@@ -489,24 +489,41 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
          mean(speedups[Design::Dfr]) / mean(speedups[Design::Ffr]), "x"},
     };
 
-    // Qualitative findings (§6), per bench, counted.
+    // Qualitative findings (§6), per bench, counted. The paper's chain qvr ≥ dfr ≥ ffr is
+    // checked as its two links, since they fail or hold for different reasons.
     {
         int ok = 0;
         std::string bad;
         for (size_t b = 0; b < nb; ++b) {
             const double q = speedups[Design::Qvr][b], d = speedups[Design::Dfr][b],
                          f = speedups[Design::Ffr][b];
-            if (q >= d && d >= f)
+            if (q >= d && q >= f)
                 ++ok;
             else
                 bad += fmt::format(" {} (qvr {:.2f}, dfr {:.2f}, ffr {:.2f});", benches[b].label, q,
                                    d, f);
         }
         output.findings.push_back(
-            {"qvr >= dfr >= ffr in end-to-end speedup", ok == static_cast<int>(nb),
+            {"qvr >= dfr and qvr >= ffr in end-to-end speedup", ok == static_cast<int>(nb),
              fmt::format("holds for {}/{} benches; means qvr {:.2f}x, dfr {:.2f}x, ffr {:.2f}x.{}",
                          ok, nb, mean(speedups[Design::Qvr]), mean(speedups[Design::Dfr]),
                          mean(speedups[Design::Ffr]), bad.empty() ? "" : " Fails:" + bad)});
+    }
+    {
+        int ok = 0;
+        std::string detail;
+        for (size_t b = 0; b < nb; ++b) {
+            const double d = speedups[Design::Dfr][b], f = speedups[Design::Ffr][b];
+            if (d >= f)
+                ++ok;
+            detail += fmt::format(" {} {:.2f}/{:.2f};", benches[b].label, d, f);
+        }
+        output.findings.push_back(
+            {"dfr >= ffr in end-to-end speedup", ok == static_cast<int>(nb),
+             fmt::format("holds for {}/{} benches (dfr/ffr speedup:{}) mean ratio {:.3f}; see "
+                         "'Where we differ' below",
+                         ok, nb, detail,
+                         mean(speedups[Design::Dfr]) / mean(speedups[Design::Ffr]))});
     }
     {
         int ok = 0, total = 0;
