@@ -171,8 +171,8 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int width, int hei
     const double x1 = std::min(x0 + kTilePx, static_cast<double>(width));
     const double y1 = std::min(y0 + kTilePx, static_cast<double>(height));
     const double corners[4][2] = {{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
-    const glm::dvec3 gaze_dir = glm::normalize(glm::dvec3(
-        std::tan(job.gaze.x_deg / kDegPerRad), std::tan(job.gaze.y_deg / kDegPerRad), -1.0));
+    // The kernel's unit gaze, in double.
+    const glm::dvec3 gaze_dir(job.params.gaze[0], job.params.gaze[1], job.params.gaze[2]);
     bool empty = true;
     double lo_deg = kInf, hi_deg = -kInf;
     for (int c = 0; c < chroma_count; ++c) {

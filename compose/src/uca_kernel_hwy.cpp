@@ -86,13 +86,28 @@ HWY_INLINE MapV mapPixels(const KernelParams& p, VF u, VF v, float chroma, bool 
     return m;
 }
 
-template <int kShift>
+// Byte c of every RGBA8 texel as a float: one byte shuffle (zeroing the other three bytes of
+// each lane) instead of a shift and a mask.
+template <int kChannel>
 HWY_INLINE VF channel(VU texel) {
     const DF df;
     const DI di;
     const DU du;
+#if HWY_TARGET == HWY_SCALAR
+    // One lane cannot be viewed as bytes; shift and mask instead.
     return hn::ConvertTo(
-        df, hn::BitCast(di, hn::And(hn::ShiftRight<kShift>(texel), hn::Set(du, 0xFFu))));
+        df, hn::BitCast(di, hn::And(hn::ShiftRight<8 * kChannel>(texel), hn::Set(du, 0xFFu))));
+#else
+    const hn::Repartition<uint8_t, DU> d8;
+    // Shuffle indices are byte positions within each 16-byte block: lane j of a block holds its
+    // texel in bytes 4j…4j+3.
+    const VU lane_in_block = hn::And(hn::Iota(du, 0u), hn::Set(du, 3u));
+    const VU index = hn::Add(hn::ShiftLeft<2>(lane_in_block),
+                             hn::Set(du, 0x80808000u | static_cast<uint32_t>(kChannel)));
+    const auto pick = hn::BitCast(d8, index);
+    const auto bytes = hn::TableLookupBytesOr0(hn::BitCast(d8, texel), pick);
+    return hn::ConvertTo(df, hn::BitCast(di, bytes));
+#endif
 }
 
 HWY_INLINE VF lerp(VF w, VF a, VF b) {
@@ -131,14 +146,16 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
     Rgb out;
     out.r = lerp(wy, lerp(wx, channel<0>(t00), channel<0>(t10)),
                  lerp(wx, channel<0>(t01), channel<0>(t11)));
-    out.g = lerp(wy, lerp(wx, channel<8>(t00), channel<8>(t10)),
-                 lerp(wx, channel<8>(t01), channel<8>(t11)));
-    out.b = lerp(wy, lerp(wx, channel<16>(t00), channel<16>(t10)),
-                 lerp(wx, channel<16>(t01), channel<16>(t11)));
+    out.g = lerp(wy, lerp(wx, channel<1>(t00), channel<1>(t10)),
+                 lerp(wx, channel<1>(t01), channel<1>(t11)));
+    out.b = lerp(wy, lerp(wx, channel<2>(t00), channel<2>(t10)),
+                 lerp(wx, channel<2>(t01), channel<2>(t11)));
     return out;
 }
 
-HWY_INLINE Rgb shade(const KernelParams& p, VF u, VF v, float chroma, uint8_t slot_mask) {
+// Eq. 4 for a vector of pixels; lanes off the rendered image come back in `valid`.
+HWY_INLINE Rgb shade(const KernelParams& p, VF u, VF v, float chroma, uint8_t slot_mask,
+                     MF& valid) {
     const DF df;
     const bool single = (slot_mask & (slot_mask - 1)) == 0;
     const MapV m = mapPixels(p, u, v, chroma, !single);
@@ -172,9 +189,7 @@ HWY_INLINE Rgb shade(const KernelParams& p, VF u, VF v, float chroma, uint8_t sl
             rgb.b = hn::MulAdd(w[k], s.b, rgb.b);
         }
     }
-    rgb.r = hn::IfThenElseZero(m.valid, rgb.r);
-    rgb.g = hn::IfThenElseZero(m.valid, rgb.g);
-    rgb.b = hn::IfThenElseZero(m.valid, rgb.b);
+    valid = m.valid;
     return rgb;
 }
 
@@ -182,26 +197,34 @@ HWY_INLINE VU quantize(VF value) {
     const DF df;
     const DI di;
     const DU du;
-    return hn::BitCast(
-        du, hn::ConvertTo(di, hn::Min(hn::Add(value, hn::Set(df, 0.5f)), hn::Set(df, 255.0f))));
+    // A convex combination of bytes stays within [0, 255], so +0.5 and truncation round it.
+    return hn::BitCast(du, hn::ConvertTo(di, hn::Add(value, hn::Set(df, 0.5f))));
+}
+
+HWY_INLINE VU pack(VF r, VF g, VF b) {
+    const DU du;
+    VU packed = hn::Or(quantize(r), hn::ShiftLeft<8>(quantize(g)));
+    packed = hn::Or(packed, hn::ShiftLeft<16>(quantize(b)));
+    return hn::Or(packed, hn::Set(du, kOpaqueBlack));
 }
 
 HWY_INLINE VU shadePacked(const KernelParams& p, VF u, VF v, uint8_t slot_mask) {
     const DU du;
-    VF r, g, b;
+    MF valid;
     if (!p.chroma) {
-        const Rgb c = shade(p, u, v, 1.0f, slot_mask);
-        r = c.r;
-        g = c.g;
-        b = c.b;
-    } else {
-        r = shade(p, u, v, p.chroma_red, slot_mask).r;
-        g = shade(p, u, v, 1.0f, slot_mask).g;
-        b = shade(p, u, v, p.chroma_blue, slot_mask).b;
+        const Rgb c = shade(p, u, v, 1.0f, slot_mask, valid);
+        // Off-image lanes become opaque black once, after packing.
+        return hn::IfThenElse(hn::RebindMask(du, valid), pack(c.r, c.g, c.b),
+                              hn::Set(du, kOpaqueBlack));
     }
-    VU packed = hn::Or(quantize(r), hn::ShiftLeft<8>(quantize(g)));
-    packed = hn::Or(packed, hn::ShiftLeft<16>(quantize(b)));
-    return hn::Or(packed, hn::Set(du, kOpaqueBlack));
+    // Lateral chromatic aberration: each channel has its own map and its own validity.
+    const VF r = shade(p, u, v, p.chroma_red, slot_mask, valid).r;
+    const VF rv = hn::IfThenElseZero(valid, r);
+    const VF g = shade(p, u, v, 1.0f, slot_mask, valid).g;
+    const VF gv = hn::IfThenElseZero(valid, g);
+    const VF b = shade(p, u, v, p.chroma_blue, slot_mask, valid).b;
+    const VF bv = hn::IfThenElseZero(valid, b);
+    return pack(rv, gv, bv);
 }
 
 }  // namespace
