@@ -9,6 +9,8 @@ QVR_PACKAGES=(
     libtbb-dev libhwy-dev libpng-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     gnuplot-nox
+    # codec: H.264 through libavcodec + libx264; trace: CMU motion capture (BVH) for head motion
+    libavcodec-dev libavutil-dev libswscale-dev libx264-dev assimp-testmodels
     # render: headless OpenGL 4.5 through EGL (GLVND headers and loaders, Mesa's EGL and llvmpipe)
     libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
     # compose: libopencv-dev only for the optional QVR_WITH_OPENCV benchmark anchor, not listed

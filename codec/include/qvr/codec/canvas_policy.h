@@ -1,0 +1,36 @@
+// How a layer stream's coded canvas follows a layer whose size changes every frame as e1 moves
+// (paper §3.1–3.2): grow with headroom when the layer outgrows it, shrink only after the layer
+// has stayed much smaller for a while, so a canvas change (and its IDR) is rare.
+#pragma once
+
+namespace qvr {
+
+struct CanvasSize {
+    int width = 0;
+    int height = 0;
+    bool operator==(const CanvasSize&) const = default;
+};
+
+class CanvasPolicy {
+public:
+    CanvasPolicy(int align_px, double headroom, double shrink_ratio, int shrink_after_frames,
+                 int max_side_px);
+    // The canvas for the next frame of a width×height layer; changed() tells whether it moved.
+    CanvasSize next(int width, int height);
+    bool changed() const { return m_changed; }
+    CanvasSize current() const { return m_canvas; }
+
+private:
+    CanvasSize snug(int width, int height, double headroom) const;
+
+    int m_align;
+    double m_headroom;
+    double m_shrink_ratio;
+    int m_shrink_after;
+    int m_max_side;
+    CanvasSize m_canvas;
+    int m_small_frames = 0;
+    bool m_changed = false;
+};
+
+}  // namespace qvr

@@ -1,0 +1,429 @@
+// H.264 layer streams through libavcodec + libx264 with low-latency settings (paper §3.2: the
+// server streams each periphery layer as video; the headset decodes it before UCA composes).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+extern "C" {
+#include <libavcodec/avcodec.h>
+#include <libavutil/error.h>
+#include <libavutil/frame.h>
+#include <libavutil/log.h>
+#include <libavutil/opt.h>
+#include <libswscale/swscale.h>
+}
+
+#include "backends.h"
+#include "qvr/codec/canvas_policy.h"
+#include "qvr/codec/frame_header.h"
+
+namespace qvr::detail {
+
+namespace {
+
+// FFmpeg's error macros expand to C casts; compute them once here with the warning silenced.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wold-style-cast"
+constexpr int kAvErrorEagain = AVERROR(EAGAIN);
+constexpr int kAvErrorEof = AVERROR_EOF;
+#pragma GCC diagnostic pop
+
+std::string avErrorText(int err) {
+    char buf[AV_ERROR_MAX_STRING_SIZE] = {};
+    av_strerror(err, buf, sizeof(buf));
+    return buf;
+}
+
+// libavcodec logs every bitstream error at ERROR level; decoding untrusted bytes would flood
+// stderr, and every error already reaches the caller as an Expected. Process-wide, set once.
+void quietFfmpegLog() {
+    static std::once_flag once;
+    std::call_once(once, [] { av_log_set_level(AV_LOG_FATAL); });
+}
+
+struct ContextDeleter {
+    void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
+};
+struct FrameDeleter {
+    void operator()(AVFrame* f) const { av_frame_free(&f); }
+};
+struct PacketDeleter {
+    void operator()(AVPacket* p) const { av_packet_free(&p); }
+};
+using ContextPtr = std::unique_ptr<AVCodecContext, ContextDeleter>;
+using FramePtr = std::unique_ptr<AVFrame, FrameDeleter>;
+using PacketPtr = std::unique_ptr<AVPacket, PacketDeleter>;
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// swscale's SIMD paths process pixels in groups and may touch a few pixels past a row's end, so
+// rows handed to it are 64-byte aligned with slack; a tightly packed image of another width is
+// staged through this buffer.
+constexpr int kRowAlignBytes = 64;
+int alignedStride(int width) {
+    return (width * 4 + 2 * kRowAlignBytes - 1) / kRowAlignBytes * kRowAlignBytes;
+}
+bool directOk(int width) {
+    return (width * 4) % kRowAlignBytes == 0;
+}
+
+// Fills the canvas outside the layer by repeating its last column and row: flat padding costs
+// the encoder almost no bits and keeps the deblocking filter from bleeding colour inward.
+void padPlane(uint8_t* plane, int stride, int w, int h, int canvas_w, int canvas_h) {
+    if (w < canvas_w) {
+        for (int y = 0; y < h; ++y) {
+            uint8_t* row = plane + static_cast<ptrdiff_t>(y) * stride;
+            std::memset(row + w, row[w - 1], static_cast<size_t>(canvas_w - w));
+        }
+    }
+    const uint8_t* last = plane + static_cast<ptrdiff_t>(h - 1) * stride;
+    for (int y = h; y < canvas_h; ++y)
+        std::memcpy(plane + static_cast<ptrdiff_t>(y) * stride, last,
+                    static_cast<size_t>(canvas_w));
+}
+
+class X264Encoder final : public VideoEncoder {
+public:
+    explicit X264Encoder(const CodecConfig& config)
+        : m_config(config),
+          m_canvas(config.canvas_align_px, config.canvas_headroom, config.canvas_shrink_ratio,
+                   config.canvas_shrink_after_frames, config.max_side_px) {}
+
+    ~X264Encoder() override { sws_freeContext(m_sws); }
+
+    Expected<EncodedFrame> encode(const ImageRgba8& image, bool force_keyframe) override {
+        const auto t0 = std::chrono::steady_clock::now();
+        const int w = image.width();
+        const int h = image.height();
+        if (w < 1 || h < 1 || w > m_config.max_side_px || h > m_config.max_side_px)
+            return makeError(fmt::format("x264 encoder: layer size {}x{} outside [1, {}]", w, h,
+                                         m_config.max_side_px));
+        const CanvasSize canvas = m_canvas.next(w, h);
+        if (m_canvas.changed() || !m_ctx) {
+            if (m_ctx)
+                ++m_stats.reopens;
+            if (Status s = open(canvas); !s) {
+                m_ctx.reset();
+                m_canvas = CanvasPolicy(m_config.canvas_align_px, m_config.canvas_headroom,
+                                        m_config.canvas_shrink_ratio,
+                                        m_config.canvas_shrink_after_frames, m_config.max_side_px);
+                return makeError(s.error());
+            }
+            m_force_key = true;  // a new SPS: the decoder must restart from an IDR
+        }
+        if (Status s = convert(image); !s)
+            return makeError(s.error());
+
+        const bool key = force_keyframe || m_force_key;
+        m_frame->pict_type = key ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
+        m_frame->pts = m_pts++;
+        int err = avcodec_send_frame(m_ctx.get(), m_frame.get());
+        if (err < 0)
+            return makeError("x264 encoder: send_frame: " + avErrorText(err));
+        m_payload.clear();
+        for (;;) {
+            err = avcodec_receive_packet(m_ctx.get(), m_packet.get());
+            if (err == kAvErrorEagain || err == kAvErrorEof)
+                break;
+            if (err < 0)
+                return makeError("x264 encoder: receive_packet: " + avErrorText(err));
+            m_payload.insert(m_payload.end(), m_packet->data, m_packet->data + m_packet->size);
+            av_packet_unref(m_packet.get());
+        }
+        if (m_payload.empty())
+            return makeError("x264 encoder: no packet for the frame (encoder delay is not zero)");
+
+        // Whether the decoder can start here is a property of the bytes: look for an IDR slice
+        // rather than trusting the request (x264 may also decide on its own, e.g. at keyint).
+        const bool idr = annexBHasIdr(m_payload);
+        if (idr)
+            m_force_key = false;
+        FrameHeader fh;
+        fh.flags = idr ? FrameHeader::kFlagKeyframe : 0;
+        fh.refresh_frames =
+            m_config.intra_refresh ? static_cast<uint16_t>(m_config.keyint_frames) : 0;
+        fh.frame_id = m_next_id++;
+        fh.width = static_cast<uint16_t>(w);
+        fh.height = static_cast<uint16_t>(h);
+        EncodedFrame out;
+        out.bytes = packFrame(fh, m_payload);
+        out.is_keyframe = idr;
+        out.frame_id = fh.frame_id;
+        ++m_stats.frames;
+        m_stats.keyframes += idr ? 1 : 0;
+        m_stats.bytes += static_cast<int64_t>(out.bytes.size());
+        out.encode_ms = msSince(t0);
+        return out;
+    }
+
+    void requestKeyframe() override { m_force_key = true; }
+    const EncoderStats& stats() const override { return m_stats; }
+    int canvasWidth() const override { return m_ctx ? m_ctx->width : 0; }
+    int canvasHeight() const override { return m_ctx ? m_ctx->height : 0; }
+
+private:
+    Status open(CanvasSize canvas) {
+        const AVCodec* codec = avcodec_find_encoder_by_name("libx264");
+        if (!codec)
+            return makeError("x264 encoder: libavcodec was built without libx264");
+        ContextPtr ctx(avcodec_alloc_context3(codec));
+        if (!ctx)
+            return makeError("x264 encoder: out of memory");
+        ctx->width = canvas.width;
+        ctx->height = canvas.height;
+        ctx->pix_fmt = AV_PIX_FMT_YUV420P;
+        const int rate_milli = static_cast<int>(std::lround(m_config.frame_rate_hz * 1000.0));
+        ctx->time_base = AVRational{1000, rate_milli};
+        ctx->framerate = AVRational{rate_milli, 1000};
+        ctx->max_b_frames = 0;  // B-frames add a frame of delay; the headset cannot wait
+        ctx->thread_count = m_config.threads;
+        ctx->slices = m_config.slices;
+        ctx->gop_size = m_config.keyint_frames > 0 ? m_config.keyint_frames : 0;
+        if (m_config.bitrate_bps > 0) {
+            // One frame of VBV buffer: a frame may not burst past what the link carries in a
+            // frame time, the constraint a per-frame deadline imposes.
+            ctx->bit_rate = m_config.bitrate_bps;
+            ctx->rc_max_rate = m_config.bitrate_bps;
+            ctx->rc_buffer_size = static_cast<int>(
+                std::min<double>(2e9, m_config.bitrate_bps / m_config.frame_rate_hz));
+        }
+        void* priv = ctx->priv_data;
+        std::string params = "repeat-headers=1:scenecut=0";
+        if (m_config.keyint_frames == 0)
+            params += ":keyint=infinite";
+        if (av_opt_set(priv, "preset", m_config.preset.c_str(), 0) < 0 ||
+            av_opt_set(priv, "tune", "zerolatency", 0) < 0 ||
+            av_opt_set(priv, "forced-idr", "1", 0) < 0 ||
+            av_opt_set(priv, "x264-params", params.c_str(), 0) < 0)
+            return makeError("x264 encoder: libx264 rejected an option");
+        if (m_config.bitrate_bps == 0 &&
+            av_opt_set(priv, "crf", std::to_string(m_config.crf).c_str(), 0) < 0)
+            return makeError("x264 encoder: libx264 rejected crf");
+        if (m_config.intra_refresh && av_opt_set(priv, "intra-refresh", "1", 0) < 0)
+            return makeError("x264 encoder: libx264 rejected intra-refresh");
+        int err = avcodec_open2(ctx.get(), codec, nullptr);
+        if (err < 0)
+            return makeError(fmt::format("x264 encoder: open {}x{}: {}", canvas.width,
+                                         canvas.height, avErrorText(err)));
+        FramePtr frame(av_frame_alloc());
+        PacketPtr packet(av_packet_alloc());
+        if (!frame || !packet)
+            return makeError("x264 encoder: out of memory");
+        frame->format = AV_PIX_FMT_YUV420P;
+        frame->width = canvas.width;
+        frame->height = canvas.height;
+        err = av_frame_get_buffer(frame.get(), kRowAlignBytes);
+        if (err < 0)
+            return makeError("x264 encoder: frame buffer: " + avErrorText(err));
+        m_ctx = std::move(ctx);
+        m_frame = std::move(frame);
+        m_packet = std::move(packet);
+        return Status::success();
+    }
+
+    Status convert(const ImageRgba8& image) {
+        const int w = image.width();
+        const int h = image.height();
+        if (int err = av_frame_make_writable(m_frame.get()); err < 0)
+            return makeError("x264 encoder: frame not writable: " + avErrorText(err));
+        m_sws = sws_getCachedContext(m_sws, w, h, AV_PIX_FMT_RGBA, w, h, AV_PIX_FMT_YUV420P,
+                                     SWS_BILINEAR, nullptr, nullptr, nullptr);
+        if (!m_sws)
+            return makeError(
+                fmt::format("x264 encoder: no RGBA→YUV420 conversion for {}x{}", w, h));
+        const uint8_t* src = image.data();
+        int src_stride = w * 4;
+        if (!directOk(w)) {
+            src_stride = alignedStride(w);
+            m_staging.resize(static_cast<size_t>(src_stride) * (h + 1));
+            for (int y = 0; y < h; ++y)
+                std::memcpy(m_staging.data() + static_cast<size_t>(y) * src_stride, image.row(y),
+                            static_cast<size_t>(w) * 4);
+            src = m_staging.data();
+        }
+        const uint8_t* src_planes[4] = {src, nullptr, nullptr, nullptr};
+        const int src_strides[4] = {src_stride, 0, 0, 0};
+        sws_scale(m_sws, src_planes, src_strides, 0, h, m_frame->data, m_frame->linesize);
+        const int cw = m_frame->width;
+        const int ch = m_frame->height;
+        padPlane(m_frame->data[0], m_frame->linesize[0], w, h, cw, ch);
+        for (int p = 1; p < 3; ++p)
+            padPlane(m_frame->data[p], m_frame->linesize[p], (w + 1) / 2, (h + 1) / 2, cw / 2,
+                     ch / 2);
+        return Status::success();
+    }
+
+    CodecConfig m_config;
+    CanvasPolicy m_canvas;
+    ContextPtr m_ctx;
+    FramePtr m_frame;
+    PacketPtr m_packet;
+    SwsContext* m_sws = nullptr;
+    std::vector<uint8_t> m_staging;
+    std::vector<uint8_t> m_payload;
+    EncoderStats m_stats;
+    int64_t m_pts = 0;
+    uint32_t m_next_id = 0;
+    bool m_force_key = true;
+};
+
+class H264Decoder final : public VideoDecoder {
+public:
+    ~H264Decoder() override { sws_freeContext(m_sws); }
+
+    Status open() {
+        const AVCodec* codec = avcodec_find_decoder(AV_CODEC_ID_H264);
+        if (!codec)
+            return makeError("h264 decoder: libavcodec has no H.264 decoder");
+        ContextPtr ctx(avcodec_alloc_context3(codec));
+        if (!ctx)
+            return makeError("h264 decoder: out of memory");
+        // One thread and low delay: a packet in, its picture out, no frame-threading queue.
+        ctx->thread_count = 1;
+        ctx->flags |= AV_CODEC_FLAG_LOW_DELAY;
+        int err = avcodec_open2(ctx.get(), codec, nullptr);
+        if (err < 0)
+            return makeError("h264 decoder: open: " + avErrorText(err));
+        m_frame.reset(av_frame_alloc());
+        m_packet.reset(av_packet_alloc());
+        if (!m_frame || !m_packet)
+            return makeError("h264 decoder: out of memory");
+        m_ctx = std::move(ctx);
+        return Status::success();
+    }
+
+    Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
+        const auto t0 = std::chrono::steady_clock::now();
+        auto parsed = parseFrame(bytes);
+        if (!parsed)
+            return makeError(parsed.error());
+        const FrameHeader& h = parsed->header;
+        if ((h.flags & FrameHeader::kFlagRaw) != 0)
+            return makeError(fmt::format("h264 decoder: frame {} is a raw frame", h.frame_id));
+        if (h.keyframe() && !annexBHasIdr(parsed->payload))
+            return makeError(
+                fmt::format("h264 decoder: frame {} claims to be a key frame but "
+                            "holds no IDR slice",
+                            h.frame_id));
+        if (Status s = m_tracker.admit(h); !s)
+            return makeError(s.error());
+        auto picture = decodePayload(h, parsed->payload);
+        m_tracker.decoded(h, picture.ok());
+        if (!picture)
+            return makeError(picture.error());
+        if (m_tracker.withholdPicture())
+            return makeError(
+                fmt::format("h264 decoder: frame {} decoded while recovering from "
+                            "loss; {} more frame(s) until the intra refresh completes",
+                            h.frame_id, m_tracker.recoveringFrames()));
+        auto image = toRgba(h);
+        m_last_ms = msSince(t0);
+        return image;
+    }
+
+    bool needsKeyframe() const override { return m_tracker.needsKeyframe(); }
+    double lastDecodeMs() const override { return m_last_ms; }
+
+private:
+    // Feeds one payload and takes its picture; leaves it in m_frame.
+    Status decodePayload(const FrameHeader& h, std::span<const uint8_t> payload) {
+        // libavcodec reads up to AV_INPUT_BUFFER_PADDING_SIZE bytes past a packet's end.
+        m_buffer.assign(payload.size() + AV_INPUT_BUFFER_PADDING_SIZE, 0);
+        std::memcpy(m_buffer.data(), payload.data(), payload.size());
+        av_packet_unref(m_packet.get());
+        m_packet->data = m_buffer.data();
+        m_packet->size = static_cast<int>(payload.size());
+        int err = avcodec_send_packet(m_ctx.get(), m_packet.get());
+        m_packet->data = nullptr;
+        m_packet->size = 0;
+        if (err < 0)
+            return makeError(
+                fmt::format("h264 decoder: frame {}: {}", h.frame_id, avErrorText(err)));
+        av_frame_unref(m_frame.get());
+        err = avcodec_receive_frame(m_ctx.get(), m_frame.get());
+        if (err == kAvErrorEagain)
+            return makeError(
+                fmt::format("h264 decoder: frame {}: the bytes held no picture", h.frame_id));
+        if (err < 0)
+            return makeError(
+                fmt::format("h264 decoder: frame {}: {}", h.frame_id, avErrorText(err)));
+        if ((m_frame->flags & AV_FRAME_FLAG_CORRUPT) != 0 || m_frame->decode_error_flags != 0)
+            return makeError(
+                fmt::format("h264 decoder: frame {}: picture damaged (concealed "
+                            "errors)",
+                            h.frame_id));
+        if (m_frame->format != AV_PIX_FMT_YUV420P && m_frame->format != AV_PIX_FMT_YUVJ420P)
+            return makeError(fmt::format("h264 decoder: frame {}: unexpected pixel format {}",
+                                         h.frame_id, m_frame->format));
+        if (m_frame->width < h.width || m_frame->height < h.height)
+            return makeError(
+                fmt::format("h264 decoder: frame {}: picture {}x{} smaller than "
+                            "the layer {}x{}",
+                            h.frame_id, m_frame->width, m_frame->height, h.width, h.height));
+        return Status::success();
+    }
+
+    Expected<ImageRgba8> toRgba(const FrameHeader& h) {
+        const int w = h.width;
+        const int ht = h.height;
+        const auto format = static_cast<AVPixelFormat>(m_frame->format);
+        m_sws = sws_getCachedContext(m_sws, w, ht, format, w, ht, AV_PIX_FMT_RGBA, SWS_BILINEAR,
+                                     nullptr, nullptr, nullptr);
+        if (!m_sws)
+            return makeError(
+                fmt::format("h264 decoder: no YUV420→RGBA conversion for {}x{}", w, ht));
+        ImageRgba8 image(w, ht);
+        // The layer sits at the canvas's top-left, so the planes need no offset: crop by size.
+        if (directOk(w)) {
+            uint8_t* dst[4] = {image.data(), nullptr, nullptr, nullptr};
+            const int dst_strides[4] = {w * 4, 0, 0, 0};
+            sws_scale(m_sws, m_frame->data, m_frame->linesize, 0, ht, dst, dst_strides);
+        } else {
+            const int stride = alignedStride(w);
+            m_staging.resize(static_cast<size_t>(stride) * (ht + 1));
+            uint8_t* dst[4] = {m_staging.data(), nullptr, nullptr, nullptr};
+            const int dst_strides[4] = {stride, 0, 0, 0};
+            sws_scale(m_sws, m_frame->data, m_frame->linesize, 0, ht, dst, dst_strides);
+            for (int y = 0; y < ht; ++y)
+                std::memcpy(image.row(y), m_staging.data() + static_cast<size_t>(y) * stride,
+                            static_cast<size_t>(w) * 4);
+        }
+        return image;
+    }
+
+    ContextPtr m_ctx;
+    FramePtr m_frame;
+    PacketPtr m_packet;
+    SwsContext* m_sws = nullptr;
+    std::vector<uint8_t> m_buffer;
+    std::vector<uint8_t> m_staging;
+    ReferenceTracker m_tracker;
+    double m_last_ms = 0.0;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<VideoEncoder>> makeX264Encoder(const CodecConfig& config) {
+    quietFfmpegLog();
+    if (!avcodec_find_encoder_by_name("libx264"))
+        return makeError("x264 encoder: libavcodec was built without libx264");
+    return std::unique_ptr<VideoEncoder>(std::make_unique<X264Encoder>(config));
+}
+
+Expected<std::unique_ptr<VideoDecoder>> makeH264Decoder() {
+    quietFfmpegLog();
+    auto decoder = std::make_unique<H264Decoder>();
+    if (Status s = decoder->open(); !s)
+        return makeError(s.error());
+    return std::unique_ptr<VideoDecoder>(std::move(decoder));
+}
+
+}  // namespace qvr::detail
