@@ -12,15 +12,22 @@
 
 #include "qvr/codec/frame_header.h"
 #include "qvr/codec/image_metrics.h"
-#include "test_images.h"
+#include "qvr/codec/synthetic_images.h"
 
 namespace qvr {
 namespace {
 
-using testing::detailedImage;
-using testing::flatImage;
 using ::testing::HasSubstr;
-using testing::noiseImage;
+
+ImageRgba8 detailedImage(int w, int h, int phase = 0) {
+    return syntheticDetailedImage(w, h, phase);
+}
+ImageRgba8 flatImage(int w, int h, uint8_t r = 90, uint8_t g = 120, uint8_t b = 160) {
+    return syntheticFlatImage(w, h, r, g, b);
+}
+ImageRgba8 noiseImage(int w, int h, uint32_t seed) {
+    return syntheticNoiseImage(w, h, seed);
+}
 
 // Bound for the detailed image at the default CRF 23: measured 33.8–35.5 dB, with 37.6 dB the
 // ceiling that RGB→YUV 4:2:0 conversion alone allows (CRF 0); docs/CODEC.md.

@@ -1,5 +1,5 @@
-// Synthetic layer images for the codec tests (paper §3.2): detail the encoder must keep, flat
-// areas it should compress away, and noise it cannot.
+// Synthetic layer images for the codec's tests, benchmark and docs (paper §3.2): detail the encoder
+// must keep, flat areas it should compress away, and noise it cannot.
 #pragma once
 
 #include <algorithm>
@@ -9,13 +9,13 @@
 
 #include "qvr/core/image.h"
 
-namespace qvr::testing {
+namespace qvr {
 
 // Smooth gradients, a sine grating, hard-edged blocks and a little grain: like a rendered,
 // textured scene, with detail at several scales. `phase` shifts it to make motion. The hard
 // edges are luminance edges and colour changes are smooth, as in shaded scenes; saturated colour
 // edges would measure 4:2:0 chroma subsampling (≈30 dB on their own) rather than the codec.
-inline ImageRgba8 detailedImage(int width, int height, int phase = 0, uint32_t seed = 7) {
+inline ImageRgba8 syntheticDetailedImage(int width, int height, int phase = 0, uint32_t seed = 7) {
     ImageRgba8 img(width, height);
     std::mt19937 rng(seed);
     std::uniform_int_distribution<int> grain(-6, 6);
@@ -39,8 +39,8 @@ inline ImageRgba8 detailedImage(int width, int height, int phase = 0, uint32_t s
     return img;
 }
 
-inline ImageRgba8 flatImage(int width, int height, uint8_t r = 90, uint8_t g = 120,
-                            uint8_t b = 160) {
+inline ImageRgba8 syntheticFlatImage(int width, int height, uint8_t r = 90, uint8_t g = 120,
+                                     uint8_t b = 160) {
     ImageRgba8 img(width, height);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
@@ -53,7 +53,7 @@ inline ImageRgba8 flatImage(int width, int height, uint8_t r = 90, uint8_t g = 1
     return img;
 }
 
-inline ImageRgba8 noiseImage(int width, int height, uint32_t seed = 11) {
+inline ImageRgba8 syntheticNoiseImage(int width, int height, uint32_t seed = 11) {
     ImageRgba8 img(width, height);
     std::mt19937 rng(seed);
     std::uniform_int_distribution<int> d(0, 255);
@@ -67,4 +67,4 @@ inline ImageRgba8 noiseImage(int width, int height, uint32_t seed = 11) {
     return img;
 }
 
-}  // namespace qvr::testing
+}  // namespace qvr
