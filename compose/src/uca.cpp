@@ -158,54 +158,79 @@ uint8_t slotMaskFor(const SlotInfo& s, double lo_deg, double hi_deg) {
     return mask;
 }
 
-// Tile classification, once per frame: the map at the tile centre and corners bounds where
-// the tile's pixels land (the map is smooth at tile scale; the factors below leave slack for
-// its curvature). Empty: every pixel lands off the rendered image. Single: one slot's weight
-// is 1 over the whole eccentricity range. Border: anything else.
-void classifyTile(const EyeJob& job, int tile, int tile_cols, int width, int height,
-                  double chroma_scales[3], int chroma_count) {
+// The map at the tile corners, shared by the four tiles that meet there: the rendered-image
+// point, the unit direction and its eccentricity, per chroma scale in use.
+struct CornerSample {
+    double px = 0, py = 0;
+    double ux = 0, uy = 0, uz = 0;
+    double e_deg = 0;
+    bool in_front = false;
+};
+
+void sampleCorner(const EyeJob& job, int point, int lattice_cols, int width, int height,
+                  int chroma_count, CornerSample* out) {
+    const double x = std::min((point % lattice_cols) * kTilePx, width);
+    const double y = std::min((point / lattice_cols) * kTilePx, height);
+    const glm::dvec3 gaze_dir(job.params.gaze[0], job.params.gaze[1], job.params.gaze[2]);
+    const double scales[3] = {1.0, job.params.chroma_red, job.params.chroma_blue};
+    for (int c = 0; c < chroma_count; ++c) {
+        const WarpSample w = job.warp.map(x, y, scales[c]);
+        const glm::dvec3 u = glm::normalize(w.dir);
+        CornerSample& s = out[c];
+        s.px = w.px;
+        s.py = w.py;
+        s.ux = u.x;
+        s.uy = u.y;
+        s.uz = u.z;
+        s.e_deg = std::acos(std::clamp(glm::dot(u, gaze_dir), -1.0, 1.0)) * kDegPerRad;
+        s.in_front = w.in_front;
+    }
+}
+
+// Tile classification, once per frame, from the map at the tile's four corners (at its outer
+// edges, so every pixel centre lies inside). Over 32 pixels the map is close to affine: the
+// tile lands inside the corners' quadrilateral, whose points are within half its longer
+// diagonal of a corner; the 25 % and the small constants leave slack for the map's curvature.
+// Empty: every pixel lands off the rendered image. Single: one slot's weight is 1 over the
+// whole eccentricity range. Border: anything else.
+void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
+                  const CornerSample* lattice, int width, int height) {
     const int tx = tile % tile_cols;
     const int ty = tile / tile_cols;
-    const double x0 = tx * kTilePx;
-    const double y0 = ty * kTilePx;
-    const double x1 = std::min(x0 + kTilePx, static_cast<double>(width));
-    const double y1 = std::min(y0 + kTilePx, static_cast<double>(height));
-    const double corners[4][2] = {{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
-    // The kernel's unit gaze, in double.
-    const glm::dvec3 gaze_dir(job.params.gaze[0], job.params.gaze[1], job.params.gaze[2]);
+    const int lattice_cols = tile_cols + 1;
+    const int points[4] = {ty * lattice_cols + tx, ty * lattice_cols + tx + 1,
+                           (ty + 1) * lattice_cols + tx, (ty + 1) * lattice_cols + tx + 1};
     bool empty = true;
     double lo_deg = kInf, hi_deg = -kInf;
     for (int c = 0; c < chroma_count; ++c) {
-        const WarpSample centre = job.warp.map(0.5 * (x0 + x1), 0.5 * (y0 + y1), chroma_scales[c]);
-        const glm::dvec3 centre_unit = glm::normalize(centre.dir);
-        WarpSample corner[4];
-        bool all_front = centre.in_front;
-        bool none_front = !centre.in_front;
-        double reach_px = 0.0, reach_rad = 0.0;
+        const CornerSample* k[4];
+        int front = 0;
+        double e_min = kInf, e_max = -kInf;
         for (int i = 0; i < 4; ++i) {
-            corner[i] = job.warp.map(corners[i][0], corners[i][1], chroma_scales[c]);
-            all_front = all_front && corner[i].in_front;
-            none_front = none_front && !corner[i].in_front;
-            reach_rad =
-                std::max(reach_rad, smallAngleBoundRad(centre_unit, glm::normalize(corner[i].dir)));
-            if (centre.in_front && corner[i].in_front) {
-                reach_px = std::max(
-                    reach_px, std::sqrt((corner[i].px - centre.px) * (corner[i].px - centre.px) +
-                                        (corner[i].py - centre.py) * (corner[i].py - centre.py)));
-            }
+            k[i] = &lattice[static_cast<size_t>(points[i]) * static_cast<size_t>(chroma_count) +
+                            static_cast<size_t>(c)];
+            front += k[i]->in_front ? 1 : 0;
+            e_min = std::min(e_min, k[i]->e_deg);
+            e_max = std::max(e_max, k[i]->e_deg);
         }
-        bool channel_empty = none_front;
-        if (all_front) {
-            const double margin = 1.25 * reach_px + 2.0;
-            channel_empty = centre.px < -margin || centre.px > width + margin ||
-                            centre.py < -margin || centre.py > height + margin;
+        auto unit = [](const CornerSample* a) { return glm::dvec3(a->ux, a->uy, a->uz); };
+        const double diag_rad = std::max(smallAngleBoundRad(unit(k[0]), unit(k[3])),
+                                         smallAngleBoundRad(unit(k[1]), unit(k[2])));
+        bool channel_empty = front == 0;
+        if (front == 4) {
+            const double diag_px = std::max(std::hypot(k[3]->px - k[0]->px, k[3]->py - k[0]->py),
+                                            std::hypot(k[2]->px - k[1]->px, k[2]->py - k[1]->py));
+            const double margin = 0.25 * diag_px + 2.0;
+            const double x_min = std::min({k[0]->px, k[1]->px, k[2]->px, k[3]->px}) - margin;
+            const double x_max = std::max({k[0]->px, k[1]->px, k[2]->px, k[3]->px}) + margin;
+            const double y_min = std::min({k[0]->py, k[1]->py, k[2]->py, k[3]->py}) - margin;
+            const double y_max = std::max({k[0]->py, k[1]->py, k[2]->py, k[3]->py}) + margin;
+            channel_empty = x_max < 0.0 || x_min > width || y_max < 0.0 || y_min > height;
         }
         empty = empty && channel_empty;
-        const double e_centre =
-            std::acos(std::clamp(glm::dot(centre_unit, gaze_dir), -1.0, 1.0)) * kDegPerRad;
-        const double reach_deg = 1.25 * reach_rad * kDegPerRad + 0.01;
-        lo_deg = std::min(lo_deg, e_centre - reach_deg);
-        hi_deg = std::max(hi_deg, e_centre + reach_deg);
+        const double reach_deg = 0.5 * 1.25 * diag_rad * kDegPerRad + 0.01;
+        lo_deg = std::min(lo_deg, e_min - reach_deg);
+        hi_deg = std::max(hi_deg, e_max + reach_deg);
     }
     uint8_t mask = 0;
     TileKind kind = TileKind::kEmpty;
@@ -231,38 +256,65 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options, tbb::task
         j.kinds->assign(static_cast<size_t>(per_eye), TileKind::kEmpty);
         j.masks->assign(static_cast<size_t>(per_eye), 0);
     }
-    // Each tile is classified once and shaded right after, in the same task: one parallel loop,
-    // so a tile never waits for the rest of the frame's classification (the paper's point that
-    // non-overlapping tiles need not wait for composition).
+    // The corner lattice first (a quarter of the maps that per-tile corners would take), then
+    // each tile is classified and shaded right after in the same task: a tile never waits for
+    // the rest of the frame's classification (the paper's point that non-overlapping tiles need
+    // not wait for composition).
+    const int lattice_cols = cols + 1;
+    const int lattice_per_eye = lattice_cols * (rows + 1);
+    std::vector<std::vector<CornerSample>> lattices(jobs.size());
+    for (size_t e = 0; e < jobs.size(); ++e) {
+        const int chroma_count = jobs[e].params.chroma ? 3 : 1;
+        if (options.classify_tiles) {
+            lattices[e].resize(static_cast<size_t>(lattice_per_eye) *
+                               static_cast<size_t>(chroma_count));
+        }
+    }
     arena.execute([&] {
-        tbb::parallel_for(
-            tbb::blocked_range<int>(0, total, 4), [&](const tbb::blocked_range<int>& r) {
-                for (int i = r.begin(); i < r.end(); ++i) {
-                    const EyeJob& j = jobs[static_cast<size_t>(i / per_eye)];
-                    const int tile = i % per_eye;
-                    if (options.classify_tiles) {
-                        double scales[3] = {1.0, j.params.chroma_red, j.params.chroma_blue};
-                        classifyTile(j, tile, cols, width, height, scales, j.params.chroma ? 3 : 1);
-                    } else {
-                        (*j.kinds)[static_cast<size_t>(tile)] = TileKind::kBorder;
-                        (*j.masks)[static_cast<size_t>(tile)] =
-                            static_cast<uint8_t>((1u << j.slots.count) - 1);
-                    }
-                    detail::TileJob t;
-                    t.x0 = (tile % cols) * kTilePx;
-                    t.y0 = (tile / cols) * kTilePx;
-                    t.x1 = std::min(t.x0 + kTilePx, width);
-                    t.y1 = std::min(t.y0 + kTilePx, height);
-                    t.slot_mask = (*j.masks)[static_cast<size_t>(tile)];
-                    t.out = j.out->data();
-                    t.out_stride_px = static_cast<size_t>(j.out->width());
-                    if (simd) {
-                        detail::ucaTileSimd(j.params, t);
-                    } else {
-                        detail::ucaTileScalar(j.params, t);
-                    }
-                }
-            });
+        if (options.classify_tiles) {
+            const int lattice_total = lattice_per_eye * static_cast<int>(jobs.size());
+            tbb::parallel_for(tbb::blocked_range<int>(0, lattice_total, 64),
+                              [&](const tbb::blocked_range<int>& r) {
+                                  for (int i = r.begin(); i < r.end(); ++i) {
+                                      const size_t e = static_cast<size_t>(i / lattice_per_eye);
+                                      const int chroma_count = jobs[e].params.chroma ? 3 : 1;
+                                      const int point = i % lattice_per_eye;
+                                      sampleCorner(jobs[e], point, lattice_cols, width, height,
+                                                   chroma_count,
+                                                   &lattices[e][static_cast<size_t>(point) *
+                                                                static_cast<size_t>(chroma_count)]);
+                                  }
+                              });
+        }
+        tbb::parallel_for(tbb::blocked_range<int>(0, total, 4),
+                          [&](const tbb::blocked_range<int>& r) {
+                              for (int i = r.begin(); i < r.end(); ++i) {
+                                  const size_t e = static_cast<size_t>(i / per_eye);
+                                  const EyeJob& j = jobs[e];
+                                  const int tile = i % per_eye;
+                                  if (options.classify_tiles) {
+                                      classifyTile(j, tile, cols, j.params.chroma ? 3 : 1,
+                                                   lattices[e].data(), width, height);
+                                  } else {
+                                      (*j.kinds)[static_cast<size_t>(tile)] = TileKind::kBorder;
+                                      (*j.masks)[static_cast<size_t>(tile)] =
+                                          static_cast<uint8_t>((1u << j.slots.count) - 1);
+                                  }
+                                  detail::TileJob t;
+                                  t.x0 = (tile % cols) * kTilePx;
+                                  t.y0 = (tile / cols) * kTilePx;
+                                  t.x1 = std::min(t.x0 + kTilePx, width);
+                                  t.y1 = std::min(t.y0 + kTilePx, height);
+                                  t.slot_mask = (*j.masks)[static_cast<size_t>(tile)];
+                                  t.out = j.out->data();
+                                  t.out_stride_px = static_cast<size_t>(j.out->width());
+                                  if (simd) {
+                                      detail::ucaTileSimd(j.params, t);
+                                  } else {
+                                      detail::ucaTileScalar(j.params, t);
+                                  }
+                              }
+                          });
     });
     for (const auto& j : jobs) {
         for (TileKind k : *j.kinds) {

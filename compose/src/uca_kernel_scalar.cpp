@@ -75,14 +75,24 @@ void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
     const float max_y = static_cast<float>(l.height - 1);
     const float lx = std::min(std::max(px * l.inv_scale + l.offset_x, 0.0f), max_x);
     const float ly = std::min(std::max(py * l.inv_scale + l.offset_y, 0.0f), max_y);
-    const float flx = std::floor(lx);
-    const float fly = std::floor(ly);
+    float flx = std::floor(lx);
+    float fly = std::floor(ly);
+    int dx = flx < max_x ? 1 : 0;
+    int dy = fly < max_y ? 1 : 0;
+    if (l.width >= 2 && l.height >= 2) {
+        // The vector kernel's pair fetch: the left tap stops one short of the edge, where the
+        // right tap's weight becomes exactly 1 — the same value.
+        flx = std::min(flx, max_x - 1.0f);
+        fly = std::min(fly, max_y - 1.0f);
+        dx = 1;
+        dy = 1;
+    }
     const float wx = lx - flx;
     const float wy = ly - fly;
     const int x0 = static_cast<int>(flx);
     const int y0 = static_cast<int>(fly);
-    const int x1 = flx < max_x ? x0 + 1 : x0;
-    const int y1 = fly < max_y ? y0 + 1 : y0;
+    const int x1 = x0 + dx;
+    const int y1 = y0 + dy;
     const uint32_t t00 = loadTexel(l, x0, y0);
     const uint32_t t10 = loadTexel(l, x1, y0);
     const uint32_t t01 = loadTexel(l, x0, y1);
