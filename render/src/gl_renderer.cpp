@@ -62,6 +62,56 @@ void main() {
 }
 )";
 
+// The counting pass: clip-space positions only.
+constexpr const char* kCountVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 a_position;
+layout(location = 0) uniform mat4 u_view_projection;
+void main() {
+    gl_Position = u_view_projection * vec4(a_position, 1.0);
+}
+)";
+
+// Sutherland–Hodgman in homogeneous clip space: a triangle clipped by six planes has at most
+// 3 + 6 vertices. Inclusive tests (≥ 0) make the volume closed, so a triangle that only touches
+// a plane counts, as in the CPU definition.
+constexpr const char* kCountGeometryShader = R"(#version 450 core
+layout(triangles) in;
+layout(points, max_vertices = 1) out;
+float planeDistance(int plane, vec4 p) {
+    float c = plane < 2 ? p.x : (plane < 4 ? p.y : p.z);
+    return (plane % 2 == 0) ? p.w + c : p.w - c;
+}
+void main() {
+    vec4 poly[9];
+    vec4 next[9];
+    poly[0] = gl_in[0].gl_Position;
+    poly[1] = gl_in[1].gl_Position;
+    poly[2] = gl_in[2].gl_Position;
+    int n = 3;
+    for (int plane = 0; plane < 6; ++plane) {
+        int m = 0;
+        for (int i = 0; i < n; ++i) {
+            vec4 a = poly[i];
+            vec4 b = poly[(i + 1) % n];
+            float da = planeDistance(plane, a);
+            float db = planeDistance(plane, b);
+            if (da >= 0.0)
+                next[m++] = a;
+            if ((da >= 0.0) != (db >= 0.0))
+                next[m++] = mix(a, b, da / (da - db));
+        }
+        n = m;
+        if (n == 0)
+            return;
+        for (int i = 0; i < n; ++i)
+            poly[i] = next[i];
+    }
+    gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
+    EmitVertex();
+    EndPrimitive();
+}
+)";
+
 double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -115,6 +165,8 @@ struct GlRenderer::Impl {
     GLuint query_primitives = 0;
     GLuint query_clip_in = 0;
     GLuint query_clip_out = 0;
+    GLuint count_program = 0;
+    GLuint query_count = 0;
 
     ~Impl() {
         if (!egl || !egl->makeCurrent())
@@ -127,6 +179,8 @@ struct GlRenderer::Impl {
         glDeleteTextures(1, &white);
         glDeleteVertexArrays(1, &vao);
         glDeleteProgram(program);
+        glDeleteProgram(count_program);
+        glDeleteQueries(1, &query_count);
     }
 
     void releaseScene() {
@@ -174,27 +228,14 @@ struct GlRenderer::Impl {
         if (Status st = checkGl("limits query"); !st)
             return st;
 
-        auto vs = compileShader(GL_VERTEX_SHADER, kVertexShader);
-        if (!vs)
-            return Error{vs.error()};
-        auto fs = compileShader(GL_FRAGMENT_SHADER, kFragmentShader);
-        if (!fs) {
-            glDeleteShader(*vs);
-            return Error{fs.error()};
-        }
-        program = glCreateProgram();
-        glAttachShader(program, *vs);
-        glAttachShader(program, *fs);
-        glLinkProgram(program);
-        glDeleteShader(*vs);
-        glDeleteShader(*fs);
-        GLint linked = GL_FALSE;
-        glGetProgramiv(program, GL_LINK_STATUS, &linked);
-        if (linked != GL_TRUE) {
-            char log[2048] = {};
-            glGetProgramInfoLog(program, sizeof(log), nullptr, log);
-            return makeError(fmt::format("GL: program link failed: {}", log));
-        }
+        auto shading = linkProgram(kVertexShader, nullptr, kFragmentShader);
+        if (!shading)
+            return Error{shading.error()};
+        program = *shading;
+        auto counting = linkProgram(kCountVertexShader, kCountGeometryShader, nullptr);
+        if (!counting)
+            return Error{counting.error()};
+        count_program = *counting;
 
         glCreateVertexArrays(1, &vao);
         // Attribute layout of SceneVertex, bound to whatever vertex buffer upload() creates.
@@ -222,11 +263,42 @@ struct GlRenderer::Impl {
         // pipeline-statistics targets with GL_INVALID_ENUM; glBeginQuery gives them a type.
         glGenQueries(1, &query_time);
         glGenQueries(1, &query_primitives);
+        glGenQueries(1, &query_count);
         if (info.pipeline_statistics) {
             glGenQueries(1, &query_clip_in);
             glGenQueries(1, &query_clip_out);
         }
         return checkGl("query creation");
+    }
+
+    static Expected<GLuint> linkProgram(const char* vertex, const char* geometry,
+                                        const char* fragment) {
+        const std::pair<GLenum, const char*> stages[] = {{GL_VERTEX_SHADER, vertex},
+                                                         {GL_GEOMETRY_SHADER, geometry},
+                                                         {GL_FRAGMENT_SHADER, fragment}};
+        const GLuint prog = glCreateProgram();
+        for (const auto& [type, source] : stages) {
+            if (source == nullptr)
+                continue;
+            auto shader = compileShader(type, source);
+            if (!shader) {
+                glDeleteProgram(prog);
+                return Error{shader.error()};
+            }
+            glAttachShader(prog, *shader);
+            // Flagged for deletion; freed with the program.
+            glDeleteShader(*shader);
+        }
+        glLinkProgram(prog);
+        GLint linked = GL_FALSE;
+        glGetProgramiv(prog, GL_LINK_STATUS, &linked);
+        if (linked != GL_TRUE) {
+            char log[2048] = {};
+            glGetProgramInfoLog(prog, sizeof(log), nullptr, log);
+            glDeleteProgram(prog);
+            return makeError(fmt::format("GL: program link failed: {}", log));
+        }
+        return prog;
     }
 
     static Status checkGl(const char* what) {
@@ -337,6 +409,38 @@ struct GlRenderer::Impl {
                                          height, static_cast<unsigned>(status)));
         }
         return &framebuffers.emplace(key, fb).first->second;
+    }
+
+    Expected<uint64_t> countTrianglesInFrustum(const RenderView& view) {
+        if (Status s = egl->makeCurrent(); !s)
+            return Error{s.error()};
+        // Drawing needs a complete framebuffer even with rasterization discarded; the surfaceless
+        // context has no default one.
+        auto fb = framebufferFor(1, 1);
+        if (!fb)
+            return Error{fb.error()};
+        glBindFramebuffer(GL_FRAMEBUFFER, (*fb)->fbo);
+        glUseProgram(count_program);
+        const glm::mat4 view_projection = view.viewProjection();
+        glUniformMatrix4fv(0, 1, GL_FALSE, glm::value_ptr(view_projection));
+        glBindVertexArray(vao);
+        glEnable(GL_RASTERIZER_DISCARD);
+        glBeginQuery(GL_PRIMITIVES_GENERATED, query_count);
+        for (const SceneBatch& b : batches) {
+            if (b.index_count < 3)
+                continue;
+            const uintptr_t offset = static_cast<uintptr_t>(b.first_index) * sizeof(uint32_t);
+            glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.index_count), GL_UNSIGNED_INT,
+                           reinterpret_cast<const void*>(offset));
+        }
+        glEndQuery(GL_PRIMITIVES_GENERATED);
+        glDisable(GL_RASTERIZER_DISCARD);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        GLuint64 count = 0;
+        glGetQueryObjectui64v(query_count, GL_QUERY_RESULT, &count);
+        if (Status s = checkGl("triangle counting"); !s)
+            return Error{s.error()};
+        return static_cast<uint64_t>(count);
     }
 
     Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) {
@@ -463,6 +567,10 @@ Status GlRenderer::upload(const Scene& scene) {
 
 Expected<RenderStats> GlRenderer::render(const RenderView& view, ImageRgba8& out) {
     return m_impl->render(view, out);
+}
+
+Expected<uint64_t> GlRenderer::countTrianglesInFrustum(const RenderView& view) {
+    return m_impl->countTrianglesInFrustum(view);
 }
 
 }  // namespace qvr

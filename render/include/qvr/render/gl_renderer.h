@@ -41,6 +41,13 @@ public:
     Status upload(const Scene& scene) override;
     Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) override;
 
+    // The triangles of the uploaded scene (all batches, no CPU culling) that a view processes:
+    // those with some part inside the closed clip volume −w ≤ x, y, z ≤ w. A geometry shader
+    // clips each triangle against the six planes and emits it when a polygon survives; a
+    // GL_PRIMITIVES_GENERATED query counts what it emitted, with rasterization discarded. This is
+    // the GL side of the check of the scene part's CPU count (TriangleBvh, docs/RENDER.md).
+    Expected<uint64_t> countTrianglesInFrustum(const RenderView& view);
+
     struct Impl;
 
 private:
