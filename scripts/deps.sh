@@ -9,6 +9,10 @@ QVR_PACKAGES=(
     libtbb-dev libhwy-dev libpng-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     gnuplot-nox
+    # scene: pk3 (zip) archives, glTF/OBJ, JPEG/TGA textures; the OpenArena levels and their
+    # textures; assimp-testmodels for the CMU mocap head motion
+    libzip-dev libassimp-dev libstb-dev
+    openarena-081-maps openarena-081-textures openarena-data assimp-testmodels
     # codec: H.264 through libavcodec + libx264; trace: CMU motion capture (BVH) for head motion
     libavcodec-dev libavutil-dev libswscale-dev libx264-dev assimp-testmodels
     # render: headless OpenGL 4.5 through EGL (GLVND headers and loaders, Mesa's EGL and llvmpipe)
