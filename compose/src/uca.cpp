@@ -190,11 +190,41 @@ void sampleCorner(const EyeJob& job, int point, int lattice_cols, int width, int
 // Tile classification, once per frame, from the map at the tile's four corners (at its outer
 // edges, so every pixel centre lies inside). Over 32 pixels the map is close to affine: the
 // tile lands inside the corners' quadrilateral, whose points are within half its longer
-// diagonal of a corner; the 25 % and the small constants leave slack for the map's curvature.
+// diagonal of a corner; the extra 25 % and the small constants leave slack for the map's
+// curvature.
 // Empty: every pixel lands off the rendered image. Single: one slot's weight is 1 over the
 // whole eccentricity range. Border: anything else.
+// The smallest angle from the gaze to a spherical quadrilateral given by its corners in cyclic
+// order: 0 when the gaze is inside, else the nearest point of its four great-circle edges.
+double nearestEccentricityDeg(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                              const glm::dvec3& d, const glm::dvec3& gaze, double corner_min_deg) {
+    const glm::dvec3 corners[4] = {a, b, c, d};
+    int positive = 0, negative = 0;
+    double nearest = corner_min_deg;
+    for (int i = 0; i < 4; ++i) {
+        const glm::dvec3& p = corners[i];
+        const glm::dvec3& q = corners[(i + 1) % 4];
+        glm::dvec3 n = glm::cross(p, q);
+        const double n_len = glm::length(n);
+        if (n_len < 1e-15)
+            continue;
+        n /= n_len;
+        const double side = glm::dot(gaze, n);
+        (side >= 0.0 ? positive : negative) += 1;
+        // The gaze's foot on the edge's great circle lies between p and q when it is on the
+        // inner side of both end planes.
+        const glm::dvec3 foot = gaze - side * n;
+        if (glm::dot(glm::cross(p, foot), n) >= 0.0 && glm::dot(glm::cross(foot, q), n) >= 0.0 &&
+            glm::dot(foot, p + q) > 0.0) {
+            nearest = std::min(nearest, std::asin(std::min(1.0, std::fabs(side))) * kDegPerRad);
+        }
+    }
+    return positive == 4 || negative == 4 ? 0.0 : nearest;
+}
+
 void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
                   const CornerSample* lattice, int width, int height) {
+    const glm::dvec3 gaze_dir(job.params.gaze[0], job.params.gaze[1], job.params.gaze[2]);
     const int tx = tile % tile_cols;
     const int ty = tile / tile_cols;
     const int lattice_cols = tile_cols + 1;
@@ -228,9 +258,14 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
             channel_empty = x_max < 0.0 || x_min > width || y_max < 0.0 || y_min > height;
         }
         empty = empty && channel_empty;
-        const double reach_deg = 0.5 * 1.25 * diag_rad * kDegPerRad + 0.01;
-        lo_deg = std::min(lo_deg, e_min - reach_deg);
-        hi_deg = std::max(hi_deg, e_max + reach_deg);
+        // Eccentricity is convex within the hemisphere around the gaze, so over the tile's
+        // (near-geodesic) quadrilateral its maximum is at a corner and its minimum on an edge,
+        // or 0 when the gaze is inside; the slack covers the edges' curvature.
+        const double slack_deg = 0.125 * diag_rad * kDegPerRad + 0.01;
+        const double nearest_deg =
+            nearestEccentricityDeg(unit(k[0]), unit(k[1]), unit(k[3]), unit(k[2]), gaze_dir, e_min);
+        lo_deg = std::min(lo_deg, nearest_deg - slack_deg);
+        hi_deg = std::max(hi_deg, e_max + slack_deg);
     }
     uint8_t mask = 0;
     TileKind kind = TileKind::kEmpty;

@@ -127,12 +127,16 @@ TEST(ComposeUca, TileClassificationNeverChangesAPixel) {
     std::uniform_real_distribution<double> gaze(-20.0, 20.0);
     for (int trial = 0; trial < 6; ++trial) {
         HmdProfile profile = smallProfile(480, 540);
+        std::uniform_real_distribution<double> k(0.0, 0.4);
+        profile.lens.k1 = k(rng);
+        profile.lens.k2 = k(rng);
         if (trial % 3 == 2)
             profile.lens.chroma_blue_scale = 1.015;
         const LayerPlan plan =
             LayerPlanner(profile).plan({gaze(rng), gaze(rng)}, 5.0 + 4.0 * trial);
         LayerFrame frame = randomFrame(profile, plan, rng);
-        const Pose display = poseDeg(angle(rng), angle(rng), angle(rng));
+        // Up to 12° of rotation: far more than a frame of head motion, to stress the bounds.
+        const Pose display = poseDeg(4 * angle(rng), 4 * angle(rng), 4 * angle(rng));
         for (bool simd : {true, false}) {
             ComposeOptions on, off;
             on.simd = off.simd = simd;
