@@ -6,11 +6,14 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "qvr/sim/benches.h"
 #include "qvr/sim/evaluation.h"
+#include "qvr/sim/network.h"
 
 namespace qvr::cli {
 
@@ -20,10 +23,17 @@ struct EvalCliOptions {
     int frames = 400;
     int jobs = 2;
     std::string out;
+    std::vector<std::string> mahimahi;
+    std::vector<std::string> benches;
 };
 
 std::string joinArgs(const EvalCliOptions& o) {
-    return fmt::format("qvr eval --frames {} --jobs {} --out {}", o.frames, o.jobs, o.out);
+    std::string s = fmt::format("qvr eval --frames {} --jobs {} --out {}", o.frames, o.jobs, o.out);
+    if (!o.mahimahi.empty())
+        s += " --mahimahi";
+    for (const auto& m : o.mahimahi)
+        s += " " + m;
+    return s;
 }
 
 int runEval(const EvalCliOptions& o) {
@@ -35,7 +45,24 @@ int runEval(const EvalCliOptions& o) {
         std::fprintf(stderr, "qvr eval: --jobs must be within 1..256, got %d\n", o.jobs);
         return 2;
     }
+    // Traces are user input: a malformed one is a bad-input exit, found before any run.
+    for (const auto& path : o.mahimahi) {
+        auto t = loadMahimahiTrace(path);
+        if (!t) {
+            std::fprintf(stderr, "qvr eval: %s\n", t.error().c_str());
+            return 2;
+        }
+    }
+    for (const auto& b : o.benches) {
+        auto t = makeSuiteBench(b, 1);
+        if (!t) {
+            std::fprintf(stderr, "qvr eval: %s\n", t.error().c_str());
+            return 2;
+        }
+    }
     EvalOptions opts;
+    opts.mahimahi_traces = o.mahimahi;
+    opts.benches = o.benches;
     opts.frames = o.frames;
     opts.jobs = o.jobs;
     opts.out_dir = o.out;
@@ -83,6 +110,11 @@ static Registered registerEval(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--jobs", o->jobs, "Runs simulated in parallel (threads)")
         ->capture_default_str();
+    cmd->add_option("--bench", o->benches,
+                    "Run only these suite workloads (repeatable); default: all seven");
+    cmd->add_option("--mahimahi", o->mahimahi,
+                    "Mahimahi capacity traces (e.g. ../shared/data/network/*.down) to replay, "
+                    "rescaled to 100 Mbps, for ffr, dfr and qvr");
     cmd->add_option("--out", o->out,
                     "Output folder: CSV + PNG per experiment, summary.json, report.html")
         ->required();

@@ -82,6 +82,8 @@ TEST_F(Cli, SimRejectsBadInputWithStatusTwoAndAMessage) {
         {"sim --trace /nonexistent.jsonl" + out, "nonexistent"},
         {"eval --frames 5" + out, "--frames"},
         {"eval --jobs 0" + out, "--jobs"},
+        {"eval --bench doom9" + out, "unknown bench"},
+        {"eval --frames 30 --mahimahi " + bad_trace.string() + out, "expected a non-negative"},
     };
     for (const Case& c : cases) {
         const Outcome o = run(c.args);

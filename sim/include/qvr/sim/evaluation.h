@@ -16,6 +16,11 @@ struct EvalOptions {
     int frames = 400;
     int jobs = 2;
     std::string out_dir;
+    // Mahimahi capacity traces to replay (rescaled to 100 Mbps) for Q-VR, DFR and FFR; none
+    // by default.
+    std::vector<std::string> mahimahi_traces;
+    // A subset of the suite by name; empty runs all seven.
+    std::vector<std::string> benches;
     std::string command_line;                           // recorded in the report
     std::function<void(int done, int total)> progress;  // called from worker threads, serialised
 };

@@ -1,0 +1,132 @@
+// `qvr eval`'s experiments end to end on short runs: every CSV, summary.json with one object
+// per run and the documented fields, report.html with the paper's headline figures, and the
+// rows of each CSV matching the runs they were computed from.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "qvr/sim/evaluation.h"
+
+namespace qvr {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+TEST(Evaluation, WritesEveryExperimentAndASummaryOfEveryRun) {
+    const fs::path out =
+        fs::temp_directory_path() / ("qvr_eval_test_" + std::to_string(::getpid()));
+    // A two-stamp trace (one packet every 5 ms) exercises the trace-driven experiment cheaply.
+    const fs::path trace = out.string() + "_tiny.down";
+    {
+        std::ofstream f(trace);
+        f << "5\n10\n";
+    }
+    EvalOptions opts;
+    opts.frames = 30;
+    opts.jobs = 2;
+    opts.out_dir = out.string();
+    opts.mahimahi_traces = {trace.string()};
+    opts.command_line = "test";
+    // Two benches keep the test short; LIWC builds a 70 ms table per run.
+    opts.benches = {"doom3-l", "synthetic-grid"};
+    int last_done = 0, total = 0;
+    opts.progress = [&](int done, int n) {
+        EXPECT_GT(done, last_done);
+        last_done = done;
+        total = n;
+    };
+    auto result = runEvaluation(opts);
+    ASSERT_TRUE(result.ok()) << result.error();
+    EXPECT_EQ(last_done, total);
+    // 2 benches × (7 designs + 8 Q-VR clock×network points + 2 local clocks + 3 trace designs).
+    EXPECT_EQ(result->runs.size(), 2u * (7 + 8 + 2 + 3));
+    for (const char* f : {"fig12_speedup.csv", "fig13_data_resolution.csv",
+                          "fig14_latency_ratio.csv", "fig14_fps.csv", "table4_e1.csv",
+                          "fig15_energy.csv", "mahimahi_lte.csv", "summary.json", "report.html"})
+        EXPECT_TRUE(fs::exists(out / f)) << f;
+
+    const auto j = nlohmann::json::parse(slurp(out / "summary.json"));
+    ASSERT_EQ(j["runs"].size(), result->runs.size());
+    for (const auto& r : j["runs"]) {
+        for (const char* k : {"bench", "design", "gpu_mhz", "net", "frames", "mtp_ms_mean",
+                              "fps_mean", "bytes_per_frame_mean", "pixels_per_frame_mean",
+                              "energy_mj_per_frame", "e1_deg_mean", "latency_ratio_final"})
+            EXPECT_TRUE(r.contains(k)) << k;
+    }
+    // Fig. 14 always covers 300 frames, whatever --frames says.
+    std::stringstream fig14(slurp(out / "fig14_latency_ratio.csv"));
+    int lines = 0;
+    for (std::string line; std::getline(fig14, line);)
+        ++lines;
+    EXPECT_EQ(lines, 301);
+
+    // The Fig. 12 speedup of Q-VR on the first bench is local MTP / Q-VR MTP of those runs.
+    double local_mtp = 0, qvr_mtp = 0;
+    const std::string first = result->runs.front().bench;
+    for (const auto& r : result->runs) {
+        if (r.bench != first || r.gpu_mhz != 500.0 || r.net != "wifi")
+            continue;
+        if (r.design == "local")
+            local_mtp = r.mtp_ms_mean;
+        if (r.design == "qvr")
+            qvr_mtp = r.mtp_ms_mean;
+    }
+    std::stringstream fig12(slurp(out / "fig12_speedup.csv"));
+    std::string header, row;
+    std::getline(fig12, header);
+    std::getline(fig12, row);
+    std::vector<std::string> cells;
+    for (size_t p = 0;;) {
+        const size_t c = row.find(',', p);
+        cells.push_back(row.substr(p, c == std::string::npos ? std::string::npos : c - p));
+        if (c == std::string::npos)
+            break;
+        p = c + 1;
+    }
+    ASSERT_EQ(cells.size(), 10u);
+    EXPECT_EQ(cells[0], "synthetic-doom3-l");
+    EXPECT_NEAR(std::stod(cells[7]), local_mtp / qvr_mtp, 1e-3);
+
+    const std::string html = slurp(out / "report.html");
+    for (const char* s : {"3.40x", "4.10x", "85.00%", "41.00%", "73.00%", "Fig. 12", "Fig. 13",
+                          "Fig. 14", "Table 4", "Fig. 15", "Where we differ"})
+        EXPECT_NE(html.find(s), std::string::npos) << s;
+    EXPECT_EQ(result->findings.size(), 5u);
+    fs::remove_all(out);
+    fs::remove(trace);
+}
+
+TEST(Evaluation, RejectsBadOptions) {
+    EvalOptions opts;
+    opts.out_dir = (fs::temp_directory_path() / "qvr_eval_bad").string();
+    opts.frames = 5;
+    EXPECT_FALSE(runEvaluation(opts).ok());
+    opts.frames = 100;
+    opts.jobs = 0;
+    EXPECT_FALSE(runEvaluation(opts).ok());
+    opts.jobs = 1;
+    opts.benches = {"doom9"};
+    EXPECT_FALSE(runEvaluation(opts).ok());
+    opts.benches = {};
+    opts.mahimahi_traces = {"/nonexistent/x.down"};
+    auto r = runEvaluation(opts);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find("/nonexistent/x.down"), std::string::npos);
+    fs::remove_all(opts.out_dir);
+}
+
+}  // namespace
+}  // namespace qvr
