@@ -30,9 +30,14 @@ struct UcaBenchResult {
     double uca_scalar_ms = 0.0;  // the scalar twin, same run
     double two_pass_ms = 0.0;
     std::optional<double> opencv_two_pass_ms;
-    double bandwidth_floor_ms = 0.0;  // UCA's bytes at the measured copy bandwidth
-    double uca_bytes = 0.0;           // layers read + display images written, both eyes
-    double copy_gbps = 0.0;           // measured read+write bandwidth of a large copy
+    double bandwidth_floor_ms = 0.0;  // UCA's bytes at the measured copy bandwidth (median)
+    // The fastest run of each, less sensitive than the median to other processes on the cores.
+    double uca_min_ms = 0.0;
+    double two_pass_min_ms = 0.0;
+    std::optional<double> opencv_two_pass_min_ms;
+    double bandwidth_floor_min_ms = 0.0;  // at the best copy bandwidth
+    double uca_bytes = 0.0;               // layers read + display images written, both eyes
+    double copy_gbps = 0.0;               // measured read+write bandwidth of a large copy
     double pose_change_deg = 0.0;
     TileStats tiles;
     QualityReport uca_quality;       // left eye
