@@ -9,6 +9,7 @@ QVR_PACKAGES=(
     libtbb-dev libhwy-dev libpng-dev
     libgtest-dev libgmock-dev libbenchmark-dev
     gnuplot-nox
+    libasio-dev libsodium-dev  # net: transport (standalone asio), PSK handshake (HMAC-SHA-256)
     # scene: pk3 (zip) archives, glTF/OBJ, JPEG/TGA textures; the OpenArena levels and their
     # textures; assimp-testmodels for the CMU mocap head motion
     libzip-dev libassimp-dev libstb-dev

@@ -1,0 +1,73 @@
+// The headset's side of the transport: connects with a timeout, proves the pre-shared key,
+// sends frame requests, reassembles the four layer streams, acknowledges each stream (the
+// server's throughput estimate comes back for LIWC), asks for a key frame after a loss, and
+// reports a lost server as an error so the caller can fall back and reconnect later.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "qvr/core/expected.h"
+#include "qvr/net/auth.h"
+#include "qvr/net/protocol.h"
+#include "qvr/net/stream_assembler.h"
+
+namespace qvr::net {
+
+struct ClientOptions {
+    PresharedKey key;
+    int connect_timeout_ms = 2000;  // TCP connect + handshake
+    AssemblerLimits assembler;
+    int key_frame_retry_ms = 100;    // at most one key-frame request per stream in this time
+    size_t max_ready_streams = 256;  // completed streams the caller has not taken yet
+    size_t max_control_queue = 256;
+};
+
+struct ClientStats {
+    uint64_t connects = 0;
+    uint64_t connect_failures = 0;
+    uint64_t server_proof_failures = 0;  // the server did not prove the key
+    uint64_t disconnects = 0;
+    DropCounters control_drops;
+    DropCounters media_drops;
+    AssemblerStats assembler;  // accumulated over connections
+    uint64_t frame_requests_sent = 0;
+    uint64_t acks_sent = 0;
+    uint64_t key_frame_requests_sent = 0;
+    uint64_t ready_streams_dropped = 0;  // the caller did not keep up
+};
+
+class Client {
+public:
+    explicit Client(ClientOptions options);
+    ~Client();
+    Client(const Client&) = delete;
+    Client& operator=(const Client&) = delete;
+
+    // Blocks until the handshake finished, failed or timed out. Drops any earlier connection.
+    Status connect(const std::string& host, uint16_t port);
+    void disconnect();
+    bool connected() const;
+    // Why the last connection ended (success while connected or never connected).
+    Status lastError() const;
+
+    Status sendFrameRequest(const FrameRequest& request);
+    Status requestKeyFrame(uint8_t stream_mask, uint32_t frame_id, KeyFrameReason reason);
+
+    // The next complete stream, waiting up to timeout_ms: nullopt on timeout, an error once
+    // the connection is gone and every stream received before has been taken.
+    Expected<std::optional<CompletedStream>> nextStream(int timeout_ms);
+
+    // The server's latest ack-based estimate, 0 before the first.
+    double throughputBps() const;
+    ClientStats stats() const;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace qvr::net

@@ -1,0 +1,108 @@
+// A userspace link between server and headset (paper §5's Wi-Fi / LTE / 5G profiles and
+// Mahimahi traces), since the kernel's netem is unavailable: a drop-tail bottleneck queue served
+// at a rate or by trace opportunities, then a delay line with jitter, with random loss before
+// the queue. Pure in time: every call takes now_ns, so a fake clock makes it deterministic.
+// Model and profiles: docs/NETWORK.md.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "qvr/core/expected.h"
+#include "qvr/net/mahimahi.h"
+
+namespace qvr::net {
+
+struct LinkConfig {
+    std::string name = "none";
+    double rate_bps = 0.0;                       // 0: no rate limit (and no trace)
+    std::shared_ptr<const MahimahiTrace> trace;  // replaces rate_bps when set
+    double trace_target_bps = 0.0;               // rescale the trace to this mean; 0: as recorded
+    double delay_ms = 0.0;                       // one way, after the queue
+    double jitter_ms = 0.0;                      // uniform in [-jitter, +jitter], order kept
+    double loss = 0.0;                           // per-packet drop probability before the queue
+    int64_t queue_bytes = 4 << 20;               // drop-tail bottleneck buffer
+    uint64_t seed = 1;
+    bool shaped() const {
+        return rate_bps > 0.0 || trace != nullptr || delay_ms > 0.0 || jitter_ms > 0.0 ||
+               loss > 0.0;
+    }
+};
+
+// "none", "wifi" (200 Mbit/s), "lte" (100), "5g" (500) — paper Table 2 — "rate:MBPS", or
+// "trace:PATH[@MBPS]" (a Mahimahi file, rescaled to MBPS when given), followed by options
+// ",delay_ms=D", ",jitter_ms=J", ",loss=P" (0 ≤ P < 1), ",queue_kb=Q", ",seed=S".
+Expected<LinkConfig> parseLinkSpec(const std::string& spec);
+const std::vector<std::string>& linkProfileNames();
+
+struct LinkStats {
+    uint64_t packets_in = 0;
+    uint64_t packets_delivered = 0;
+    uint64_t dropped_loss = 0;   // random loss
+    uint64_t dropped_queue = 0;  // the bottleneck buffer was full
+    uint64_t bytes_in = 0;
+    uint64_t bytes_delivered = 0;
+};
+
+// The link seam the media sender writes through; LinkEmulator is the only implementation the
+// runtime needs (an unshaped config passes packets through at once).
+class PacketLink {
+public:
+    virtual ~PacketLink() = default;
+    // Accepts a packet at now_ns; false when it was dropped (loss or full queue).
+    virtual bool send(std::vector<uint8_t> packet, int64_t now_ns) = 0;
+    // Appends the packets whose delivery time is ≤ now_ns, in order.
+    virtual void deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& out) = 0;
+    virtual std::optional<int64_t> nextDeliveryNs() const = 0;
+    virtual int64_t queuedBytes(int64_t now_ns) = 0;  // waiting for the bottleneck
+    virtual LinkStats stats() const = 0;
+};
+
+class LinkEmulator final : public PacketLink {
+public:
+    explicit LinkEmulator(LinkConfig config);
+    bool send(std::vector<uint8_t> packet, int64_t now_ns) override;
+    void deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& out) override;
+    std::optional<int64_t> nextDeliveryNs() const override;
+    int64_t queuedBytes(int64_t now_ns) override;
+    LinkStats stats() const override { return m_stats; }
+    const LinkConfig& config() const { return m_config; }
+    // Trace mode: how much one trace millisecond lasts, in ns (1e6 · mean / target).
+    double traceNsPerMs() const { return m_trace_ns_per_ms; }
+
+private:
+    // When the last byte of a packet of `bytes` entering the bottleneck at start_ns leaves it.
+    double departureNs(double start_ns, int64_t bytes);
+    double opportunityNs(int64_t index) const;
+    int64_t firstOpportunityAtOrAfter(double t_ns) const;
+    double uniform01(std::mt19937_64& rng);
+    void drainQueue(int64_t now_ns);
+
+    struct InFlight {
+        std::vector<uint8_t> bytes;
+        int64_t deliver_ns;
+    };
+    struct Queued {
+        double departure_ns;
+        int64_t bytes;
+    };
+    LinkConfig m_config;
+    std::mt19937_64 m_loss_rng;
+    std::mt19937_64 m_jitter_rng;
+    double m_link_free_ns = 0.0;   // rate mode: when the bottleneck finishes its backlog
+    int64_t m_opp_index = 0;       // trace mode: the opportunity being filled
+    int64_t m_opp_left_bytes = 0;  // bytes left in it
+    double m_trace_ns_per_ms = 1e6;
+    int64_t m_last_deliver_ns = 0;
+    std::deque<Queued> m_queue;  // departure times of packets still in the bottleneck
+    int64_t m_queue_bytes = 0;
+    std::deque<InFlight> m_flight;  // ordered by deliver_ns
+    LinkStats m_stats;
+};
+
+}  // namespace qvr::net

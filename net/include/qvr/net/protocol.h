@@ -1,0 +1,208 @@
+// The qvr wire protocol (paper §3.2: parallel streams of the middle and outer layers per eye,
+// plus a control channel). Pure encode/decode between bytes and structs; every byte is hostile.
+// Byte layouts, limits and versioning: docs/PROTOCOL.md.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "qvr/core/pose.h"
+#include "qvr/foveation/layer_plan.h"
+
+namespace qvr::net {
+
+inline constexpr uint8_t kProtocolVersion = 1;
+
+// Limits a decoder enforces before it trusts any length a peer sent.
+inline constexpr size_t kControlHeaderBytes = 8;
+inline constexpr size_t kMaxControlPayloadBytes = 1024;  // the largest message is ~270 bytes
+inline constexpr size_t kMediaHeaderBytes = 32;
+inline constexpr size_t kMediaChunkBytes = 1200;  // payload per packet; fits a 1280-byte IPv6 MTU
+inline constexpr size_t kMaxDatagramBytes = kMediaHeaderBytes + kMediaChunkBytes;
+inline constexpr uint32_t kMaxPacketsPerFrame = 4096;  // ≤ 4.9 MB per layer and frame
+inline constexpr uint32_t kMaxStreamFrameBytes = kMaxPacketsPerFrame * kMediaChunkBytes;
+inline constexpr int kMaxStreams = 4;                // eye × {middle, outer}
+inline constexpr int32_t kMaxImageExtentPx = 16384;  // rectangle coordinates and framebuffer sizes
+inline constexpr size_t kNonceBytes = 32;
+inline constexpr size_t kMacBytes = 32;
+
+// Stream id = 2·eye + layer: the four parallel streams of Fig. 7.
+enum class Layer : uint8_t { kMiddle = 0, kOuter = 1 };
+constexpr uint8_t streamId(int eye, Layer layer) {
+    return static_cast<uint8_t>(2 * eye + static_cast<int>(layer));
+}
+
+// Why a message was dropped; each has a counter (DropCounters).
+enum class WireError : uint8_t {
+    kNone = 0,
+    kTruncated,      // shorter than its header or its declared length
+    kOversized,      // a length field above the protocol limit
+    kBadMagic,       // not a qvr message at all
+    kWrongVersion,   // a qvr message of another protocol version
+    kUnknownType,    // a message type this version does not define
+    kBadField,       // a field out of its range (NaN pose, rect outside the image, ...)
+    kTrailingBytes,  // more bytes than the type's fixed layout
+    kBadMac,         // handshake proof that does not verify
+    kWrongSession,   // media of another session
+};
+inline constexpr int kWireErrorCount = 10;
+std::string_view wireErrorName(WireError e);
+
+struct DropCounters {
+    std::array<uint64_t, kWireErrorCount> by_error{};
+    void count(WireError e) { ++by_error[static_cast<size_t>(e)]; }
+    uint64_t operator[](WireError e) const { return by_error[static_cast<size_t>(e)]; }
+    uint64_t total() const;
+    DropCounters& operator+=(const DropCounters& o);
+};
+
+// ---- control channel (TCP): 8-byte header + payload --------------------------------------
+
+enum class ControlType : uint8_t {
+    kClientHello = 1,
+    kServerChallenge = 2,
+    kClientAuth = 3,
+    kWelcome = 4,
+    kFrameRequest = 5,
+    kMediaAck = 6,
+    kKeyFrameRequest = 7,
+    kThroughputReport = 8,
+    kBye = 9,
+};
+
+struct ControlHeader {
+    ControlType type = ControlType::kBye;
+    uint32_t payload_bytes = 0;
+};
+
+// Handshake (docs/PROTOCOL.md §Handshake): nonces both ways, HMAC proofs both ways, never the key.
+struct ClientHello {
+    std::array<uint8_t, kNonceBytes> client_nonce{};
+    uint16_t media_port = 0;  // the client's UDP port on the address it connected from
+};
+struct ServerChallenge {
+    std::array<uint8_t, kNonceBytes> server_nonce{};
+    uint64_t session_id = 0;
+    std::array<uint8_t, kMacBytes> server_proof{};
+};
+struct ClientAuth {
+    std::array<uint8_t, kMacBytes> client_proof{};
+};
+struct Welcome {
+    uint64_t session_id = 0;
+    uint16_t media_port = 0;  // the server's UDP port media comes from
+};
+
+// What the server renders for one frame: the head pose, the gaze and the layer plan (§3.1).
+struct LayerGeometry {
+    PixelRect rect;
+    float scale = 1.0f;
+    int32_t width_px = 0;
+    int32_t height_px = 0;
+};
+struct EyeGeometryWire {
+    LayerGeometry fovea;
+    LayerGeometry middle;
+    LayerGeometry outer;
+};
+struct FrameRequest {
+    uint32_t frame_id = 0;
+    uint64_t client_send_ns = 0;  // the client's clock, echoed for its own latency bookkeeping
+    Pose pose;
+    Gaze gaze;
+    float e1_deg = 0.0f;
+    float e2_deg = 0.0f;
+    float s1 = 1.0f;
+    float s2 = 1.0f;
+    std::array<EyeGeometryWire, 2> eyes;
+};
+FrameRequest makeFrameRequest(uint32_t frame_id, uint64_t client_send_ns, const Pose& pose,
+                              const LayerPlan& plan);
+// The plan's geometry as the server needs it (pixel counts recomputed from the rectangles).
+LayerPlan layerPlanOf(const FrameRequest& request);
+
+// One per stream of a frame, sent when the stream completed or was declared lost.
+struct MediaAck {
+    uint32_t frame_id = 0;
+    uint8_t stream_id = 0;
+    bool complete = false;
+    uint16_t packets_received = 0;
+    uint32_t bytes_received = 0;
+    uint64_t first_rx_ns = 0;  // client clock: first and last packet of the stream's frame
+    uint64_t last_rx_ns = 0;
+};
+
+enum class KeyFrameReason : uint8_t { kPacketLoss = 1, kDecoderError = 2, kStart = 3 };
+struct KeyFrameRequest {
+    uint8_t stream_mask = 0;     // bit s: stream s needs an intra frame
+    uint32_t last_frame_id = 0;  // the frame whose loss triggered the request
+    KeyFrameReason reason = KeyFrameReason::kPacketLoss;
+};
+
+// The server's ack-based estimate (§4.1, Eq. 2's Throughput), for LIWC on the headset.
+struct ThroughputReport {
+    uint64_t throughput_bps = 0;
+    uint32_t samples = 0;
+};
+
+enum class ByeReason : uint8_t {
+    kNormal = 0,
+    kAuthFailed = 1,
+    kProtocolError = 2,
+    kServerFull = 3,
+    kTimeout = 4
+};
+struct Bye {
+    ByeReason reason = ByeReason::kNormal;
+};
+
+using ControlMessage = std::variant<ClientHello, ServerChallenge, ClientAuth, Welcome, FrameRequest,
+                                    MediaAck, KeyFrameRequest, ThroughputReport, Bye>;
+
+// Header + payload, ready to write.
+std::vector<uint8_t> encodeControl(const ControlMessage& message);
+// The first kControlHeaderBytes of a message: magic, version, type, length ≤ the type's limit.
+WireError decodeControlHeader(std::span<const uint8_t> bytes, ControlHeader& out);
+// A payload of exactly header.payload_bytes.
+WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payload,
+                               ControlMessage& out);
+// A whole message (header + payload), nothing after it.
+WireError decodeControl(std::span<const uint8_t> bytes, ControlMessage& out);
+
+// ---- media streams (UDP datagrams): 32-byte header + payload ------------------------------
+
+struct MediaHeader {
+    bool key_frame = false;
+    uint64_t session_id = 0;
+    uint32_t seq = 0;  // per stream, +1 per packet across frames: gaps reveal loss
+    uint32_t frame_id = 0;
+    uint8_t stream_id = 0;
+    uint16_t packet_index = 0;
+    uint16_t packet_count = 0;
+    uint16_t payload_bytes = 0;
+    uint32_t frame_bytes = 0;  // the stream's encoded size for this frame
+};
+struct MediaPacketView {
+    MediaHeader header;
+    std::span<const uint8_t> payload;  // into the datagram
+};
+
+// Checks every field against the limits and against each other: packet_count =
+// ceil(frame_bytes / kMediaChunkBytes), packet_index < packet_count, and payload_bytes is
+// kMediaChunkBytes except for the last packet, which carries the remainder.
+WireError decodeMediaPacket(std::span<const uint8_t> datagram, MediaPacketView& out);
+void encodeMediaPacket(const MediaHeader& header, std::span<const uint8_t> payload,
+                       std::vector<uint8_t>& out);
+uint32_t packetCountFor(uint32_t frame_bytes);
+// Splits one stream's frame into datagrams; seq advances by the packet count.
+// Precondition: 0 < bytes.size() ≤ kMaxStreamFrameBytes, stream_id < kMaxStreams.
+std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t& seq,
+                                                  uint32_t frame_id, uint8_t stream_id,
+                                                  bool key_frame, std::span<const uint8_t> bytes);
+
+}  // namespace qvr::net

@@ -1,0 +1,90 @@
+// The render server's side of the transport (paper Fig. 7): a TCP control channel per headset,
+// accepted only after the pre-shared-key handshake, and the four layer streams sent as UDP
+// datagrams through a per-client link emulator. One asio thread serves every client.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "qvr/core/expected.h"
+#include "qvr/net/auth.h"
+#include "qvr/net/link_emulator.h"
+#include "qvr/net/protocol.h"
+
+namespace qvr::net {
+
+using ClientId = uint64_t;  // the session id agreed in the handshake
+
+struct ServerOptions {
+    std::string bind_address = "127.0.0.1";  // loopback unless the caller opts into more
+    uint16_t port = 0;                       // 0: an ephemeral port, see Server::port()
+    PresharedKey key;
+    int max_clients = 8;
+    int max_pending_handshakes = 16;
+    int handshake_timeout_ms = 2000;
+    size_t max_control_queue = 256;           // outgoing control messages per client
+    int64_t max_media_queue_bytes = 8 << 20;  // accepted by sendStream, not yet in the link
+    LinkConfig link;                          // each client gets its own emulator with this
+    double throughput_alpha = 0.25;
+};
+
+// Called on the server's network thread: keep them short (hand work to the render thread).
+class ServerHandler {
+public:
+    virtual ~ServerHandler() = default;
+    virtual void onClientConnected(ClientId /*client*/) {}
+    virtual void onFrameRequest(ClientId /*client*/, const FrameRequest& /*request*/) {}
+    virtual void onKeyFrameRequest(ClientId /*client*/, const KeyFrameRequest& /*request*/) {}
+    virtual void onClientGone(ClientId /*client*/) {}
+};
+
+struct ServerStats {
+    uint64_t connections = 0;
+    uint64_t clients_accepted = 0;
+    uint64_t auth_failures = 0;
+    uint64_t handshake_timeouts = 0;
+    uint64_t refused_full = 0;
+    uint64_t protocol_errors = 0;  // wrong message for the state, or a broken stream
+    DropCounters control_drops;
+    uint64_t frame_requests = 0;
+    uint64_t key_frame_requests = 0;
+    uint64_t acks = 0;
+    uint64_t streams_sent = 0;
+    uint64_t streams_rejected = 0;  // per-client media queue full or client gone
+    uint64_t packets_sent = 0;
+    uint64_t packets_send_failed = 0;  // the socket buffer was full
+};
+
+class Server {
+public:
+    static Expected<std::unique_ptr<Server>> start(ServerOptions options, ServerHandler& handler);
+    ~Server();
+    Server(const Server&) = delete;
+    Server& operator=(const Server&) = delete;
+
+    // Closes every connection at once (clients see the connection end) and joins the thread.
+    void stop();
+    uint16_t port() const;
+    uint16_t mediaPort() const;
+
+    // Thread-safe. Queues one layer's encoded frame for a client; fails without blocking when
+    // the client is gone or its queue is full. 0 < bytes ≤ kMaxStreamFrameBytes.
+    Status sendStream(ClientId client, uint32_t frame_id, uint8_t stream_id, bool key_frame,
+                      std::vector<uint8_t> bytes);
+
+    ServerStats stats() const;
+    std::vector<ClientId> clients() const;
+    // The ack-based estimate for one client (0 before the first sample or for unknown ids).
+    double throughputBps(ClientId client) const;
+    LinkStats linkStats(ClientId client) const;
+
+    struct Impl;
+
+private:
+    explicit Server(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace qvr::net

@@ -1,0 +1,108 @@
+// Reassembles the headset's four media streams from datagrams: a stream's frame is complete
+// when all its packets arrived; loss shows as a gap in the per-stream sequence numbers or a
+// frame left incomplete past a reorder window or a timeout. After a loss the stream waits for
+// a key frame (§3.2's streams are inter-coded video), which the client requests.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <vector>
+
+#include "qvr/net/protocol.h"
+
+namespace qvr::net {
+
+struct AssemblerLimits {
+    int max_partial_frames_per_stream = 8;
+    int64_t max_buffered_bytes = 64 << 20;   // all partial frames of all streams
+    uint32_t reorder_window_packets = 32;    // a frame is lost once seq passed its end by this
+    int64_t frame_timeout_ns = 250'000'000;  // or once it saw no packet for this long
+};
+
+struct CompletedStream {
+    uint32_t frame_id = 0;
+    uint8_t stream_id = 0;
+    bool key_frame = false;
+    bool decodable = false;  // a key frame, or no loss on this stream since the last key frame
+    std::vector<uint8_t> bytes;
+    uint16_t packets = 0;
+    int64_t first_rx_ns = 0;
+    int64_t last_rx_ns = 0;
+};
+
+struct LostStream {
+    uint32_t frame_id = 0;
+    uint8_t stream_id = 0;
+    uint16_t packets_received = 0;
+    uint16_t packet_count = 0;
+    uint32_t bytes_received = 0;
+    int64_t first_rx_ns = 0;
+    int64_t last_rx_ns = 0;
+};
+
+struct AssemblerStats {
+    uint64_t packets_accepted = 0;
+    uint64_t packets_duplicate = 0;
+    uint64_t packets_late = 0;          // for a frame already completed or declared lost
+    uint64_t packets_inconsistent = 0;  // disagrees with earlier packets of its frame
+    uint64_t packets_over_budget = 0;
+    uint64_t seq_gap_packets = 0;  // packets presumed lost from sequence gaps
+    uint64_t streams_completed = 0;
+    uint64_t streams_lost = 0;
+    uint64_t streams_undecodable = 0;  // completed while waiting for a key frame
+};
+
+class StreamAssembler {
+public:
+    explicit StreamAssembler(AssemblerLimits limits = {});
+
+    // A packet that decodeMediaPacket accepted and whose session was checked.
+    void onPacket(const MediaPacketView& packet, int64_t now_ns);
+    // Declares frames that saw no packet for frame_timeout_ns lost.
+    void expire(int64_t now_ns);
+
+    std::vector<CompletedStream> takeCompleted();
+    std::vector<LostStream> takeLost();
+    // Streams on which a loss was newly detected since the last call (bit s = stream s).
+    uint8_t takeLossMask();
+    bool awaitingKeyFrame(uint8_t stream_id) const { return m_streams[stream_id].awaiting_key; }
+    const AssemblerStats& stats() const { return m_stats; }
+    int64_t bufferedBytes() const { return m_buffered_bytes; }
+
+private:
+    struct Partial {
+        bool key_frame = false;
+        uint16_t packet_count = 0;
+        uint32_t frame_bytes = 0;
+        uint32_t last_seq = 0;
+        uint16_t received = 0;
+        uint32_t bytes_received = 0;
+        int64_t first_rx_ns = 0;
+        int64_t last_rx_ns = 0;
+        std::vector<uint8_t> bytes;
+        std::vector<bool> have;
+    };
+    struct Stream {
+        bool has_seq = false;
+        uint32_t next_seq = 0;
+        bool awaiting_key = true;  // the first decodable frame is a key frame
+        std::map<uint32_t, Partial> partials;
+        std::deque<uint32_t> finished;  // recently completed or lost frame ids
+    };
+
+    void finish(uint8_t stream_id, uint32_t frame_id);
+    void declareLost(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
+    bool isFinished(const Stream& s, uint32_t frame_id) const;
+
+    AssemblerLimits m_limits;
+    std::array<Stream, kMaxStreams> m_streams;
+    int64_t m_buffered_bytes = 0;
+    std::vector<CompletedStream> m_completed;
+    std::vector<LostStream> m_lost;
+    uint8_t m_loss_mask = 0;
+    AssemblerStats m_stats;
+};
+
+}  // namespace qvr::net

@@ -1,0 +1,534 @@
+// Client transport: a connection is an io_context with its TCP and UDP sockets; the handshake
+// runs on the caller's thread with a deadline, then a network thread serves the connection
+// until it fails or the caller disconnects.
+#include "qvr/net/client.h"
+
+#include <asio.hpp>
+#include <condition_variable>
+#include <deque>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include "control_io.h"
+#include "qvr/net/clock.h"
+
+namespace qvr::net {
+namespace {
+
+using asio::ip::tcp;
+using asio::ip::udp;
+
+void add(AssemblerStats& a, const AssemblerStats& b) {
+    a.packets_accepted += b.packets_accepted;
+    a.packets_duplicate += b.packets_duplicate;
+    a.packets_late += b.packets_late;
+    a.packets_inconsistent += b.packets_inconsistent;
+    a.packets_over_budget += b.packets_over_budget;
+    a.seq_gap_packets += b.seq_gap_packets;
+    a.streams_completed += b.streams_completed;
+    a.streams_lost += b.streams_lost;
+    a.streams_undecodable += b.streams_undecodable;
+}
+
+const char* byeText(ByeReason r) {
+    switch (r) {
+        case ByeReason::kNormal:
+            return "closed the session";
+        case ByeReason::kAuthFailed:
+            return "refused the pre-shared key";
+        case ByeReason::kProtocolError:
+            return "reported a protocol error";
+        case ByeReason::kServerFull:
+            return "is full";
+        case ByeReason::kTimeout:
+            return "timed out the handshake";
+    }
+    return "said bye";
+}
+
+}  // namespace
+
+struct Connection {
+    explicit Connection(const ClientOptions& o)
+        : writer(o.max_control_queue), expire_timer(io), assembler(o.assembler) {
+        last_key_request_ns.fill(std::numeric_limits<int64_t>::min() / 2);
+    }
+    asio::io_context io;
+    tcp::socket control{io};
+    udp::socket media{io};
+    detail::ControlReader reader;
+    detail::ControlWriter writer;
+    asio::steady_timer expire_timer;
+    StreamAssembler assembler;
+    uint64_t session_id = 0;
+    // One byte more than the largest valid datagram, so an oversized one is seen as such
+    // (the kernel truncates to the buffer) instead of passing as a maximal one.
+    std::array<uint8_t, kMaxDatagramBytes + 1> datagram{};
+    std::array<int64_t, kMaxStreams> last_key_request_ns{};
+    std::thread thread;
+    bool closed = false;
+};
+
+struct Client::Impl {
+    explicit Impl(ClientOptions o) : options(std::move(o)) {}
+
+    Status handshake(Connection& c, const std::string& host, uint16_t port);
+    void startLoops(Connection& c);
+    void readControl(Connection& c);
+    void readMedia(Connection& c);
+    void armExpiry(Connection& c);
+    void handleAssembler(Connection& c, int64_t now_ns);
+    void sendControl(Connection& c, const ControlMessage& m);
+    void fail(Connection& c, Status reason);
+
+    ClientOptions options;
+    std::unique_ptr<Connection> conn;  // owned and replaced by the caller's thread only
+
+    mutable std::mutex mutex;  // guards everything below
+    std::condition_variable cv;
+    std::deque<CompletedStream> ready;
+    bool connected = false;
+    Status last_error = makeError("never connected");
+    ClientStats stats;
+    AssemblerStats closed_assembler;  // from connections that ended
+    AssemblerStats live_assembler;
+    double throughput_bps = 0.0;
+};
+
+Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t port) {
+    struct State {
+        bool done = false;
+        Status result;
+    } st;
+    const auto finish = [&st](Status s) {
+        if (!st.done) {
+            st.done = true;
+            st.result = std::move(s);
+        }
+    };
+    const std::string where = host + ":" + std::to_string(port);
+
+    asio::error_code ec;
+    tcp::resolver resolver(c.io);
+    const auto endpoints = resolver.resolve(host, std::to_string(port), ec);
+    if (ec) {
+        return makeError("connect " + where + ": cannot resolve: " + ec.message());
+    }
+    const Nonce client_nonce = randomNonce();
+    ServerChallenge challenge;
+
+    asio::async_connect(
+        c.control, endpoints, [&](const asio::error_code& cec, const tcp::endpoint&) {
+            if (cec) {
+                finish(makeError("connect " + where + ": " + cec.message()));
+                return;
+            }
+            asio::error_code e;
+            c.control.set_option(tcp::no_delay(true), e);
+            // Media arrives on the local address the control connection uses.
+            const auto local = c.control.local_endpoint(e);
+            c.media.open(local.protocol() == tcp::v4() ? udp::v4() : udp::v6(), e);
+            if (!e) {
+                c.media.bind(udp::endpoint(local.address(), 0), e);
+            }
+            if (!e) {
+                c.media.set_option(asio::socket_base::receive_buffer_size(4 << 20), e);
+                e.clear();
+            }
+            if (e) {
+                finish(makeError("connect " + where +
+                                 ": cannot open the media socket: " + e.message()));
+                return;
+            }
+            const uint16_t media_port = c.media.local_endpoint(e).port();
+            const auto fail_write = [&, where](const asio::error_code& we) {
+                finish(makeError("connect " + where + ": " + we.message()));
+            };
+            c.writer.push(c.control, encodeControl(ClientHello{client_nonce, media_port}),
+                          fail_write);
+            c.reader.read(c.control, [&, media_port, fail_write](detail::ReadResult r) {
+                if (r.ec || r.error != WireError::kNone) {
+                    finish(makeError("connect " + where + ": no valid challenge from the server (" +
+                                     (r.ec ? r.ec.message() : std::string(wireErrorName(r.error))) +
+                                     ")"));
+                    return;
+                }
+                if (const auto* bye = std::get_if<Bye>(&r.message)) {
+                    finish(makeError("connect " + where + ": the server " + byeText(bye->reason)));
+                    return;
+                }
+                const auto* ch = std::get_if<ServerChallenge>(&r.message);
+                if (!ch) {
+                    finish(makeError("connect " + where + ": unexpected message in the handshake"));
+                    return;
+                }
+                challenge = *ch;
+                const Mac expected = serverProof(options.key, client_nonce, challenge.server_nonce,
+                                                 challenge.session_id);
+                if (!macEqual(expected, challenge.server_proof)) {
+                    {
+                        std::lock_guard lock(mutex);
+                        ++stats.server_proof_failures;
+                        stats.control_drops.count(WireError::kBadMac);
+                    }
+                    finish(makeError("connect " + where +
+                                     ": the server does not hold the pre-shared key"));
+                    return;
+                }
+                c.writer.push(c.control,
+                              encodeControl(ClientAuth{
+                                  clientProof(options.key, client_nonce, challenge.server_nonce,
+                                              challenge.session_id, media_port)}),
+                              fail_write);
+                c.reader.read(c.control, [&](detail::ReadResult w) {
+                    if (w.ec) {
+                        finish(makeError("connect " + where +
+                                         ": the server closed the connection (" + w.ec.message() +
+                                         ")"));
+                        return;
+                    }
+                    if (const auto* bye = std::get_if<Bye>(&w.message)) {
+                        finish(
+                            makeError("connect " + where + ": the server " + byeText(bye->reason)));
+                        return;
+                    }
+                    const auto* welcome = std::get_if<Welcome>(&w.message);
+                    if (w.error != WireError::kNone || !welcome ||
+                        welcome->session_id != challenge.session_id) {
+                        finish(
+                            makeError("connect " + where + ": no valid welcome from the server"));
+                        return;
+                    }
+                    asio::error_code ue;
+                    // Only the server's media socket may feed ours.
+                    c.media.connect(
+                        udp::endpoint(c.control.remote_endpoint(ue).address(), welcome->media_port),
+                        ue);
+                    if (ue) {
+                        finish(makeError("connect " + where + ": " + ue.message()));
+                        return;
+                    }
+                    c.session_id = welcome->session_id;
+                    finish(Status::success());
+                });
+            });
+        });
+
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(options.connect_timeout_ms);
+    while (!st.done && !c.io.stopped()) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now >= deadline) {
+            break;
+        }
+        c.io.run_for(deadline - now);
+    }
+    if (!st.done) {
+        finish(makeError("connect " + where + ": timed out after " +
+                         std::to_string(options.connect_timeout_ms) + " ms"));
+    }
+    if (!st.result.ok()) {
+        // Cancel what is in flight and let the handlers see it before the state goes away.
+        c.control.close(ec);
+        c.media.close(ec);
+        c.io.restart();
+        c.io.run();
+    }
+    return st.result;
+}
+
+void Client::Impl::fail(Connection& c, Status reason) {
+    if (c.closed) {
+        return;
+    }
+    c.closed = true;
+    asio::error_code ec;
+    c.expire_timer.cancel();
+    c.control.shutdown(tcp::socket::shutdown_both, ec);
+    c.control.close(ec);
+    c.media.close(ec);
+    c.writer.clear();
+    {
+        std::lock_guard lock(mutex);
+        connected = false;
+        last_error = std::move(reason);
+        ++stats.disconnects;
+        add(closed_assembler, c.assembler.stats());
+        live_assembler = {};
+    }
+    cv.notify_all();
+}
+
+void Client::Impl::sendControl(Connection& c, const ControlMessage& m) {
+    if (c.closed) {
+        return;
+    }
+    Connection* cp = &c;
+    const bool queued =
+        c.writer.push(c.control, encodeControl(m), [this, cp](const asio::error_code& e) {
+            fail(*cp, makeError("connection to the server lost: " + e.message()));
+        });
+    if (!queued) {
+        fail(c, makeError("the server stopped reading control messages"));
+    }
+}
+
+void Client::Impl::readControl(Connection& c) {
+    c.reader.read(c.control, [this, &c](detail::ReadResult r) {
+        if (c.closed) {
+            return;
+        }
+        if (r.ec) {
+            fail(c, makeError("connection to the server lost: " + r.ec.message()));
+            return;
+        }
+        if (r.error != WireError::kNone) {
+            {
+                std::lock_guard lock(mutex);
+                stats.control_drops.count(r.error);
+            }
+            if (r.stream_broken) {
+                fail(c, makeError(std::string("protocol error from the server: ") +
+                                  std::string(wireErrorName(r.error))));
+                return;
+            }
+        } else if (const auto* report = std::get_if<ThroughputReport>(&r.message)) {
+            std::lock_guard lock(mutex);
+            throughput_bps = static_cast<double>(report->throughput_bps);
+        } else if (const auto* bye = std::get_if<Bye>(&r.message)) {
+            fail(c, makeError(std::string("the server ") + byeText(bye->reason)));
+            return;
+        }
+        readControl(c);
+    });
+}
+
+void Client::Impl::readMedia(Connection& c) {
+    c.media.async_receive(asio::buffer(c.datagram), [this, &c](const asio::error_code& ec,
+                                                               size_t n) {
+        if (c.closed || ec == asio::error::operation_aborted) {
+            return;
+        }
+        // Other errors (an ICMP unreachable from an earlier send) do not end the session; the
+        // control connection is what says the server is gone.
+        if (!ec) {
+            const int64_t now_ns = SteadyClock::instance().nowNs();
+            MediaPacketView view;
+            WireError e = decodeMediaPacket(std::span<const uint8_t>(c.datagram.data(), n), view);
+            if (e == WireError::kNone && view.header.session_id != c.session_id) {
+                e = WireError::kWrongSession;
+            }
+            if (e != WireError::kNone) {
+                std::lock_guard lock(mutex);
+                stats.media_drops.count(e);
+            } else {
+                c.assembler.onPacket(view, now_ns);
+                handleAssembler(c, now_ns);
+            }
+        }
+        readMedia(c);
+    });
+}
+
+void Client::Impl::armExpiry(Connection& c) {
+    c.expire_timer.expires_after(std::chrono::milliseconds(20));
+    c.expire_timer.async_wait([this, &c](const asio::error_code& ec) {
+        if (ec || c.closed) {
+            return;
+        }
+        const int64_t now_ns = SteadyClock::instance().nowNs();
+        c.assembler.expire(now_ns);
+        handleAssembler(c, now_ns);
+        armExpiry(c);
+    });
+}
+
+void Client::Impl::handleAssembler(Connection& c, int64_t now_ns) {
+    uint8_t need_key = c.assembler.takeLossMask();
+    uint32_t trigger_frame = 0;
+    std::vector<MediaAck> acks;
+    for (const LostStream& l : c.assembler.takeLost()) {
+        acks.push_back({l.frame_id, l.stream_id, false, l.packets_received, l.bytes_received,
+                        static_cast<uint64_t>(l.first_rx_ns), static_cast<uint64_t>(l.last_rx_ns)});
+        trigger_frame = l.frame_id;
+    }
+    auto completed = c.assembler.takeCompleted();
+    for (const CompletedStream& s : completed) {
+        acks.push_back({s.frame_id, s.stream_id, true, s.packets,
+                        static_cast<uint32_t>(s.bytes.size()), static_cast<uint64_t>(s.first_rx_ns),
+                        static_cast<uint64_t>(s.last_rx_ns)});
+        if (!s.decodable) {
+            // Still waiting for the key frame: the request or the key frame itself was lost.
+            need_key |= static_cast<uint8_t>(1u << s.stream_id);
+            trigger_frame = s.frame_id;
+        }
+    }
+    for (const MediaAck& a : acks) {
+        sendControl(c, a);
+    }
+    // Rate-limit per stream: a request is in flight for key_frame_retry_ms.
+    uint8_t mask = 0;
+    const int64_t retry_ns = static_cast<int64_t>(options.key_frame_retry_ms) * 1'000'000;
+    for (int s = 0; s < kMaxStreams; ++s) {
+        if ((need_key >> s & 1) &&
+            now_ns - c.last_key_request_ns[static_cast<size_t>(s)] >= retry_ns) {
+            mask |= static_cast<uint8_t>(1u << s);
+            c.last_key_request_ns[static_cast<size_t>(s)] = now_ns;
+        }
+    }
+    if (mask != 0) {
+        sendControl(c, KeyFrameRequest{mask, trigger_frame, KeyFrameReason::kPacketLoss});
+    }
+    std::lock_guard lock(mutex);
+    stats.acks_sent += acks.size();
+    stats.key_frame_requests_sent += mask != 0 ? 1 : 0;
+    live_assembler = c.assembler.stats();
+    for (CompletedStream& s : completed) {
+        if (ready.size() >= options.max_ready_streams) {
+            ready.pop_front();  // the newest frames matter most to a display
+            ++stats.ready_streams_dropped;
+        }
+        ready.push_back(std::move(s));
+    }
+    if (!completed.empty()) {
+        cv.notify_all();
+    }
+}
+
+void Client::Impl::startLoops(Connection& c) {
+    readControl(c);
+    readMedia(c);
+    armExpiry(c);
+}
+
+Client::Client(ClientOptions options) : m_impl(std::make_unique<Impl>(std::move(options))) {}
+
+Client::~Client() {
+    disconnect();
+}
+
+Status Client::connect(const std::string& host, uint16_t port) {
+    disconnect();
+    Impl& impl = *m_impl;
+    auto c = std::make_unique<Connection>(impl.options);
+    Status s = impl.handshake(*c, host, port);
+    if (!s.ok()) {
+        std::lock_guard lock(impl.mutex);
+        ++impl.stats.connect_failures;
+        impl.last_error = s;
+        return s;
+    }
+    {
+        std::lock_guard lock(impl.mutex);
+        ++impl.stats.connects;
+        impl.connected = true;
+        impl.last_error = Status::success();
+        impl.throughput_bps = 0.0;
+        impl.ready.clear();
+    }
+    Connection* cp = c.get();
+    c->io.restart();
+    impl.startLoops(*cp);
+    c->thread = std::thread([cp] { cp->io.run(); });
+    impl.conn = std::move(c);
+    return Status::success();
+}
+
+void Client::disconnect() {
+    Impl& impl = *m_impl;
+    if (!impl.conn) {
+        return;
+    }
+    Connection* c = impl.conn.get();
+    asio::post(c->io, [&impl, c] {
+        if (!c->closed) {
+            // Say goodbye if the socket takes it at once; the server also copes without.
+            const auto bye = encodeControl(Bye{ByeReason::kNormal});
+            asio::error_code ec;
+            c->control.non_blocking(true, ec);
+            asio::write(c->control, asio::buffer(bye), ec);
+        }
+        impl.fail(*c, makeError("disconnected by the caller"));
+    });
+    if (c->thread.joinable()) {
+        c->thread.join();
+    }
+    impl.conn.reset();
+}
+
+bool Client::connected() const {
+    std::lock_guard lock(m_impl->mutex);
+    return m_impl->connected;
+}
+
+Status Client::lastError() const {
+    std::lock_guard lock(m_impl->mutex);
+    return m_impl->last_error;
+}
+
+Status Client::sendFrameRequest(const FrameRequest& request) {
+    Impl& impl = *m_impl;
+    {
+        std::lock_guard lock(impl.mutex);
+        if (!impl.connected || !impl.conn) {
+            return makeError("not connected: " + impl.last_error.error());
+        }
+        ++impl.stats.frame_requests_sent;
+    }
+    Connection* c = impl.conn.get();
+    asio::post(c->io, [&impl, c, request] { impl.sendControl(*c, request); });
+    return Status::success();
+}
+
+Status Client::requestKeyFrame(uint8_t stream_mask, uint32_t frame_id, KeyFrameReason reason) {
+    Impl& impl = *m_impl;
+    if (stream_mask == 0 || stream_mask >= (1u << kMaxStreams)) {
+        return makeError("requestKeyFrame: stream mask must name streams 0.." +
+                         std::to_string(kMaxStreams - 1));
+    }
+    {
+        std::lock_guard lock(impl.mutex);
+        if (!impl.connected || !impl.conn) {
+            return makeError("not connected: " + impl.last_error.error());
+        }
+        ++impl.stats.key_frame_requests_sent;
+    }
+    Connection* c = impl.conn.get();
+    asio::post(c->io, [&impl, c, stream_mask, frame_id, reason] {
+        impl.sendControl(*c, KeyFrameRequest{stream_mask, frame_id, reason});
+    });
+    return Status::success();
+}
+
+Expected<std::optional<CompletedStream>> Client::nextStream(int timeout_ms) {
+    Impl& impl = *m_impl;
+    std::unique_lock lock(impl.mutex);
+    impl.cv.wait_for(lock, std::chrono::milliseconds(timeout_ms),
+                     [&] { return !impl.ready.empty() || !impl.connected; });
+    if (!impl.ready.empty()) {
+        CompletedStream s = std::move(impl.ready.front());
+        impl.ready.pop_front();
+        return std::optional<CompletedStream>(std::move(s));
+    }
+    if (!impl.connected) {
+        return makeError(impl.last_error.ok() ? std::string("not connected")
+                                              : impl.last_error.error());
+    }
+    return std::optional<CompletedStream>();
+}
+
+double Client::throughputBps() const {
+    std::lock_guard lock(m_impl->mutex);
+    return m_impl->throughput_bps;
+}
+
+ClientStats Client::stats() const {
+    std::lock_guard lock(m_impl->mutex);
+    ClientStats s = m_impl->stats;
+    s.assembler = m_impl->closed_assembler;
+    add(s.assembler, m_impl->live_assembler);
+    return s;
+}
+
+}  // namespace qvr::net

@@ -1,0 +1,118 @@
+// Reading and writing control messages on a TCP stream with asio: the header is checked before
+// the payload is read, and the payload lands in a fixed buffer of the protocol's maximum size,
+// so no length a peer sends ever decides an allocation.
+#pragma once
+
+#include <asio.hpp>
+#include <deque>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "qvr/net/protocol.h"
+
+namespace qvr::net::detail {
+
+struct ReadResult {
+    asio::error_code ec;  // the socket failed or closed
+    WireError error = WireError::kNone;
+    bool stream_broken = false;  // a bad header: the byte stream cannot be re-synchronised
+    ControlMessage message;
+};
+
+class ControlReader {
+public:
+    // handler(ReadResult). The reader and socket must outlive the operation.
+    template <typename Handler>
+    void read(asio::ip::tcp::socket& socket, Handler handler) {
+        asio::async_read(socket, asio::buffer(m_header),
+                         [this, &socket, handler = std::move(handler)](const asio::error_code& ec,
+                                                                       size_t) mutable {
+                             if (ec) {
+                                 handler(ReadResult{ec, WireError::kNone, true, {}});
+                                 return;
+                             }
+                             ControlHeader header;
+                             const WireError e = decodeControlHeader(m_header, header);
+                             if (e != WireError::kNone) {
+                                 handler(ReadResult{{}, e, true, {}});
+                                 return;
+                             }
+                             readPayload(socket, header, std::move(handler));
+                         });
+    }
+
+private:
+    template <typename Handler>
+    void readPayload(asio::ip::tcp::socket& socket, ControlHeader header, Handler handler) {
+        // decodeControlHeader bounded payload_bytes by kMaxControlPayloadBytes.
+        asio::async_read(socket, asio::buffer(m_payload.data(), header.payload_bytes),
+                         [this, header, handler = std::move(handler)](const asio::error_code& ec,
+                                                                      size_t) mutable {
+                             if (ec) {
+                                 handler(ReadResult{ec, WireError::kNone, true, {}});
+                                 return;
+                             }
+                             ReadResult r;
+                             r.error = decodeControlPayload(
+                                 header.type,
+                                 std::span<const uint8_t>(m_payload.data(), header.payload_bytes),
+                                 r.message);
+                             handler(std::move(r));
+                         });
+    }
+
+    std::array<uint8_t, kControlHeaderBytes> m_header{};
+    std::array<uint8_t, kMaxControlPayloadBytes> m_payload{};
+};
+
+// A bounded queue of outgoing messages with one write in flight at a time.
+class ControlWriter {
+public:
+    explicit ControlWriter(size_t max_queued) : m_max_queued(max_queued) {}
+
+    // False when the queue is full (the peer stopped reading). on_error(ec) runs on failure.
+    template <typename OnError>
+    bool push(asio::ip::tcp::socket& socket, std::vector<uint8_t> bytes, OnError on_error) {
+        if (m_queue.size() >= m_max_queued) {
+            return false;
+        }
+        m_queue.push_back(std::move(bytes));
+        if (!m_busy) {
+            writeNext(socket, std::move(on_error));
+        }
+        return true;
+    }
+    void clear() {
+        m_queue.clear();
+        m_busy = false;
+    }
+
+private:
+    template <typename OnError>
+    void writeNext(asio::ip::tcp::socket& socket, OnError on_error) {
+        if (m_queue.empty()) {
+            m_busy = false;
+            return;
+        }
+        m_busy = true;
+        asio::async_write(socket, asio::buffer(m_queue.front()),
+                          [this, &socket, on_error](const asio::error_code& ec, size_t) mutable {
+                              if (ec) {
+                                  m_busy = false;
+                                  on_error(ec);
+                                  return;
+                              }
+                              if (!m_queue.empty()) {
+                                  m_queue.pop_front();
+                              }
+                              writeNext(socket, std::move(on_error));
+                          });
+    }
+
+    size_t m_max_queued;
+    std::deque<std::vector<uint8_t>> m_queue;
+    bool m_busy = false;
+};
+
+}  // namespace qvr::net::detail

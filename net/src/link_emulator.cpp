@@ -1,0 +1,257 @@
+// Link emulator: bottleneck queue (rate or Mahimahi opportunities) + delay line + loss.
+#include "qvr/net/link_emulator.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+#include "qvr/core/check.h"
+
+namespace qvr::net {
+namespace {
+
+bool parseDouble(std::string_view s, double& out) {
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && p == s.data() + s.size() && std::isfinite(out);
+}
+
+bool parseU64(std::string_view s, uint64_t& out) {
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && p == s.data() + s.size();
+}
+
+}  // namespace
+
+const std::vector<std::string>& linkProfileNames() {
+    static const std::vector<std::string> names{"none", "wifi", "lte", "5g"};
+    return names;
+}
+
+Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
+    std::vector<std::string_view> parts;
+    std::string_view rest = spec;
+    while (true) {
+        const size_t comma = rest.find(',');
+        parts.push_back(rest.substr(0, comma));
+        if (comma == std::string_view::npos) {
+            break;
+        }
+        rest.remove_prefix(comma + 1);
+    }
+    LinkConfig c;
+    const std::string_view profile = parts[0];
+    c.name = std::string(profile);
+    if (profile == "none") {
+    } else if (profile == "wifi") {
+        c.rate_bps = 200e6;
+    } else if (profile == "lte") {
+        c.rate_bps = 100e6;
+    } else if (profile == "5g") {
+        c.rate_bps = 500e6;
+    } else if (profile.starts_with("rate:")) {
+        double mbps = 0;
+        if (!parseDouble(profile.substr(5), mbps) || mbps <= 0 || mbps > 1e6) {
+            return makeError("link '" + spec + "': rate:MBPS needs a rate in (0, 1e6] Mbit/s");
+        }
+        c.rate_bps = mbps * 1e6;
+    } else if (profile.starts_with("trace:")) {
+        std::string_view path = profile.substr(6);
+        const size_t at = path.rfind('@');
+        if (at != std::string_view::npos) {
+            double mbps = 0;
+            if (!parseDouble(path.substr(at + 1), mbps) || mbps <= 0 || mbps > 1e6) {
+                return makeError("link '" + spec + "': trace:PATH@MBPS needs a mean in (0, 1e6]");
+            }
+            c.trace_target_bps = mbps * 1e6;
+            path = path.substr(0, at);
+        }
+        auto trace = loadMahimahiTrace(std::string(path));
+        if (!trace) {
+            return makeError(trace.error());
+        }
+        c.trace = std::make_shared<const MahimahiTrace>(std::move(trace).value());
+    } else {
+        return makeError("link '" + spec +
+                         "': unknown profile (none, wifi, lte, 5g, rate:MBPS, trace:PATH[@MBPS])");
+    }
+    for (size_t i = 1; i < parts.size(); ++i) {
+        const size_t eq = parts[i].find('=');
+        if (eq == std::string_view::npos) {
+            return makeError("link '" + spec + "': option '" + std::string(parts[i]) +
+                             "' is not key=value");
+        }
+        const std::string_view key = parts[i].substr(0, eq);
+        const std::string_view value = parts[i].substr(eq + 1);
+        double v = 0;
+        uint64_t u = 0;
+        const auto bad = [&](const char* what) {
+            return makeError("link '" + spec + "': " + std::string(key) + " " + what);
+        };
+        if (key == "delay_ms" || key == "jitter_ms") {
+            if (!parseDouble(value, v) || v < 0 || v > 10'000) {
+                return bad("must be in [0, 10000] ms");
+            }
+            (key == "delay_ms" ? c.delay_ms : c.jitter_ms) = v;
+        } else if (key == "loss") {
+            if (!parseDouble(value, v) || v < 0 || v >= 1) {
+                return bad("must be a probability in [0, 1)");
+            }
+            c.loss = v;
+        } else if (key == "queue_kb") {
+            if (!parseU64(value, u) || u == 0 || u > (1u << 20)) {
+                return bad("must be in [1, 1048576] KiB");
+            }
+            c.queue_bytes = static_cast<int64_t>(u) * 1024;
+        } else if (key == "seed") {
+            if (!parseU64(value, u)) {
+                return bad("must be an unsigned integer");
+            }
+            c.seed = u;
+        } else {
+            return makeError("link '" + spec + "': unknown option '" + std::string(key) +
+                             "' (delay_ms, jitter_ms, loss, queue_kb, seed)");
+        }
+    }
+    return c;
+}
+
+LinkEmulator::LinkEmulator(LinkConfig config)
+    : m_config(std::move(config)),
+      m_loss_rng(m_config.seed * 0x9E3779B97F4A7C15ull + 1),
+      m_jitter_rng(m_config.seed * 0xBF58476D1CE4E5B9ull + 2) {
+    QVR_CHECK(m_config.rate_bps >= 0 && m_config.delay_ms >= 0 && m_config.jitter_ms >= 0);
+    QVR_CHECK(m_config.loss >= 0 && m_config.loss < 1 && m_config.queue_bytes > 0);
+    if (m_config.trace) {
+        QVR_CHECK(m_config.trace->period_ms > 0 && !m_config.trace->stamps_ms.empty());
+        // Dividing every stamp by target / mean compresses time so the mean becomes the target.
+        const double mean = m_config.trace->meanBps();
+        m_trace_ns_per_ms =
+            m_config.trace_target_bps > 0 ? 1e6 * mean / m_config.trace_target_bps : 1e6;
+        m_opp_left_bytes = kMahimahiPacketBytes;
+    }
+}
+
+double LinkEmulator::uniform01(std::mt19937_64& rng) {
+    // 53 random bits: the same sequence on every standard library, unlike the distributions.
+    return static_cast<double>(rng() >> 11) * 0x1.0p-53;
+}
+
+double LinkEmulator::opportunityNs(int64_t index) const {
+    const auto& stamps = m_config.trace->stamps_ms;
+    const int64_t n = static_cast<int64_t>(stamps.size());
+    const int64_t loop = index / n;
+    const double ms = static_cast<double>(stamps[static_cast<size_t>(index % n)]) +
+                      static_cast<double>(loop) * static_cast<double>(m_config.trace->period_ms);
+    return ms * m_trace_ns_per_ms;
+}
+
+int64_t LinkEmulator::firstOpportunityAtOrAfter(double t_ns) const {
+    const auto& stamps = m_config.trace->stamps_ms;
+    const int64_t n = static_cast<int64_t>(stamps.size());
+    const double period_ms = static_cast<double>(m_config.trace->period_ms);
+    const double t_ms = std::max(0.0, t_ns / m_trace_ns_per_ms);
+    int64_t loop = static_cast<int64_t>(std::floor(t_ms / period_ms));
+    int64_t index = loop * n;
+    // Within the loop, the first stamp whose time is not before t; rounding can put t a hair
+    // past the loop's last stamp, in which case the next loop's first stamp is it.
+    const double within = t_ms - static_cast<double>(loop) * period_ms;
+    const auto it = std::lower_bound(stamps.begin(), stamps.end(), within, [](int64_t s, double v) {
+        return static_cast<double>(s) < v;
+    });
+    index += static_cast<int64_t>(it - stamps.begin());
+    while (opportunityNs(index) < t_ns) {
+        ++index;
+    }
+    return index;
+}
+
+double LinkEmulator::departureNs(double start_ns, int64_t bytes) {
+    if (m_config.trace) {
+        if (opportunityNs(m_opp_index) < start_ns) {
+            // Opportunities that passed with nothing queued are lost, as in Mahimahi.
+            m_opp_index = firstOpportunityAtOrAfter(start_ns);
+            m_opp_left_bytes = kMahimahiPacketBytes;
+        }
+        int64_t remaining = bytes;
+        while (true) {
+            const int64_t take = std::min(remaining, m_opp_left_bytes);
+            remaining -= take;
+            m_opp_left_bytes -= take;
+            const double t = opportunityNs(m_opp_index);
+            if (m_opp_left_bytes == 0) {
+                ++m_opp_index;
+                m_opp_left_bytes = kMahimahiPacketBytes;
+            }
+            if (remaining == 0) {
+                return t;
+            }
+        }
+    }
+    if (m_config.rate_bps > 0) {
+        m_link_free_ns = std::max(start_ns, m_link_free_ns) +
+                         static_cast<double>(bytes) * 8.0 * 1e9 / m_config.rate_bps;
+        return m_link_free_ns;
+    }
+    return start_ns;
+}
+
+void LinkEmulator::drainQueue(int64_t now_ns) {
+    while (!m_queue.empty() && m_queue.front().departure_ns <= static_cast<double>(now_ns)) {
+        m_queue_bytes -= m_queue.front().bytes;
+        m_queue.pop_front();
+    }
+}
+
+int64_t LinkEmulator::queuedBytes(int64_t now_ns) {
+    drainQueue(now_ns);
+    return m_queue_bytes;
+}
+
+bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
+    const int64_t bytes = static_cast<int64_t>(packet.size());
+    ++m_stats.packets_in;
+    m_stats.bytes_in += static_cast<uint64_t>(bytes);
+    if (m_config.loss > 0 && uniform01(m_loss_rng) < m_config.loss) {
+        ++m_stats.dropped_loss;
+        return false;
+    }
+    drainQueue(now_ns);
+    if (m_queue_bytes + bytes > m_config.queue_bytes) {
+        ++m_stats.dropped_queue;
+        return false;
+    }
+    const double departure = departureNs(static_cast<double>(now_ns), bytes);
+    if (departure > static_cast<double>(now_ns)) {
+        m_queue.push_back({departure, bytes});
+        m_queue_bytes += bytes;
+    }
+    double delay_ns = m_config.delay_ms * 1e6;
+    if (m_config.jitter_ms > 0) {
+        delay_ns += (2.0 * uniform01(m_jitter_rng) - 1.0) * m_config.jitter_ms * 1e6;
+        delay_ns = std::max(0.0, delay_ns);
+    }
+    // Jitter never reorders: a packet leaves the delay line no earlier than the one before it.
+    const int64_t deliver_ns =
+        std::max(m_last_deliver_ns, static_cast<int64_t>(std::llround(departure + delay_ns)));
+    m_last_deliver_ns = deliver_ns;
+    m_flight.push_back({std::move(packet), deliver_ns});
+    return true;
+}
+
+void LinkEmulator::deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& out) {
+    while (!m_flight.empty() && m_flight.front().deliver_ns <= now_ns) {
+        ++m_stats.packets_delivered;
+        m_stats.bytes_delivered += m_flight.front().bytes.size();
+        out.push_back(std::move(m_flight.front().bytes));
+        m_flight.pop_front();
+    }
+}
+
+std::optional<int64_t> LinkEmulator::nextDeliveryNs() const {
+    if (m_flight.empty()) {
+        return std::nullopt;
+    }
+    return m_flight.front().deliver_ns;
+}
+
+}  // namespace qvr::net

@@ -1,0 +1,541 @@
+// Encoders and decoders of the control messages and media packets (docs/PROTOCOL.md). Decoders
+// read through ByteReader only, check every field's range, and allocate nothing.
+#include "qvr/net/protocol.h"
+
+#include <cmath>
+
+#include "bytes.h"
+#include "qvr/core/check.h"
+
+namespace qvr::net {
+namespace {
+
+using detail::ByteReader;
+using detail::ByteWriter;
+
+constexpr uint8_t kControlMagic0 = 'Q';
+constexpr uint8_t kControlMagic1 = 'C';
+constexpr uint8_t kMediaMagic0 = 'Q';
+constexpr uint8_t kMediaMagic1 = 'M';
+constexpr uint8_t kFlagKeyFrame = 0x01;
+
+constexpr size_t kLayerGeometryBytes = 4 * 4 + 4 + 4 + 4;  // rect, scale, width, height
+constexpr size_t kFrameRequestBytes = 4 + 8 + 7 * 4 + 2 * 4 + 4 * 4 + 2 * 3 * kLayerGeometryBytes;
+
+// The fixed payload size of each type; 0 for types this version does not define.
+size_t payloadBytesOf(ControlType type) {
+    switch (type) {
+        case ControlType::kClientHello:
+            return kNonceBytes + 2;
+        case ControlType::kServerChallenge:
+            return kNonceBytes + 8 + kMacBytes;
+        case ControlType::kClientAuth:
+            return kMacBytes;
+        case ControlType::kWelcome:
+            return 8 + 2;
+        case ControlType::kFrameRequest:
+            return kFrameRequestBytes;
+        case ControlType::kMediaAck:
+            return 4 + 1 + 1 + 2 + 4 + 8 + 8;
+        case ControlType::kKeyFrameRequest:
+            return 1 + 4 + 1;
+        case ControlType::kThroughputReport:
+            return 8 + 4;
+        case ControlType::kBye:
+            return 1;
+    }
+    return 0;
+}
+
+bool finiteIn(float v, float lo, float hi) {
+    return std::isfinite(v) && v >= lo && v <= hi;
+}
+
+void writeLayer(ByteWriter& w, const LayerGeometry& g) {
+    w.i32(g.rect.x0);
+    w.i32(g.rect.y0);
+    w.i32(g.rect.x1);
+    w.i32(g.rect.y1);
+    w.f32(g.scale);
+    w.i32(g.width_px);
+    w.i32(g.height_px);
+}
+
+bool readLayer(ByteReader& r, LayerGeometry& g) {
+    g.rect.x0 = r.i32();
+    g.rect.y0 = r.i32();
+    g.rect.x1 = r.i32();
+    g.rect.y1 = r.i32();
+    g.scale = r.f32();
+    g.width_px = r.i32();
+    g.height_px = r.i32();
+    const auto coord = [](int32_t v) { return v >= 0 && v <= kMaxImageExtentPx; };
+    return coord(g.rect.x0) && coord(g.rect.y0) && coord(g.rect.x1) && coord(g.rect.y1) &&
+           g.rect.x0 <= g.rect.x1 && g.rect.y0 <= g.rect.y1 && finiteIn(g.scale, 1.0f, 64.0f) &&
+           coord(g.width_px) && coord(g.height_px);
+}
+
+struct Encoder {
+    ByteWriter& w;
+    void operator()(const ClientHello& m) {
+        w.bytes(m.client_nonce);
+        w.u16(m.media_port);
+    }
+    void operator()(const ServerChallenge& m) {
+        w.bytes(m.server_nonce);
+        w.u64(m.session_id);
+        w.bytes(m.server_proof);
+    }
+    void operator()(const ClientAuth& m) { w.bytes(m.client_proof); }
+    void operator()(const Welcome& m) {
+        w.u64(m.session_id);
+        w.u16(m.media_port);
+    }
+    void operator()(const FrameRequest& m) {
+        w.u32(m.frame_id);
+        w.u64(m.client_send_ns);
+        w.f32(m.pose.orientation.w);
+        w.f32(m.pose.orientation.x);
+        w.f32(m.pose.orientation.y);
+        w.f32(m.pose.orientation.z);
+        w.f32(m.pose.position_m.x);
+        w.f32(m.pose.position_m.y);
+        w.f32(m.pose.position_m.z);
+        w.f32(static_cast<float>(m.gaze.x_deg));
+        w.f32(static_cast<float>(m.gaze.y_deg));
+        w.f32(m.e1_deg);
+        w.f32(m.e2_deg);
+        w.f32(m.s1);
+        w.f32(m.s2);
+        for (const EyeGeometryWire& eye : m.eyes) {
+            writeLayer(w, eye.fovea);
+            writeLayer(w, eye.middle);
+            writeLayer(w, eye.outer);
+        }
+    }
+    void operator()(const MediaAck& m) {
+        w.u32(m.frame_id);
+        w.u8(m.stream_id);
+        w.u8(m.complete ? 1 : 0);
+        w.u16(m.packets_received);
+        w.u32(m.bytes_received);
+        w.u64(m.first_rx_ns);
+        w.u64(m.last_rx_ns);
+    }
+    void operator()(const KeyFrameRequest& m) {
+        w.u8(m.stream_mask);
+        w.u32(m.last_frame_id);
+        w.u8(static_cast<uint8_t>(m.reason));
+    }
+    void operator()(const ThroughputReport& m) {
+        w.u64(m.throughput_bps);
+        w.u32(m.samples);
+    }
+    void operator()(const Bye& m) { w.u8(static_cast<uint8_t>(m.reason)); }
+};
+
+ControlType typeOf(const ControlMessage& m) {
+    return static_cast<ControlType>(m.index() + 1);  // the variant lists the types in id order
+}
+
+WireError decodeFrameRequest(ByteReader& r, FrameRequest& m) {
+    m.frame_id = r.u32();
+    m.client_send_ns = r.u64();
+    const float qw = r.f32(), qx = r.f32(), qy = r.f32(), qz = r.f32();
+    const float px = r.f32(), py = r.f32(), pz = r.f32();
+    const float gx = r.f32(), gy = r.f32();
+    m.e1_deg = r.f32();
+    m.e2_deg = r.f32();
+    m.s1 = r.f32();
+    m.s2 = r.f32();
+    bool layers_ok = true;
+    for (EyeGeometryWire& eye : m.eyes) {
+        layers_ok = readLayer(r, eye.fovea) && layers_ok;
+        layers_ok = readLayer(r, eye.middle) && layers_ok;
+        layers_ok = readLayer(r, eye.outer) && layers_ok;
+    }
+    if (!r.ok()) {
+        return WireError::kTruncated;
+    }
+    const bool quat_ok = finiteIn(qw, -1.01f, 1.01f) && finiteIn(qx, -1.01f, 1.01f) &&
+                         finiteIn(qy, -1.01f, 1.01f) && finiteIn(qz, -1.01f, 1.01f) &&
+                         std::fabs(qw * qw + qx * qx + qy * qy + qz * qz - 1.0f) < 0.01f;
+    const bool pos_ok =
+        finiteIn(px, -1e4f, 1e4f) && finiteIn(py, -1e4f, 1e4f) && finiteIn(pz, -1e4f, 1e4f);
+    const bool plan_ok = finiteIn(gx, -90.0f, 90.0f) && finiteIn(gy, -90.0f, 90.0f) &&
+                         finiteIn(m.e1_deg, 0.0f, 180.0f) && finiteIn(m.e2_deg, m.e1_deg, 180.0f) &&
+                         finiteIn(m.s1, 1.0f, 64.0f) && finiteIn(m.s2, 1.0f, 64.0f);
+    if (!quat_ok || !pos_ok || !plan_ok || !layers_ok) {
+        return WireError::kBadField;
+    }
+    m.pose.orientation = glm::quat(qw, qx, qy, qz);
+    m.pose.position_m = glm::vec3(px, py, pz);
+    m.gaze = Gaze{gx, gy};
+    return WireError::kNone;
+}
+
+}  // namespace
+
+std::string_view wireErrorName(WireError e) {
+    switch (e) {
+        case WireError::kNone:
+            return "none";
+        case WireError::kTruncated:
+            return "truncated";
+        case WireError::kOversized:
+            return "oversized";
+        case WireError::kBadMagic:
+            return "bad magic";
+        case WireError::kWrongVersion:
+            return "wrong version";
+        case WireError::kUnknownType:
+            return "unknown type";
+        case WireError::kBadField:
+            return "field out of range";
+        case WireError::kTrailingBytes:
+            return "trailing bytes";
+        case WireError::kBadMac:
+            return "bad MAC";
+        case WireError::kWrongSession:
+            return "wrong session";
+    }
+    return "?";
+}
+
+uint64_t DropCounters::total() const {
+    uint64_t sum = 0;
+    for (size_t i = 1; i < by_error.size(); ++i) {
+        sum += by_error[i];
+    }
+    return sum;
+}
+
+DropCounters& DropCounters::operator+=(const DropCounters& o) {
+    for (size_t i = 0; i < by_error.size(); ++i) {
+        by_error[i] += o.by_error[i];
+    }
+    return *this;
+}
+
+FrameRequest makeFrameRequest(uint32_t frame_id, uint64_t client_send_ns, const Pose& pose,
+                              const LayerPlan& plan) {
+    FrameRequest r;
+    r.frame_id = frame_id;
+    r.client_send_ns = client_send_ns;
+    r.pose = pose;
+    r.gaze = plan.gaze;
+    r.e1_deg = static_cast<float>(plan.e1_deg);
+    r.e2_deg = static_cast<float>(plan.e2_deg);
+    r.s1 = static_cast<float>(plan.s1);
+    r.s2 = static_cast<float>(plan.s2);
+    const auto wire = [](const LayerRect& l) {
+        return LayerGeometry{l.rect, static_cast<float>(l.scale), l.width_px, l.height_px};
+    };
+    for (size_t e = 0; e < 2; ++e) {
+        r.eyes[e] = {wire(plan.eyes[e].fovea), wire(plan.eyes[e].middle), wire(plan.eyes[e].outer)};
+    }
+    return r;
+}
+
+LayerPlan layerPlanOf(const FrameRequest& request) {
+    LayerPlan plan;
+    plan.gaze = request.gaze;
+    plan.e1_deg = request.e1_deg;
+    plan.e2_deg = request.e2_deg;
+    plan.s1 = request.s1;
+    plan.s2 = request.s2;
+    const auto layer = [](const LayerGeometry& g) {
+        return LayerRect{g.rect, g.scale, g.width_px, g.height_px};
+    };
+    for (size_t e = 0; e < 2; ++e) {
+        plan.eyes[e] = {layer(request.eyes[e].fovea), layer(request.eyes[e].middle),
+                        layer(request.eyes[e].outer)};
+    }
+    plan.fovea_pixels = plan.eyes[0].fovea.pixels();
+    plan.middle_pixels = plan.eyes[0].middle.pixels();
+    plan.outer_pixels = plan.eyes[0].outer.pixels();
+    return plan;
+}
+
+std::vector<uint8_t> encodeControl(const ControlMessage& message) {
+    std::vector<uint8_t> out;
+    const ControlType type = typeOf(message);
+    const size_t payload = payloadBytesOf(type);
+    out.reserve(kControlHeaderBytes + payload);
+    ByteWriter w(out);
+    w.u8(kControlMagic0);
+    w.u8(kControlMagic1);
+    w.u8(kProtocolVersion);
+    w.u8(static_cast<uint8_t>(type));
+    w.u32(static_cast<uint32_t>(payload));
+    std::visit(Encoder{w}, message);
+    QVR_CHECK(out.size() == kControlHeaderBytes + payload);
+    return out;
+}
+
+WireError decodeControlHeader(std::span<const uint8_t> bytes, ControlHeader& out) {
+    if (bytes.size() < kControlHeaderBytes) {
+        return WireError::kTruncated;
+    }
+    ByteReader r(bytes.first(kControlHeaderBytes));
+    const uint8_t m0 = r.u8(), m1 = r.u8(), version = r.u8(), type = r.u8();
+    const uint32_t length = r.u32();
+    if (m0 != kControlMagic0 || m1 != kControlMagic1) {
+        return WireError::kBadMagic;
+    }
+    if (version != kProtocolVersion) {
+        return WireError::kWrongVersion;
+    }
+    const size_t expected = payloadBytesOf(static_cast<ControlType>(type));
+    if (expected == 0) {
+        return WireError::kUnknownType;
+    }
+    if (length > kMaxControlPayloadBytes) {
+        return WireError::kOversized;
+    }
+    if (length < expected) {
+        return WireError::kTruncated;
+    }
+    if (length > expected) {
+        return WireError::kTrailingBytes;
+    }
+    out.type = static_cast<ControlType>(type);
+    out.payload_bytes = length;
+    return WireError::kNone;
+}
+
+WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payload,
+                               ControlMessage& out) {
+    const size_t expected = payloadBytesOf(type);
+    if (expected == 0) {
+        return WireError::kUnknownType;
+    }
+    if (payload.size() < expected) {
+        return WireError::kTruncated;
+    }
+    if (payload.size() > expected) {
+        return WireError::kTrailingBytes;
+    }
+    ByteReader r(payload);
+    switch (type) {
+        case ControlType::kClientHello: {
+            ClientHello m;
+            r.bytes(m.client_nonce);
+            m.media_port = r.u16();
+            if (m.media_port == 0) {
+                return WireError::kBadField;
+            }
+            out = m;
+            break;
+        }
+        case ControlType::kServerChallenge: {
+            ServerChallenge m;
+            r.bytes(m.server_nonce);
+            m.session_id = r.u64();
+            r.bytes(m.server_proof);
+            if (m.session_id == 0) {
+                return WireError::kBadField;
+            }
+            out = m;
+            break;
+        }
+        case ControlType::kClientAuth: {
+            ClientAuth m;
+            r.bytes(m.client_proof);
+            out = m;
+            break;
+        }
+        case ControlType::kWelcome: {
+            Welcome m;
+            m.session_id = r.u64();
+            m.media_port = r.u16();
+            if (m.session_id == 0 || m.media_port == 0) {
+                return WireError::kBadField;
+            }
+            out = m;
+            break;
+        }
+        case ControlType::kFrameRequest: {
+            FrameRequest m;
+            const WireError e = decodeFrameRequest(r, m);
+            if (e != WireError::kNone) {
+                return e;
+            }
+            out = m;
+            break;
+        }
+        case ControlType::kMediaAck: {
+            MediaAck m;
+            m.frame_id = r.u32();
+            m.stream_id = r.u8();
+            const uint8_t complete = r.u8();
+            m.packets_received = r.u16();
+            m.bytes_received = r.u32();
+            m.first_rx_ns = r.u64();
+            m.last_rx_ns = r.u64();
+            m.complete = complete == 1;
+            if (m.stream_id >= kMaxStreams || complete > 1 ||
+                m.packets_received > kMaxPacketsPerFrame ||
+                m.bytes_received > kMaxStreamFrameBytes || m.last_rx_ns < m.first_rx_ns) {
+                return WireError::kBadField;
+            }
+            out = m;
+            break;
+        }
+        case ControlType::kKeyFrameRequest: {
+            KeyFrameRequest m;
+            m.stream_mask = r.u8();
+            m.last_frame_id = r.u32();
+            const uint8_t reason = r.u8();
+            if (m.stream_mask == 0 || m.stream_mask >= (1u << kMaxStreams) || reason < 1 ||
+                reason > 3) {
+                return WireError::kBadField;
+            }
+            m.reason = static_cast<KeyFrameReason>(reason);
+            out = m;
+            break;
+        }
+        case ControlType::kThroughputReport: {
+            ThroughputReport m;
+            m.throughput_bps = r.u64();
+            m.samples = r.u32();
+            if (m.throughput_bps > 1'000'000'000'000ull) {
+                return WireError::kBadField;
+            }
+            out = m;
+            break;
+        }
+        case ControlType::kBye: {
+            const uint8_t reason = r.u8();
+            if (reason > static_cast<uint8_t>(ByeReason::kTimeout)) {
+                return WireError::kBadField;
+            }
+            out = Bye{static_cast<ByeReason>(reason)};
+            break;
+        }
+    }
+    return r.ok() ? WireError::kNone : WireError::kTruncated;
+}
+
+WireError decodeControl(std::span<const uint8_t> bytes, ControlMessage& out) {
+    ControlHeader header;
+    const WireError e = decodeControlHeader(bytes, header);
+    if (e != WireError::kNone) {
+        return e;
+    }
+    const size_t total = kControlHeaderBytes + header.payload_bytes;
+    if (bytes.size() < total) {
+        return WireError::kTruncated;
+    }
+    if (bytes.size() > total) {
+        return WireError::kTrailingBytes;
+    }
+    return decodeControlPayload(header.type, bytes.subspan(kControlHeaderBytes), out);
+}
+
+uint32_t packetCountFor(uint32_t frame_bytes) {
+    return static_cast<uint32_t>((static_cast<uint64_t>(frame_bytes) + kMediaChunkBytes - 1) /
+                                 kMediaChunkBytes);
+}
+
+WireError decodeMediaPacket(std::span<const uint8_t> datagram, MediaPacketView& out) {
+    if (datagram.size() < kMediaHeaderBytes) {
+        return WireError::kTruncated;
+    }
+    if (datagram.size() > kMaxDatagramBytes) {
+        return WireError::kOversized;
+    }
+    ByteReader r(datagram.first(kMediaHeaderBytes));
+    const uint8_t m0 = r.u8(), m1 = r.u8(), version = r.u8(), flags = r.u8();
+    MediaHeader h;
+    h.session_id = r.u64();
+    h.seq = r.u32();
+    h.frame_id = r.u32();
+    h.stream_id = r.u8();
+    const uint8_t reserved = r.u8();
+    h.packet_index = r.u16();
+    h.packet_count = r.u16();
+    h.payload_bytes = r.u16();
+    h.frame_bytes = r.u32();
+    if (m0 != kMediaMagic0 || m1 != kMediaMagic1) {
+        return WireError::kBadMagic;
+    }
+    if (version != kProtocolVersion) {
+        return WireError::kWrongVersion;
+    }
+    if (h.payload_bytes > kMediaChunkBytes || h.packet_count > kMaxPacketsPerFrame ||
+        h.frame_bytes > kMaxStreamFrameBytes) {
+        return WireError::kOversized;
+    }
+    const size_t available = datagram.size() - kMediaHeaderBytes;
+    if (available < h.payload_bytes) {
+        return WireError::kTruncated;
+    }
+    if (available > h.payload_bytes) {
+        return WireError::kTrailingBytes;
+    }
+    h.key_frame = (flags & kFlagKeyFrame) != 0;
+    const bool consistent =
+        (flags & ~kFlagKeyFrame) == 0 && reserved == 0 && h.stream_id < kMaxStreams &&
+        h.session_id != 0 && h.frame_bytes > 0 && h.packet_count == packetCountFor(h.frame_bytes) &&
+        h.packet_index < h.packet_count &&
+        h.payload_bytes == (h.packet_index + 1u < h.packet_count
+                                ? kMediaChunkBytes
+                                : h.frame_bytes - (h.packet_count - 1u) * kMediaChunkBytes);
+    if (!consistent) {
+        return WireError::kBadField;
+    }
+    out.header = h;
+    out.payload = datagram.subspan(kMediaHeaderBytes, h.payload_bytes);
+    return WireError::kNone;
+}
+
+void encodeMediaPacket(const MediaHeader& h, std::span<const uint8_t> payload,
+                       std::vector<uint8_t>& out) {
+    QVR_CHECK(payload.size() <= kMediaChunkBytes && payload.size() == h.payload_bytes);
+    out.clear();
+    out.reserve(kMediaHeaderBytes + payload.size());
+    ByteWriter w(out);
+    w.u8(kMediaMagic0);
+    w.u8(kMediaMagic1);
+    w.u8(kProtocolVersion);
+    w.u8(h.key_frame ? kFlagKeyFrame : 0);
+    w.u64(h.session_id);
+    w.u32(h.seq);
+    w.u32(h.frame_id);
+    w.u8(h.stream_id);
+    w.u8(0);
+    w.u16(h.packet_index);
+    w.u16(h.packet_count);
+    w.u16(h.payload_bytes);
+    w.u32(h.frame_bytes);
+    w.bytes(payload);
+}
+
+std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t& seq,
+                                                  uint32_t frame_id, uint8_t stream_id,
+                                                  bool key_frame, std::span<const uint8_t> bytes) {
+    QVR_CHECK(!bytes.empty() && bytes.size() <= kMaxStreamFrameBytes);
+    QVR_CHECK(stream_id < kMaxStreams);
+    const uint32_t frame_bytes = static_cast<uint32_t>(bytes.size());
+    const uint32_t count = packetCountFor(frame_bytes);
+    std::vector<std::vector<uint8_t>> packets(count);
+    for (uint32_t i = 0; i < count; ++i) {
+        const size_t offset = static_cast<size_t>(i) * kMediaChunkBytes;
+        const size_t n = std::min(kMediaChunkBytes, bytes.size() - offset);
+        MediaHeader h;
+        h.key_frame = key_frame;
+        h.session_id = session_id;
+        h.seq = seq++;
+        h.frame_id = frame_id;
+        h.stream_id = stream_id;
+        h.packet_index = static_cast<uint16_t>(i);
+        h.packet_count = static_cast<uint16_t>(count);
+        h.payload_bytes = static_cast<uint16_t>(n);
+        h.frame_bytes = frame_bytes;
+        encodeMediaPacket(h, bytes.subspan(offset, n), packets[i]);
+    }
+    return packets;
+}
+
+}  // namespace qvr::net

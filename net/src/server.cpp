@@ -1,0 +1,518 @@
+// Server transport: accept → PSK handshake → control messages; media through the per-client
+// link emulator onto a UDP socket. Every socket and session lives on the one network thread.
+#include "qvr/net/server.h"
+
+#include <asio.hpp>
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "control_io.h"
+#include "qvr/net/clock.h"
+#include "qvr/net/throughput_estimator.h"
+
+namespace qvr::net {
+namespace {
+
+using asio::ip::tcp;
+using asio::ip::udp;
+
+asio::steady_timer::time_point steadyAt(int64_t ns) {
+    return asio::steady_timer::time_point(std::chrono::nanoseconds(ns));
+}
+
+}  // namespace
+
+struct Session;
+
+struct Server::Impl {
+    Impl(ServerOptions o, ServerHandler& h)
+        : options(std::move(o)), handler(h), acceptor(io), udp_socket(io) {}
+    void accept();
+    void onAccepted(tcp::socket socket);
+
+    ServerOptions options;
+    ServerHandler& handler;
+    asio::io_context io;
+    tcp::acceptor acceptor;
+    udp::socket udp_socket;
+    std::thread thread;
+    bool stopped = false;
+
+    mutable std::mutex mutex;  // guards clients, stats; sessions' own state is io-thread only
+    std::map<ClientId, std::shared_ptr<Session>> clients;
+    std::vector<std::shared_ptr<Session>> sessions;  // every open connection
+    int pending = 0;
+    ServerStats stats;
+};
+
+struct Session : std::enable_shared_from_this<Session> {
+    enum class State { kAwaitHello, kAwaitAuth, kAuthed, kClosed };
+
+    Session(Server::Impl& s, tcp::socket sock)
+        : server(s),
+          socket(std::move(sock)),
+          writer(s.options.max_control_queue),
+          handshake_timer(s.io),
+          flush_timer(s.io),
+          link(s.options.link),
+          estimator(s.options.throughput_alpha) {}
+
+    void start() {
+        handshake_timer.expires_after(
+            std::chrono::milliseconds(server.options.handshake_timeout_ms));
+        handshake_timer.async_wait([self = shared_from_this()](const asio::error_code& ec) {
+            if (!ec && self->state != State::kAuthed && self->state != State::kClosed) {
+                self->count([](ServerStats& st) { ++st.handshake_timeouts; });
+                self->refuse(ByeReason::kTimeout);
+            }
+        });
+        readNext();
+    }
+
+    template <typename F>
+    void count(F f) {
+        std::lock_guard lock(server.mutex);
+        f(server.stats);
+    }
+
+    void readNext() {
+        reader.read(socket, [self = shared_from_this()](detail::ReadResult r) {
+            self->onRead(std::move(r));
+        });
+    }
+
+    void onRead(detail::ReadResult r) {
+        if (state == State::kClosed) {
+            return;
+        }
+        if (r.ec) {
+            close();  // the client went away
+            return;
+        }
+        if (r.error != WireError::kNone) {
+            count([&](ServerStats& st) { st.control_drops.count(r.error); });
+            // Before authentication nothing malformed is tolerated; after it, a well-framed
+            // but invalid message is dropped and the stream goes on.
+            if (r.stream_broken || state != State::kAuthed) {
+                count([](ServerStats& st) { ++st.protocol_errors; });
+                refuse(ByeReason::kProtocolError);
+                return;
+            }
+            readNext();
+            return;
+        }
+        if (!onMessage(r.message)) {
+            return;
+        }
+        readNext();
+    }
+
+    // False when the session ended.
+    bool onMessage(const ControlMessage& m) {
+        switch (state) {
+            case State::kAwaitHello: {
+                const auto* hello = std::get_if<ClientHello>(&m);
+                if (!hello) {
+                    break;
+                }
+                client_nonce = hello->client_nonce;
+                media_port = hello->media_port;
+                server_nonce = randomNonce();
+                session_id = randomSessionId();
+                ServerChallenge c;
+                c.server_nonce = server_nonce;
+                c.session_id = session_id;
+                c.server_proof =
+                    serverProof(server.options.key, client_nonce, server_nonce, session_id);
+                state = State::kAwaitAuth;
+                return send(c);
+            }
+            case State::kAwaitAuth: {
+                const auto* auth = std::get_if<ClientAuth>(&m);
+                if (!auth) {
+                    break;
+                }
+                const Mac expected = clientProof(server.options.key, client_nonce, server_nonce,
+                                                 session_id, media_port);
+                if (!macEqual(expected, auth->client_proof)) {
+                    count([](ServerStats& st) {
+                        ++st.auth_failures;
+                        st.control_drops.count(WireError::kBadMac);
+                    });
+                    refuse(ByeReason::kAuthFailed);
+                    return false;
+                }
+                return admit();
+            }
+            case State::kAuthed:
+                return onAuthedMessage(m);
+            case State::kClosed:
+                return false;
+        }
+        count([](ServerStats& st) { ++st.protocol_errors; });
+        refuse(ByeReason::kProtocolError);
+        return false;
+    }
+
+    bool admit() {
+        handshake_timer.cancel();
+        asio::error_code ec;
+        const tcp::endpoint peer = socket.remote_endpoint(ec);
+        if (ec) {
+            close();
+            return false;
+        }
+        {
+            std::lock_guard lock(server.mutex);
+            --server.pending;
+            pending = false;
+            if (static_cast<int>(server.clients.size()) >= server.options.max_clients) {
+                ++server.stats.refused_full;
+            } else {
+                server.clients.emplace(session_id, shared_from_this());
+                ++server.stats.clients_accepted;
+                state = State::kAuthed;
+            }
+        }
+        if (state != State::kAuthed) {
+            refuse(ByeReason::kServerFull);
+            return false;
+        }
+        // Media goes only to the address that authenticated, at the port it named.
+        media_endpoint = udp::endpoint(peer.address(), media_port);
+        if (!send(Welcome{session_id, server.udp_socket.local_endpoint().port()})) {
+            return false;
+        }
+        server.handler.onClientConnected(session_id);
+        return state == State::kAuthed;
+    }
+
+    bool onAuthedMessage(const ControlMessage& m) {
+        if (const auto* req = std::get_if<FrameRequest>(&m)) {
+            count([](ServerStats& st) { ++st.frame_requests; });
+            server.handler.onFrameRequest(session_id, *req);
+        } else if (const auto* ack = std::get_if<MediaAck>(&m)) {
+            count([](ServerStats& st) { ++st.acks; });
+            estimator.onAck(ack->frame_id, ack->bytes_received, SteadyClock::instance().nowNs());
+            throughput_bps = estimator.throughputBps();
+            if (estimator.samples() > 0) {
+                return send(ThroughputReport{static_cast<uint64_t>(estimator.throughputBps()),
+                                             estimator.samples()});
+            }
+        } else if (const auto* key = std::get_if<KeyFrameRequest>(&m)) {
+            count([](ServerStats& st) { ++st.key_frame_requests; });
+            server.handler.onKeyFrameRequest(session_id, *key);
+        } else if (std::holds_alternative<Bye>(m)) {
+            close();
+            return false;
+        } else {
+            count([](ServerStats& st) { ++st.protocol_errors; });  // a handshake message again
+        }
+        return state == State::kAuthed;
+    }
+
+    bool send(const ControlMessage& m) {
+        const bool queued =
+            writer.push(socket, encodeControl(m),
+                        [self = shared_from_this()](const asio::error_code&) { self->close(); });
+        if (!queued) {
+            // The client stopped reading its control channel: drop it rather than grow.
+            count([](ServerStats& st) { ++st.protocol_errors; });
+            close();
+            return false;
+        }
+        return true;
+    }
+
+    // Tell the peer why (best effort, a few bytes into an idle socket), then hang up.
+    void refuse(ByeReason reason) {
+        if (state == State::kClosed) {
+            return;
+        }
+        const std::vector<uint8_t> bye = encodeControl(Bye{reason});
+        asio::error_code ec;
+        socket.non_blocking(true, ec);
+        asio::write(socket, asio::buffer(bye), ec);
+        close();
+    }
+
+    void close() {
+        if (state == State::kClosed) {
+            return;
+        }
+        const bool was_client = state == State::kAuthed;
+        state = State::kClosed;
+        asio::error_code ec;
+        handshake_timer.cancel();
+        flush_timer.cancel();
+        socket.shutdown(tcp::socket::shutdown_both, ec);
+        socket.close(ec);
+        writer.clear();
+        auto self = shared_from_this();
+        {
+            std::lock_guard lock(server.mutex);
+            if (pending) {
+                --server.pending;
+                pending = false;
+            }
+            if (was_client) {
+                server.clients.erase(session_id);
+            }
+            std::erase(server.sessions, self);
+        }
+        if (was_client) {
+            server.handler.onClientGone(session_id);
+        }
+    }
+
+    void enqueueStream(uint32_t frame_id, uint8_t stream_id, bool key_frame,
+                       const std::vector<uint8_t>& bytes) {
+        queued_bytes -= static_cast<int64_t>(bytes.size());
+        if (state != State::kAuthed) {
+            return;
+        }
+        const int64_t now_ns = SteadyClock::instance().nowNs();
+        auto packets =
+            packetizeStream(session_id, seq[stream_id], frame_id, stream_id, key_frame, bytes);
+        estimator.onSend(frame_id, static_cast<int64_t>(bytes.size()), now_ns);
+        for (auto& p : packets) {
+            link.send(std::move(p), now_ns);  // the link counts its own drops
+        }
+        count([&](ServerStats& st) { ++st.streams_sent; });
+        flush();
+    }
+
+    void flush() {
+        if (state != State::kAuthed) {
+            return;
+        }
+        out.clear();
+        link.deliver(SteadyClock::instance().nowNs(), out);
+        uint64_t sent = 0, failed = 0;
+        for (const auto& p : out) {
+            asio::error_code ec;
+            server.udp_socket.send_to(asio::buffer(p), media_endpoint, 0, ec);
+            (ec ? failed : sent) += 1;
+        }
+        {
+            std::lock_guard lock(server.mutex);
+            server.stats.packets_sent += sent;
+            server.stats.packets_send_failed += failed;
+            link_stats = link.stats();
+        }
+        const auto next = link.nextDeliveryNs();
+        if (next && !flush_armed) {
+            flush_armed = true;
+            flush_timer.expires_at(steadyAt(*next));
+            flush_timer.async_wait([self = shared_from_this()](const asio::error_code& ec) {
+                self->flush_armed = false;
+                if (!ec) {
+                    self->flush();
+                }
+            });
+        }
+    }
+
+    Server::Impl& server;
+    tcp::socket socket;
+    detail::ControlReader reader;
+    detail::ControlWriter writer;
+    asio::steady_timer handshake_timer;
+    asio::steady_timer flush_timer;
+    bool flush_armed = false;
+    State state = State::kAwaitHello;
+    bool pending = true;
+    Nonce client_nonce{};
+    Nonce server_nonce{};
+    uint64_t session_id = 0;
+    uint16_t media_port = 0;
+    udp::endpoint media_endpoint;
+    LinkEmulator link;
+    LinkStats link_stats;  // a copy for other threads, under server.mutex
+    ThroughputEstimator estimator;
+    std::array<uint32_t, kMaxStreams> seq{};
+    std::vector<std::vector<uint8_t>> out;
+    std::atomic<int64_t> queued_bytes{0};
+    std::atomic<double> throughput_bps{0.0};
+};
+
+void Server::Impl::accept() {
+    acceptor.async_accept([this](const asio::error_code& ec, tcp::socket socket) {
+        if (ec) {
+            if (ec != asio::error::operation_aborted && !stopped) {
+                accept();  // e.g. EMFILE: keep serving the clients we have
+            }
+            return;
+        }
+        onAccepted(std::move(socket));
+        accept();
+    });
+}
+
+void Server::Impl::onAccepted(tcp::socket socket) {
+    asio::error_code ec;
+    socket.set_option(tcp::no_delay(true), ec);  // small control messages must not wait
+    std::shared_ptr<Session> session;
+    {
+        std::lock_guard lock(mutex);
+        ++stats.connections;
+        if (pending >= options.max_pending_handshakes) {
+            ++stats.refused_full;
+            socket.close(ec);
+            return;
+        }
+        ++pending;
+        session = std::make_shared<Session>(*this, std::move(socket));
+        sessions.push_back(session);
+    }
+    session->start();
+}
+
+Server::Server(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+
+Server::~Server() {
+    stop();
+}
+
+Expected<std::unique_ptr<Server>> Server::start(ServerOptions options, ServerHandler& handler) {
+    auto impl = std::make_unique<Impl>(std::move(options), handler);
+    asio::error_code ec;
+    const asio::ip::address address = asio::ip::make_address(impl->options.bind_address, ec);
+    if (ec) {
+        return makeError("server: bad bind address '" + impl->options.bind_address +
+                         "': " + ec.message());
+    }
+    const tcp::endpoint endpoint(address, impl->options.port);
+    impl->acceptor.open(endpoint.protocol(), ec);
+    if (!ec) {
+        // A restarted server must get its port back while old connections sit in TIME_WAIT.
+        impl->acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+    }
+    if (!ec) {
+        impl->acceptor.bind(endpoint, ec);
+    }
+    if (!ec) {
+        impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    }
+    if (ec) {
+        return makeError("server: cannot listen on " + impl->options.bind_address + ":" +
+                         std::to_string(impl->options.port) + ": " + ec.message());
+    }
+    impl->udp_socket.open(address.is_v4() ? udp::v4() : udp::v6(), ec);
+    if (!ec) {
+        impl->udp_socket.bind(udp::endpoint(address, 0), ec);
+    }
+    if (!ec) {
+        // Never block the network thread on a full socket buffer: count and drop instead.
+        impl->udp_socket.non_blocking(true, ec);
+        impl->udp_socket.set_option(asio::socket_base::send_buffer_size(4 << 20), ec);
+        ec.clear();
+    }
+    if (ec) {
+        return makeError("server: cannot open the media socket: " + ec.message());
+    }
+    impl->accept();
+    Impl* raw = impl.get();
+    impl->thread = std::thread([raw] { raw->io.run(); });
+    return std::unique_ptr<Server>(new Server(std::move(impl)));
+}
+
+void Server::stop() {
+    if (!m_impl || m_impl->stopped) {
+        return;
+    }
+    Impl* impl = m_impl.get();
+    asio::post(impl->io, [impl] {
+        impl->stopped = true;
+        asio::error_code ec;
+        impl->acceptor.close(ec);
+        std::vector<std::shared_ptr<Session>> sessions;
+        {
+            std::lock_guard lock(impl->mutex);
+            sessions = impl->sessions;
+        }
+        for (auto& s : sessions) {
+            s->close();
+        }
+        impl->udp_socket.close(ec);
+    });
+    if (impl->thread.joinable()) {
+        impl->thread.join();
+    }
+    impl->stopped = true;
+}
+
+uint16_t Server::port() const {
+    asio::error_code ec;
+    const auto ep = m_impl->acceptor.local_endpoint(ec);
+    return ec ? 0 : ep.port();
+}
+
+uint16_t Server::mediaPort() const {
+    asio::error_code ec;
+    const auto ep = m_impl->udp_socket.local_endpoint(ec);
+    return ec ? 0 : ep.port();
+}
+
+Status Server::sendStream(ClientId client, uint32_t frame_id, uint8_t stream_id, bool key_frame,
+                          std::vector<uint8_t> bytes) {
+    if (stream_id >= kMaxStreams) {
+        return makeError("sendStream: stream id " + std::to_string(stream_id) + " ≥ " +
+                         std::to_string(kMaxStreams));
+    }
+    if (bytes.empty() || bytes.size() > kMaxStreamFrameBytes) {
+        return makeError("sendStream: " + std::to_string(bytes.size()) + " bytes outside (0, " +
+                         std::to_string(kMaxStreamFrameBytes) + "]");
+    }
+    std::shared_ptr<Session> session;
+    {
+        std::lock_guard lock(m_impl->mutex);
+        const auto it = m_impl->clients.find(client);
+        if (it == m_impl->clients.end() || m_impl->stopped) {
+            ++m_impl->stats.streams_rejected;
+            return makeError("sendStream: client " + std::to_string(client) + " is not connected");
+        }
+        session = it->second;
+        const int64_t size = static_cast<int64_t>(bytes.size());
+        if (session->queued_bytes.load() + size > m_impl->options.max_media_queue_bytes) {
+            ++m_impl->stats.streams_rejected;
+            return makeError("sendStream: media queue of client " + std::to_string(client) +
+                             " is full");
+        }
+        session->queued_bytes += size;
+    }
+    asio::post(m_impl->io, [session, frame_id, stream_id, key_frame, b = std::move(bytes)] {
+        session->enqueueStream(frame_id, stream_id, key_frame, b);
+    });
+    return Status::success();
+}
+
+ServerStats Server::stats() const {
+    std::lock_guard lock(m_impl->mutex);
+    return m_impl->stats;
+}
+
+std::vector<ClientId> Server::clients() const {
+    std::lock_guard lock(m_impl->mutex);
+    std::vector<ClientId> ids;
+    for (const auto& [id, s] : m_impl->clients) {
+        ids.push_back(id);
+    }
+    return ids;
+}
+
+double Server::throughputBps(ClientId client) const {
+    std::lock_guard lock(m_impl->mutex);
+    const auto it = m_impl->clients.find(client);
+    return it == m_impl->clients.end() ? 0.0 : it->second->throughput_bps.load();
+}
+
+LinkStats Server::linkStats(ClientId client) const {
+    std::lock_guard lock(m_impl->mutex);
+    const auto it = m_impl->clients.find(client);
+    return it == m_impl->clients.end() ? LinkStats{} : it->second->link_stats;
+}
+
+}  // namespace qvr::net

@@ -1,0 +1,180 @@
+// Media reassembly with bounded memory and loss detection (see the header).
+#include "qvr/net/stream_assembler.h"
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+#include "qvr/core/check.h"
+
+namespace qvr::net {
+namespace {
+
+// Serial-number distance (RFC 1982 style): positive when a is after b.
+int64_t seqAfter(uint32_t a, uint32_t b) {
+    return static_cast<int32_t>(a - b);
+}
+
+constexpr size_t kFinishedMemory = 64;
+
+}  // namespace
+
+StreamAssembler::StreamAssembler(AssemblerLimits limits) : m_limits(limits) {
+    QVR_CHECK(limits.max_partial_frames_per_stream > 0 && limits.max_buffered_bytes > 0);
+}
+
+bool StreamAssembler::isFinished(const Stream& s, uint32_t frame_id) const {
+    return std::find(s.finished.begin(), s.finished.end(), frame_id) != s.finished.end();
+}
+
+void StreamAssembler::finish(uint8_t stream_id, uint32_t frame_id) {
+    Stream& s = m_streams[stream_id];
+    s.finished.push_back(frame_id);
+    if (s.finished.size() > kFinishedMemory) {
+        s.finished.pop_front();
+    }
+}
+
+void StreamAssembler::declareLost(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it) {
+    Stream& s = m_streams[stream_id];
+    const Partial& p = it->second;
+    m_lost.push_back({it->first, stream_id, p.received, p.packet_count, p.bytes_received,
+                      p.first_rx_ns, p.last_rx_ns});
+    ++m_stats.streams_lost;
+    m_buffered_bytes -= static_cast<int64_t>(p.bytes.size());
+    s.awaiting_key = true;
+    m_loss_mask |= static_cast<uint8_t>(1u << stream_id);
+    finish(stream_id, it->first);
+    s.partials.erase(it);
+}
+
+void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
+    const MediaHeader& h = packet.header;
+    QVR_CHECK(h.stream_id < kMaxStreams);
+    Stream& s = m_streams[h.stream_id];
+
+    // Sequence gaps: packets that never came. A late packet (negative distance) fills no gap
+    // count back in; reordering on the emulated link cannot happen (it keeps order).
+    if (!s.has_seq) {
+        s.has_seq = true;
+        s.next_seq = h.seq + 1;
+    } else {
+        const int64_t d = seqAfter(h.seq, s.next_seq);
+        if (d >= 0) {
+            if (d > 0) {
+                m_stats.seq_gap_packets += static_cast<uint64_t>(d);
+                s.awaiting_key = true;
+                m_loss_mask |= static_cast<uint8_t>(1u << h.stream_id);
+            }
+            s.next_seq = h.seq + 1;
+        }
+    }
+
+    // Frames whose last packet is well behind the newest sequence number will not complete.
+    for (auto it = s.partials.begin(); it != s.partials.end();) {
+        const auto next = std::next(it);
+        if (seqAfter(h.seq, it->second.last_seq) > m_limits.reorder_window_packets) {
+            declareLost(h.stream_id, it);
+        }
+        it = next;
+    }
+
+    if (isFinished(s, h.frame_id)) {
+        ++m_stats.packets_late;
+        return;
+    }
+    auto it = s.partials.find(h.frame_id);
+    if (it == s.partials.end()) {
+        // Allocate only what the validated header allows, within the budget: make room by
+        // giving up the oldest partial frames first.
+        while (!s.partials.empty() &&
+               (static_cast<int>(s.partials.size()) >= m_limits.max_partial_frames_per_stream ||
+                m_buffered_bytes + h.frame_bytes > m_limits.max_buffered_bytes)) {
+            declareLost(h.stream_id, s.partials.begin());
+        }
+        if (m_buffered_bytes + h.frame_bytes > m_limits.max_buffered_bytes) {
+            ++m_stats.packets_over_budget;
+            return;
+        }
+        Partial p;
+        p.key_frame = h.key_frame;
+        p.packet_count = h.packet_count;
+        p.frame_bytes = h.frame_bytes;
+        p.last_seq = h.seq - h.packet_index + (h.packet_count - 1u);
+        p.first_rx_ns = now_ns;
+        p.bytes.resize(h.frame_bytes);
+        p.have.assign(h.packet_count, false);
+        m_buffered_bytes += h.frame_bytes;
+        it = s.partials.emplace(h.frame_id, std::move(p)).first;
+    }
+    Partial& p = it->second;
+    if (p.packet_count != h.packet_count || p.frame_bytes != h.frame_bytes ||
+        p.key_frame != h.key_frame ||
+        p.last_seq != h.seq - h.packet_index + (h.packet_count - 1u)) {
+        ++m_stats.packets_inconsistent;
+        return;
+    }
+    if (p.have[h.packet_index]) {
+        ++m_stats.packets_duplicate;
+        return;
+    }
+    // decodeMediaPacket guaranteed the payload fits: index·chunk + payload ≤ frame_bytes.
+    std::memcpy(p.bytes.data() + static_cast<size_t>(h.packet_index) * kMediaChunkBytes,
+                packet.payload.data(), packet.payload.size());
+    p.have[h.packet_index] = true;
+    ++p.received;
+    p.bytes_received += h.payload_bytes;
+    p.last_rx_ns = now_ns;
+    ++m_stats.packets_accepted;
+    if (p.received < p.packet_count) {
+        return;
+    }
+    CompletedStream done;
+    done.frame_id = h.frame_id;
+    done.stream_id = h.stream_id;
+    done.key_frame = p.key_frame;
+    if (p.key_frame) {
+        s.awaiting_key = false;
+    }
+    done.decodable = !s.awaiting_key;
+    if (!done.decodable) {
+        ++m_stats.streams_undecodable;
+    }
+    done.packets = p.packet_count;
+    done.first_rx_ns = p.first_rx_ns;
+    done.last_rx_ns = p.last_rx_ns;
+    done.bytes = std::move(p.bytes);
+    m_buffered_bytes -= static_cast<int64_t>(done.bytes.size());
+    ++m_stats.streams_completed;
+    m_completed.push_back(std::move(done));
+    finish(h.stream_id, h.frame_id);
+    s.partials.erase(it);
+}
+
+void StreamAssembler::expire(int64_t now_ns) {
+    for (uint8_t id = 0; id < kMaxStreams; ++id) {
+        auto& partials = m_streams[id].partials;
+        for (auto it = partials.begin(); it != partials.end();) {
+            const auto next = std::next(it);
+            if (now_ns - std::max(it->second.first_rx_ns, it->second.last_rx_ns) >
+                m_limits.frame_timeout_ns) {
+                declareLost(id, it);
+            }
+            it = next;
+        }
+    }
+}
+
+std::vector<CompletedStream> StreamAssembler::takeCompleted() {
+    return std::exchange(m_completed, {});
+}
+
+std::vector<LostStream> StreamAssembler::takeLost() {
+    return std::exchange(m_lost, {});
+}
+
+uint8_t StreamAssembler::takeLossMask() {
+    return std::exchange(m_loss_mask, 0);
+}
+
+}  // namespace qvr::net

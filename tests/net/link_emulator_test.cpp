@@ -1,0 +1,297 @@
+// Link emulator under a fake clock: serialization at the configured rate in closed form, delay
+// and jitter bounds, loss rate, drop-tail queue, and Mahimahi traces at their README means.
+#include "qvr/net/link_emulator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "qvr/net/clock.h"
+#include "qvr/net/mahimahi.h"
+
+namespace qvr::net {
+namespace {
+
+const std::string kTraceDir = std::string(QVR_SHARED_DIR) + "/data/network/";
+
+std::vector<uint8_t> packet(size_t n) {
+    return std::vector<uint8_t>(n, 0xAB);
+}
+
+// Delivers everything, stepping a fake clock to each next delivery; returns the time the last
+// packet arrived.
+int64_t drainAll(LinkEmulator& link, FakeClock& clock, int64_t& packets, int64_t& bytes) {
+    std::vector<std::vector<uint8_t>> out;
+    int64_t last_ns = clock.nowNs();
+    while (auto next = link.nextDeliveryNs()) {
+        clock.setNs(std::max(clock.nowNs(), *next));
+        out.clear();
+        link.deliver(clock.nowNs(), out);
+        for (const auto& p : out) {
+            ++packets;
+            bytes += static_cast<int64_t>(p.size());
+        }
+        last_ns = clock.nowNs();
+    }
+    return last_ns;
+}
+
+TEST(NetLinkEmulator, SerializesAtTheConfiguredRate) {
+    // N bytes at R bit/s leave the bottleneck after N·8/R; with a fixed delay d, arrive d later.
+    for (double mbps : {100.0, 200.0, 500.0}) {
+        LinkConfig c;
+        c.rate_bps = mbps * 1e6;
+        c.delay_ms = 3.0;
+        c.queue_bytes = 64 << 20;
+        LinkEmulator link(c);
+        FakeClock clock;
+        const int64_t n_packets = 1000, size = 1232;
+        for (int i = 0; i < n_packets; ++i) {
+            ASSERT_TRUE(link.send(packet(size), clock.nowNs()));
+        }
+        int64_t packets = 0, bytes = 0;
+        const int64_t last_ns = drainAll(link, clock, packets, bytes);
+        const double expected_ns = n_packets * size * 8.0 / c.rate_bps * 1e9 + 3e6;
+        EXPECT_EQ(packets, n_packets);
+        EXPECT_EQ(bytes, n_packets * size);
+        EXPECT_NEAR(static_cast<double>(last_ns), expected_ns, 1.0) << mbps;
+    }
+}
+
+TEST(NetLinkEmulator, PacedSenderSeesOnlyTheDelay) {
+    LinkConfig c;
+    c.rate_bps = 100e6;
+    c.delay_ms = 10.0;
+    LinkEmulator link(c);
+    FakeClock clock;
+    // One 1250-byte packet every 1 ms is 10 Mbit/s: no queue forms, each takes 0.1 ms + 10 ms.
+    std::vector<std::vector<uint8_t>> out;
+    std::vector<int64_t> arrivals;
+    for (int i = 0; i < 50; ++i) {
+        ASSERT_TRUE(link.send(packet(1250), clock.nowNs()));
+        // Step through the next millisecond at every delivery time inside it.
+        const int64_t end_ns = clock.nowNs() + 1'000'000;
+        while (link.nextDeliveryNs() && *link.nextDeliveryNs() < end_ns) {
+            clock.setNs(*link.nextDeliveryNs());
+            out.clear();
+            link.deliver(clock.nowNs(), out);
+            arrivals.insert(arrivals.end(), out.size(), clock.nowNs());
+        }
+        clock.setNs(end_ns);
+    }
+    ASSERT_GE(arrivals.size(), 40u);
+    for (size_t i = 0; i < arrivals.size(); ++i) {
+        EXPECT_EQ(arrivals[i], static_cast<int64_t>(i) * 1'000'000 + 100'000 + 10'000'000) << i;
+    }
+}
+
+TEST(NetLinkEmulator, JitterStaysInBoundsAndKeepsOrder) {
+    LinkConfig c;
+    c.delay_ms = 20.0;
+    c.jitter_ms = 5.0;
+    c.seed = 7;
+    LinkEmulator link(c);
+    FakeClock clock;
+    int64_t prev = 0;
+    double sum_ms = 0;
+    int64_t early = 0, late = 0;
+    const int n = 2000;
+    for (int i = 0; i < n; ++i) {
+        std::vector<uint8_t> p = packet(100);
+        p[0] = static_cast<uint8_t>(i);
+        ASSERT_TRUE(link.send(std::move(p), clock.nowNs()));
+        const int64_t d = *link.nextDeliveryNs() - clock.nowNs();
+        // Order is kept, so a packet may wait for the one before it: only the lower bound and
+        // the upper bound of the sampled delay hold for every packet.
+        EXPECT_GE(d, 15'000'000 - 1);
+        EXPECT_GE(*link.nextDeliveryNs(), prev);
+        prev = *link.nextDeliveryNs();
+        std::vector<std::vector<uint8_t>> out;
+        clock.advanceNs(30'000'000);  // past any delay, so the next packet is alone in the line
+        link.deliver(clock.nowNs(), out);
+        ASSERT_EQ(out.size(), 1u);
+        EXPECT_EQ(out[0][0], static_cast<uint8_t>(i));
+        EXPECT_LE(d, 25'000'000 + 1);
+        sum_ms += static_cast<double>(d) / 1e6;
+        early += d < 20'000'000;
+        late += d > 20'000'000;
+    }
+    EXPECT_NEAR(sum_ms / n, 20.0, 0.3);  // uniform ±5 ms: σ of the mean ≈ 0.065 ms
+    EXPECT_GT(early, n / 3);
+    EXPECT_GT(late, n / 3);
+}
+
+TEST(NetLinkEmulator, LossMatchesItsProbabilityAndIsDeterministic) {
+    LinkConfig c;
+    c.loss = 0.05;
+    c.seed = 11;
+    auto run = [&] {
+        LinkEmulator link(c);
+        std::vector<bool> kept;
+        for (int i = 0; i < 20000; ++i) {
+            kept.push_back(link.send(packet(10), 0));
+        }
+        return std::make_pair(kept, link.stats());
+    };
+    const auto [a, stats] = run();
+    const auto [b, stats_b] = run();
+    EXPECT_EQ(a, b);  // the same seed gives the same losses
+    const double rate = static_cast<double>(stats.dropped_loss) / 20000.0;
+    EXPECT_NEAR(rate, 0.05, 0.006);  // 4σ of a binomial(20000, 0.05)
+    EXPECT_EQ(stats.packets_in, 20000u);
+}
+
+TEST(NetLinkEmulator, DropTailQueueBoundsTheBacklog) {
+    LinkConfig c;
+    c.rate_bps = 8e6;  // 1 byte per µs
+    c.queue_bytes = 10'000;
+    LinkEmulator link(c);
+    int accepted = 0;
+    for (int i = 0; i < 20; ++i) {
+        accepted += link.send(packet(1000), 0) ? 1 : 0;
+    }
+    EXPECT_EQ(accepted, 10);
+    EXPECT_EQ(link.stats().dropped_queue, 10u);
+    EXPECT_EQ(link.queuedBytes(0), 10'000);
+    // After 5 ms half the backlog has left; room for five more.
+    EXPECT_EQ(link.queuedBytes(5'000'000), 5'000);
+    for (int i = 0; i < 6; ++i) {
+        accepted += link.send(packet(1000), 5'000'000) ? 1 : 0;
+    }
+    EXPECT_EQ(accepted, 15);
+}
+
+TEST(NetLinkEmulator, ParsesProfilesAndOptions) {
+    auto wifi = parseLinkSpec("wifi");
+    ASSERT_TRUE(wifi) << wifi.error();
+    EXPECT_EQ(wifi->rate_bps, 200e6);
+    EXPECT_EQ(parseLinkSpec("lte")->rate_bps, 100e6);
+    EXPECT_EQ(parseLinkSpec("5g")->rate_bps, 500e6);
+    EXPECT_FALSE(parseLinkSpec("none")->shaped());
+    auto opts = parseLinkSpec("lte,delay_ms=15,jitter_ms=2.5,loss=0.05,queue_kb=512,seed=3");
+    ASSERT_TRUE(opts) << opts.error();
+    EXPECT_EQ(opts->delay_ms, 15.0);
+    EXPECT_EQ(opts->jitter_ms, 2.5);
+    EXPECT_EQ(opts->loss, 0.05);
+    EXPECT_EQ(opts->queue_bytes, 512 * 1024);
+    EXPECT_EQ(opts->seed, 3u);
+    EXPECT_EQ(parseLinkSpec("rate:42.5")->rate_bps, 42.5e6);
+    for (const char* bad :
+         {"wlan", "lte,loss=1", "lte,loss=-0.1", "lte,delay_ms=x", "lte,foo=1", "lte,delay_ms",
+          "rate:0", "rate:abc", "trace:/nonexistent.down", "lte,queue_kb=0"}) {
+        EXPECT_FALSE(parseLinkSpec(bad)) << bad;
+    }
+}
+
+struct ReadmeRow {
+    const char* file;
+    int64_t packets;
+    double mean_mbps;
+};
+
+TEST(NetMahimahi, TracesMatchTheReadmeTable) {
+    for (const ReadmeRow& row : {ReadmeRow{"Verizon-LTE-short.down", 58655, 5.0},
+                                 ReadmeRow{"TMobile-LTE-short.down", 194846, 16.7},
+                                 ReadmeRow{"ATT-LTE-driving-2016.down", 45604, 4.6}}) {
+        auto trace = loadMahimahiTrace(kTraceDir + row.file);
+        ASSERT_TRUE(trace) << trace.error();
+        EXPECT_EQ(trace->packets(), row.packets) << row.file;
+        EXPECT_NEAR(trace->meanBps() / 1e6, row.mean_mbps, 0.05) << row.file;
+    }
+}
+
+// A saturating sender over one loop of the trace measures the trace's mean; rescaled, the
+// target mean. The sender keeps 1 MB queued (more than any burst of opportunities drains in
+// a 1 ms step), so the link never idles.
+double measuredMeanBps(LinkConfig c, double loop_ns) {
+    c.queue_bytes = 2 << 20;
+    LinkEmulator link(c);
+    FakeClock clock;
+    int64_t delivered = 0;
+    std::vector<std::vector<uint8_t>> out;
+    while (clock.nowNs() < static_cast<int64_t>(loop_ns)) {
+        while (link.queuedBytes(clock.nowNs()) < 1024 * 1024) {
+            link.send(packet(1500), clock.nowNs());
+        }
+        clock.advanceNs(1'000'000);
+        out.clear();
+        link.deliver(clock.nowNs(), out);
+        for (const auto& p : out) {
+            delivered += static_cast<int64_t>(p.size());
+        }
+    }
+    return static_cast<double>(delivered) * 8.0 / (loop_ns / 1e9);
+}
+
+TEST(NetMahimahi, TraceLinkDeliversTheMeanAndRescales) {
+    auto trace = loadMahimahiTrace(kTraceDir + "TMobile-LTE-short.down");
+    ASSERT_TRUE(trace) << trace.error();
+    LinkConfig c;
+    c.trace = std::make_shared<const MahimahiTrace>(std::move(trace).value());
+    const double mean = c.trace->meanBps();
+    const double period_ns = static_cast<double>(c.trace->period_ms) * 1e6;
+    EXPECT_NEAR(measuredMeanBps(c, period_ns) / mean, 1.0, 0.01);
+
+    c.trace_target_bps = 100e6;  // the paper's LTE: every stamp divided by 100 / 16.7
+    const LinkEmulator scaled(c);
+    EXPECT_NEAR(scaled.traceNsPerMs(), 1e6 * mean / 100e6, 1e-6);
+    EXPECT_NEAR(measuredMeanBps(c, period_ns * mean / 100e6) / 100e6, 1.0, 0.01);
+}
+
+TEST(NetMahimahi, OpportunitiesFollowTheStampsAndLoop) {
+    // Stamps 0, 0, 5, 10 ms: two packets at 0, one at 5, one at 10, then the loop repeats
+    // shifted by 10 ms (Mahimahi's rule: the last stamp is the period).
+    auto trace = parseMahimahiTrace("0\n0\n5\n10\n", "tiny");
+    ASSERT_TRUE(trace) << trace.error();
+    LinkConfig c;
+    c.trace = std::make_shared<const MahimahiTrace>(std::move(trace).value());
+    LinkEmulator link(c);
+    std::vector<int64_t> times;
+    for (int i = 0; i < 8; ++i) {
+        ASSERT_TRUE(link.send(packet(1500), 0));
+    }
+    std::vector<std::vector<uint8_t>> out;
+    for (int64_t t = 0; t <= 30'000'000; t += 1'000'000) {
+        out.clear();
+        link.deliver(t, out);
+        for (size_t k = 0; k < out.size(); ++k) {
+            times.push_back(t / 1'000'000);
+        }
+    }
+    EXPECT_EQ(times, (std::vector<int64_t>{0, 0, 5, 10, 10, 10, 15, 20}));
+    // Two 750-byte packets share one opportunity.
+    LinkEmulator half(c);
+    ASSERT_TRUE(half.send(packet(750), 1'000'000));
+    ASSERT_TRUE(half.send(packet(750), 1'000'000));
+    out.clear();
+    half.deliver(5'000'000, out);
+    EXPECT_EQ(out.size(), 2u);
+}
+
+TEST(NetMahimahi, MalformedFilesAreRejectedWithTheLine) {
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"", "no delivery"},
+        {"\n\n", "no delivery"},
+        {"0\n0\n", "last timestamp"},
+        {"5\n3\n", ":2: timestamp 3 ms goes back"},
+        {"1\n-2\n", ":2: expected"},
+        {"1\n2 \n", ":2: expected"},
+        {"1\nabc\n", ":2: expected"},
+        {"1\n12345678901\n", "too long"},
+        {"1\n2000000000\n", "exceeds"},
+        {std::string("1\n2\0\n", 5), "expected"},
+    };
+    for (const auto& [text, message] : bad) {
+        auto t = parseMahimahiTrace(text, "bad.down");
+        ASSERT_FALSE(t) << text;
+        EXPECT_NE(t.error().find(message), std::string::npos) << t.error();
+    }
+    auto crlf = parseMahimahiTrace("1\r\n2\r\n\r\n4\n", "crlf.down");
+    ASSERT_TRUE(crlf) << crlf.error();
+    EXPECT_EQ(crlf->packets(), 3);
+    EXPECT_FALSE(loadMahimahiTrace("/nonexistent/trace.down"));
+}
+
+}  // namespace
+}  // namespace qvr::net

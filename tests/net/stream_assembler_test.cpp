@@ -1,0 +1,188 @@
+// Stream reassembly: complete frames in any packet order, loss detected from sequence gaps and
+// timeouts, decodability after loss only from the next key frame, memory bounded.
+#include "qvr/net/stream_assembler.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "qvr/net/throughput_estimator.h"
+
+namespace qvr::net {
+namespace {
+
+std::vector<uint8_t> frameBytes(size_t n, uint32_t seed) {
+    std::vector<uint8_t> v(n);
+    std::mt19937 rng(seed);
+    for (auto& b : v) {
+        b = static_cast<uint8_t>(rng());
+    }
+    return v;
+}
+
+void feed(StreamAssembler& a, const std::vector<uint8_t>& datagram, int64_t now_ns = 0) {
+    MediaPacketView v;
+    ASSERT_EQ(decodeMediaPacket(datagram, v), WireError::kNone);
+    a.onPacket(v, now_ns);
+}
+
+TEST(NetStreamAssembler, CompletesFramesInAnyPacketOrder) {
+    StreamAssembler a;
+    uint32_t seq = 0;
+    const auto bytes = frameBytes(10 * kMediaChunkBytes + 333, 1);
+    auto packets = packetizeStream(1, seq, 5, 3, true, bytes);
+    std::mt19937 rng(2);
+    std::shuffle(packets.begin(), packets.end(), rng);
+    for (const auto& p : packets) {
+        feed(a, p);
+    }
+    feed(a, packets[0]);  // a duplicate after completion is late, not a second frame
+    const auto done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);
+    EXPECT_EQ(done[0].bytes, bytes);
+    EXPECT_EQ(done[0].frame_id, 5u);
+    EXPECT_EQ(done[0].stream_id, 3);
+    EXPECT_TRUE(done[0].decodable);
+    EXPECT_EQ(a.stats().packets_late, 1u);
+    EXPECT_EQ(a.bufferedBytes(), 0);
+}
+
+TEST(NetStreamAssembler, GapTriggersKeyFrameWaitUntilAKeyFrameCompletes) {
+    StreamAssembler a;
+    uint32_t seq = 0;
+    for (const auto& p : packetizeStream(1, seq, 1, 0, true, frameBytes(3000, 1))) {
+        feed(a, p);
+    }
+    EXPECT_FALSE(a.awaitingKeyFrame(0));
+    // Frame 2 loses its middle packet.
+    auto f2 = packetizeStream(1, seq, 2, 0, false, frameBytes(3000, 2));
+    feed(a, f2[0]);
+    feed(a, f2[2]);
+    EXPECT_EQ(a.stats().seq_gap_packets, 1u);
+    EXPECT_TRUE(a.awaitingKeyFrame(0));
+    EXPECT_EQ(a.takeLossMask(), 0b0001);
+    // Frame 3 (not a key frame) completes but cannot be decoded; frame 2 times out as lost.
+    for (const auto& p : packetizeStream(1, seq, 3, 0, false, frameBytes(100, 3))) {
+        feed(a, p, 1'000'000);
+    }
+    a.expire(1'000'000'000);
+    const auto lost = a.takeLost();
+    ASSERT_EQ(lost.size(), 1u);
+    EXPECT_EQ(lost[0].frame_id, 2u);
+    EXPECT_EQ(lost[0].packets_received, 2);
+    auto done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 2u);
+    EXPECT_TRUE(done[0].decodable);
+    EXPECT_FALSE(done[1].decodable);
+    // A key frame restores decoding.
+    for (const auto& p : packetizeStream(1, seq, 4, 0, true, frameBytes(100, 4))) {
+        feed(a, p);
+    }
+    done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);
+    EXPECT_TRUE(done[0].decodable);
+    EXPECT_FALSE(a.awaitingKeyFrame(0));
+}
+
+TEST(NetStreamAssembler, FrameIsLostOncePacketsPassItsEnd) {
+    AssemblerLimits limits;
+    limits.reorder_window_packets = 4;
+    StreamAssembler a(limits);
+    uint32_t seq = 0;
+    auto f1 = packetizeStream(1, seq, 1, 1, true, frameBytes(5 * kMediaChunkBytes, 1));
+    for (size_t i = 0; i + 1 < f1.size(); ++i) {
+        feed(a, f1[i]);  // the last packet never comes
+    }
+    const auto f2 = packetizeStream(1, seq, 2, 1, false, frameBytes(10 * kMediaChunkBytes, 2));
+    for (size_t i = 0; i < 4; ++i) {
+        feed(a, f2[i]);
+        EXPECT_TRUE(a.takeLost().empty()) << i;  // still within the reorder window
+    }
+    feed(a, f2[4]);
+    const auto lost = a.takeLost();
+    ASSERT_EQ(lost.size(), 1u);
+    EXPECT_EQ(lost[0].frame_id, 1u);
+    EXPECT_EQ(lost[0].packets_received, 4);
+    EXPECT_EQ(lost[0].packet_count, 5);
+}
+
+TEST(NetStreamAssembler, InconsistentPacketsAreDropped) {
+    StreamAssembler a;
+    uint32_t seq = 0;
+    const auto f = packetizeStream(1, seq, 1, 0, true, frameBytes(3 * kMediaChunkBytes, 1));
+    feed(a, f[0]);
+    // The same frame id claiming another size.
+    uint32_t seq2 = 1;
+    const auto other = packetizeStream(1, seq2, 1, 0, true, frameBytes(5 * kMediaChunkBytes, 2));
+    feed(a, other[1]);
+    EXPECT_EQ(a.stats().packets_inconsistent, 1u);
+    feed(a, f[0]);
+    EXPECT_EQ(a.stats().packets_duplicate, 1u);
+}
+
+TEST(NetStreamAssembler, MemoryStaysWithinBudget) {
+    AssemblerLimits limits;
+    limits.max_buffered_bytes = 1 << 20;
+    limits.max_partial_frames_per_stream = 3;
+    StreamAssembler a(limits);
+    // A peer that opens many big frames and never finishes them: each claims 4.9 MB.
+    uint32_t seq = 0;
+    for (uint32_t frame = 0; frame < 50; ++frame) {
+        MediaHeader h;
+        h.session_id = 1;
+        h.seq = seq++;
+        h.frame_id = frame;
+        h.stream_id = static_cast<uint8_t>(frame % kMaxStreams);
+        h.packet_count = kMaxPacketsPerFrame;
+        h.frame_bytes = kMaxStreamFrameBytes;
+        h.payload_bytes = kMediaChunkBytes;
+        std::vector<uint8_t> payload(kMediaChunkBytes, 1), datagram;
+        encodeMediaPacket(h, payload, datagram);
+        feed(a, datagram);
+        EXPECT_LE(a.bufferedBytes(), limits.max_buffered_bytes);
+    }
+    EXPECT_EQ(a.stats().packets_over_budget, 50u);
+    // Small frames still fit, and at most three partials per stream are kept.
+    for (uint32_t frame = 100; frame < 110; ++frame) {
+        const auto f =
+            packetizeStream(1, seq, frame, 0, false, frameBytes(2 * kMediaChunkBytes, frame));
+        feed(a, f[0]);
+    }
+    EXPECT_LE(a.bufferedBytes(), 3 * 2 * static_cast<int64_t>(kMediaChunkBytes));
+    EXPECT_GE(a.stats().streams_lost, 7u);
+}
+
+TEST(NetThroughputEstimator, BytesOverFirstSendToLastAck) {
+    ThroughputEstimator est(0.5);
+    // Frame 1: two streams of 1 MB sent at t = 0; acks at 40 ms and 80 ms → 2 MB / 80 ms.
+    est.onSend(1, 1'000'000, 0);
+    est.onSend(1, 1'000'000, 1'000'000);
+    est.onAck(1, 1'000'000, 40'000'000);
+    EXPECT_EQ(est.samples(), 0u);  // one stream still unacknowledged
+    est.onAck(1, 1'000'000, 80'000'000);
+    ASSERT_EQ(est.samples(), 1u);
+    EXPECT_DOUBLE_EQ(est.throughputBps(), 2e6 * 8 / 0.08);
+    // Frame 2: 1 MB in 20 ms = 400 Mbit/s; EMA with α = 0.5.
+    est.onSend(2, 1'000'000, 100'000'000);
+    est.onAck(2, 1'000'000, 120'000'000);
+    EXPECT_DOUBLE_EQ(*est.lastSampleBps(), 400e6);
+    EXPECT_DOUBLE_EQ(est.throughputBps(), 0.5 * 200e6 + 0.5 * 400e6);
+    est.onAck(99, 5'000'000, 130'000'000);  // unknown frame: ignored
+    EXPECT_EQ(est.samples(), 2u);
+}
+
+TEST(NetThroughputEstimator, ForgetsFramesBeyondItsWindow) {
+    ThroughputEstimator est(0.25, 4);
+    for (uint32_t f = 0; f < 10; ++f) {
+        est.onSend(f, 1000, f * 1'000'000);
+    }
+    est.onAck(0, 1000, 50'000'000);  // evicted long ago
+    EXPECT_EQ(est.samples(), 0u);
+    est.onAck(9, 1000, 10'000'000);
+    EXPECT_EQ(est.samples(), 1u);
+    EXPECT_DOUBLE_EQ(est.throughputBps(), 8000.0 / 1e-3);
+}
+
+}  // namespace
+}  // namespace qvr::net

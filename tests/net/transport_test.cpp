@@ -1,0 +1,526 @@
+// Client and server on 127.0.0.1 (ephemeral ports): handshake accepted and refused, malformed
+// control bytes dropped and counted, frames served to several clients, 5% loss through the
+// emulator still completing frames with key-frame requests, a killed server surfacing as an
+// error and a reconnect to its successor, and the ack-based throughput on a shaped link.
+#include <gtest/gtest.h>
+
+#include <asio.hpp>
+#include <atomic>
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "qvr/foveation/hmd_profile.h"
+#include "qvr/net/auth.h"
+#include "qvr/net/client.h"
+#include "qvr/net/server.h"
+
+namespace qvr::net {
+namespace {
+
+using namespace std::chrono_literals;
+
+PresharedKey testKey() {
+    return PresharedKey::fromHex(std::string(64, 'a')).value();
+}
+
+// Deterministic content, so the client can check every byte it reassembled.
+std::vector<uint8_t> streamBytes(ClientId client, uint32_t frame, uint8_t stream, size_t n) {
+    std::vector<uint8_t> v(n);
+    uint32_t x = static_cast<uint32_t>(client) ^ (frame * 2654435761u) ^ (stream * 97u + 1u);
+    for (auto& b : v) {
+        x = x * 1664525u + 1013904223u;
+        b = static_cast<uint8_t>(x >> 24);
+    }
+    return v;
+}
+
+// Answers every frame request with the four layer streams, as the render server will; a
+// stream goes out as a key frame first and after each key-frame request that names it.
+class EchoServer : public ServerHandler {
+public:
+    explicit EchoServer(size_t stream_bytes) : m_stream_bytes(stream_bytes) {}
+    Server* server = nullptr;
+
+    void onClientConnected(ClientId id) override {
+        std::lock_guard lock(m_mutex);
+        m_need_key[id] = 0xF;
+        ++connected;
+    }
+    void onClientGone(ClientId id) override {
+        std::lock_guard lock(m_mutex);
+        m_need_key.erase(id);
+        ++gone;
+    }
+    void onFrameRequest(ClientId id, const FrameRequest& request) override {
+        ++requests;
+        uint8_t key_mask = 0;
+        {
+            std::lock_guard lock(m_mutex);
+            key_mask = std::exchange(m_need_key[id], 0);
+        }
+        for (uint8_t s = 0; s < kMaxStreams; ++s) {
+            const bool key = (key_mask >> s) & 1;
+            key_frames_sent += key ? 1 : 0;
+            auto st = server->sendStream(id, request.frame_id, s, key,
+                                         streamBytes(id, request.frame_id, s, m_stream_bytes));
+            send_errors += st.ok() ? 0 : 1;
+        }
+    }
+    void onKeyFrameRequest(ClientId id, const KeyFrameRequest& request) override {
+        ++key_requests;
+        std::lock_guard lock(m_mutex);
+        m_need_key[id] |= request.stream_mask;
+    }
+
+    std::atomic<int> connected{0}, gone{0}, requests{0}, key_requests{0}, key_frames_sent{0},
+        send_errors{0};
+
+private:
+    size_t m_stream_bytes;
+    std::mutex m_mutex;
+    std::map<ClientId, uint8_t> m_need_key;
+};
+
+FrameRequest request(uint32_t frame_id) {
+    static const LayerPlanner planner(defaultHmdProfile());
+    return makeFrameRequest(frame_id, 0, Pose{}, planner.plan(Gaze{}, 10.0));
+}
+
+std::unique_ptr<Server> startServer(EchoServer& handler, ServerOptions options = {}) {
+    if (options.key.toHex() == PresharedKey().toHex()) {
+        options.key = testKey();
+    }
+    auto server = Server::start(std::move(options), handler);
+    EXPECT_TRUE(server) << server.error();
+    handler.server = server->get();
+    return std::move(server).value();
+}
+
+ClientOptions clientOptions(PresharedKey key = testKey()) {
+    ClientOptions o;
+    o.key = key;
+    o.connect_timeout_ms = 2000;
+    return o;
+}
+
+struct Received {
+    int streams = 0;
+    int decodable = 0;
+    int corrupt = 0;
+    std::map<uint32_t, int> per_frame;
+};
+
+// Takes streams until `streams` arrived or `timeout` passed.
+Received receive(Client& client, ClientId id_for_content, size_t stream_bytes, int streams,
+                 std::chrono::milliseconds timeout) {
+    Received r;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (r.streams < streams && std::chrono::steady_clock::now() < deadline) {
+        auto s = client.nextStream(50);
+        if (!s) {
+            break;
+        }
+        if (!s->has_value()) {
+            continue;
+        }
+        const CompletedStream& cs = **s;
+        ++r.streams;
+        r.decodable += cs.decodable ? 1 : 0;
+        ++r.per_frame[cs.frame_id];
+        if (id_for_content != 0 &&
+            cs.bytes != streamBytes(id_for_content, cs.frame_id, cs.stream_id, stream_bytes)) {
+            ++r.corrupt;
+        }
+    }
+    return r;
+}
+
+TEST(NetTransport, ServesFrameRequestsOverLoopback) {
+    EchoServer handler(20'000);
+    auto server = startServer(handler);
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok()) << client.lastError().error();
+    ASSERT_EQ(server->clients().size(), 1u);
+    const ClientId id = server->clients()[0];
+    for (uint32_t f = 1; f <= 20; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+    }
+    const Received r = receive(client, id, 20'000, 80, 5s);
+    EXPECT_EQ(r.streams, 80);
+    EXPECT_EQ(r.decodable, 80);
+    EXPECT_EQ(r.corrupt, 0);
+    EXPECT_EQ(r.per_frame.size(), 20u);
+    EXPECT_EQ(handler.requests.load(), 20);
+    // Acks flowed back: the server has a throughput estimate and told the client.
+    const auto deadline = std::chrono::steady_clock::now() + 2s;
+    while ((client.throughputBps() == 0 || server->stats().acks < 80) &&
+           std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(5ms);
+    }
+    EXPECT_GT(client.throughputBps(), 0.0);
+    EXPECT_GT(server->throughputBps(id), 0.0);
+    EXPECT_EQ(server->stats().acks, 80u);
+    EXPECT_EQ(client.stats().assembler.streams_lost, 0u);
+    client.disconnect();
+    EXPECT_FALSE(client.connected());
+}
+
+TEST(NetTransport, WrongKeyIsRefused) {
+    EchoServer handler(1000);
+    auto server = startServer(handler);
+    Client client(clientOptions(PresharedKey::fromPassphrase("not the key").value()));
+    const Status s = client.connect("127.0.0.1", server->port());
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().find("pre-shared key"), std::string::npos) << s.error();
+    EXPECT_FALSE(client.connected());
+    EXPECT_TRUE(server->clients().empty());
+    EXPECT_EQ(handler.connected.load(), 0);
+    EXPECT_FALSE(client.sendFrameRequest(request(1)).ok());
+    EXPECT_FALSE(client.nextStream(10).ok());
+}
+
+// A raw peer on the control port: lets tests send exactly the bytes they mean.
+class RawPeer {
+public:
+    explicit RawPeer(uint16_t port) : m_socket(m_io) {
+        m_socket.connect({asio::ip::make_address("127.0.0.1"), port});
+    }
+    void send(const std::vector<uint8_t>& bytes) { asio::write(m_socket, asio::buffer(bytes)); }
+    // Reads one control message; nullopt when the server closed the connection.
+    std::optional<ControlMessage> read() {
+        std::array<uint8_t, kControlHeaderBytes> header{};
+        asio::error_code ec;
+        asio::read(m_socket, asio::buffer(header), ec);
+        if (ec) {
+            return std::nullopt;
+        }
+        ControlHeader h;
+        if (decodeControlHeader(header, h) != WireError::kNone) {
+            return std::nullopt;
+        }
+        std::vector<uint8_t> payload(h.payload_bytes);
+        asio::read(m_socket, asio::buffer(payload), ec);
+        ControlMessage m;
+        if (ec || decodeControlPayload(h.type, payload, m) != WireError::kNone) {
+            return std::nullopt;
+        }
+        return m;
+    }
+    bool closedByPeer() {
+        std::array<uint8_t, 64> buf{};
+        asio::error_code ec;
+        while (!ec) {
+            m_socket.read_some(asio::buffer(buf), ec);
+        }
+        return ec == asio::error::eof || ec == asio::error::connection_reset;
+    }
+    // The client side of the handshake with any key; returns the Welcome or what came instead.
+    std::optional<ControlMessage> handshake(const PresharedKey& key) {
+        const Nonce cn = randomNonce();
+        send(encodeControl(ClientHello{cn, 40000}));
+        auto m = read();
+        if (!m || !std::holds_alternative<ServerChallenge>(*m)) {
+            return m;
+        }
+        const auto& ch = std::get<ServerChallenge>(*m);
+        send(
+            encodeControl(ClientAuth{clientProof(key, cn, ch.server_nonce, ch.session_id, 40000)}));
+        return read();
+    }
+
+private:
+    asio::io_context m_io;
+    asio::ip::tcp::socket m_socket;
+};
+
+TEST(NetTransport, ServerRefusesABadProofAndSaysWhy) {
+    EchoServer handler(1000);
+    auto server = startServer(handler);
+    RawPeer peer(server->port());
+    auto reply = peer.handshake(PresharedKey::fromPassphrase("guess").value());
+    ASSERT_TRUE(reply.has_value());
+    ASSERT_TRUE(std::holds_alternative<Bye>(*reply));
+    EXPECT_EQ(std::get<Bye>(*reply).reason, ByeReason::kAuthFailed);
+    EXPECT_TRUE(peer.closedByPeer());
+    EXPECT_EQ(server->stats().auth_failures, 1u);
+    EXPECT_EQ(server->stats().control_drops[WireError::kBadMac], 1u);
+    EXPECT_EQ(handler.connected.load(), 0);
+}
+
+TEST(NetTransport, MalformedControlBytesAreDroppedAndCounted) {
+    EchoServer handler(1000);
+    auto server = startServer(handler);
+    {
+        RawPeer peer(server->port());  // not a qvr message: the stream is closed
+        peer.send({'G', 'E', 'T', ' ', '/', ' ', 'H', 'T', 'T', 'P'});
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // a header claiming 4 GB of payload
+        peer.send({'Q', 'C', kProtocolVersion, 5, 0xFF, 0xFF, 0xFF, 0xFF});
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // another protocol version
+        auto hello = encodeControl(ClientHello{randomNonce(), 1234});
+        hello[2] = kProtocolVersion + 1;
+        peer.send(hello);
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // an unknown type, then a frame request before auth
+        peer.send({'Q', 'C', kProtocolVersion, 77, 0, 0, 0, 0});
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // truncated: half a header, then the peer leaves
+        peer.send({'Q', 'C', kProtocolVersion});
+    }
+    {
+        // After authentication a well-framed but invalid message is dropped and the session
+        // goes on: the next valid request is served.
+        RawPeer peer(server->port());
+        auto welcome = peer.handshake(testKey());
+        ASSERT_TRUE(welcome && std::holds_alternative<Welcome>(*welcome));
+        FrameRequest bad = request(1);
+        bad.e1_deg = std::numeric_limits<float>::quiet_NaN();
+        peer.send(encodeControl(bad));
+        peer.send(encodeControl(request(2)));
+        const auto deadline = std::chrono::steady_clock::now() + 2s;
+        while (handler.requests.load() < 1 && std::chrono::steady_clock::now() < deadline) {
+            std::this_thread::sleep_for(5ms);
+        }
+        EXPECT_EQ(handler.requests.load(), 1);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + 2s;
+    while (server->stats().control_drops.total() < 5 &&
+           std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(5ms);
+    }
+    const ServerStats st = server->stats();
+    EXPECT_EQ(st.control_drops[WireError::kBadMagic], 1u);
+    EXPECT_EQ(st.control_drops[WireError::kOversized], 1u);
+    EXPECT_EQ(st.control_drops[WireError::kWrongVersion], 1u);
+    EXPECT_EQ(st.control_drops[WireError::kUnknownType], 1u);
+    EXPECT_EQ(st.control_drops[WireError::kBadField], 1u);
+    EXPECT_EQ(st.clients_accepted, 1u);
+}
+
+TEST(NetTransport, SilentPeerIsDroppedAfterTheHandshakeTimeout) {
+    EchoServer handler(1000);
+    ServerOptions o;
+    o.handshake_timeout_ms = 150;
+    auto server = startServer(handler, o);
+    RawPeer peer(server->port());
+    auto m = peer.read();  // blocks until the server gives up
+    ASSERT_TRUE(m && std::holds_alternative<Bye>(*m));
+    EXPECT_EQ(std::get<Bye>(*m).reason, ByeReason::kTimeout);
+    EXPECT_EQ(server->stats().handshake_timeouts, 1u);
+}
+
+TEST(NetTransport, ServesSeveralClientsAndRefusesBeyondTheLimit) {
+    EchoServer handler(5000);
+    ServerOptions o;
+    o.max_clients = 3;
+    auto server = startServer(handler, o);
+    std::vector<std::unique_ptr<Client>> clients;
+    for (int i = 0; i < 3; ++i) {
+        clients.push_back(std::make_unique<Client>(clientOptions()));
+        ASSERT_TRUE(clients.back()->connect("127.0.0.1", server->port()).ok());
+    }
+    Client fourth(clientOptions());
+    const Status full = fourth.connect("127.0.0.1", server->port());
+    ASSERT_FALSE(full.ok());
+    EXPECT_NE(full.error().find("full"), std::string::npos) << full.error();
+    EXPECT_EQ(server->stats().refused_full, 1u);
+    for (auto& c : clients) {
+        for (uint32_t f = 1; f <= 10; ++f) {
+            ASSERT_TRUE(c->sendFrameRequest(request(f)).ok());
+        }
+    }
+    for (auto& c : clients) {
+        // Each client receives its own 40 streams (content is keyed by its session id, checked
+        // below by counting: a stream meant for another client would not reach this socket).
+        const Received r = receive(*c, 0, 5000, 40, 5s);
+        EXPECT_EQ(r.streams, 40);
+        EXPECT_EQ(r.per_frame.size(), 10u);
+    }
+    EXPECT_EQ(server->clients().size(), 3u);
+}
+
+TEST(NetTransport, FivePercentLossKeepsFramesComingWithKeyFrameRequests) {
+    EchoServer handler(4 * kMediaChunkBytes);  // 4 packets per stream: P(complete) = 0.95^4
+    ServerOptions o;
+    auto link = parseLinkSpec("wifi,loss=0.05,seed=5");
+    ASSERT_TRUE(link) << link.error();
+    o.link = link.value();
+    auto server = startServer(handler, o);
+    ClientOptions co = clientOptions();
+    co.key_frame_retry_ms = 5;
+    co.assembler.frame_timeout_ns = 30'000'000;
+    Client client(co);
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok()) << client.lastError().error();
+    const ClientId id = server->clients()[0];
+    const int frames = 300;
+    Received total;
+    std::map<uint32_t, int> decodable_last_quarter;
+    for (uint32_t f = 1; f <= frames; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+        std::this_thread::sleep_for(2ms);  // a 500 Hz client: losses reach the server in time
+        while (true) {
+            auto s = client.nextStream(0);
+            ASSERT_TRUE(s.ok()) << s.error();
+            if (!s->has_value()) {
+                break;
+            }
+            ++total.streams;
+            total.decodable += (*s)->decodable ? 1 : 0;
+            total.corrupt += (*s)->bytes !=
+                             streamBytes(id, (*s)->frame_id, (*s)->stream_id, 4 * kMediaChunkBytes);
+            if ((*s)->frame_id > 3 * frames / 4 && (*s)->decodable) {
+                ++decodable_last_quarter[(*s)->frame_id];
+            }
+        }
+    }
+    const Received tail = receive(client, id, 4 * kMediaChunkBytes, 1 << 20, 300ms);
+    total.streams += tail.streams;
+    total.decodable += tail.decodable;
+    const LinkStats ls = server->linkStats(id);
+    const ClientStats cs = client.stats();
+    const double loss = static_cast<double>(ls.dropped_loss) / static_cast<double>(ls.packets_in);
+    EXPECT_NEAR(loss, 0.05, 0.02);
+    EXPECT_EQ(total.corrupt, 0);
+    // ≈ 0.95^4 = 81% of 1200 streams complete; most are decodable because a key frame follows
+    // each loss within a frame or two.
+    EXPECT_GT(total.streams, 1200 * 0.70);
+    EXPECT_GT(total.decodable, 1200 * 0.55);
+    EXPECT_GT(cs.assembler.streams_lost, 0u);
+    EXPECT_GT(cs.key_frame_requests_sent, 10u);
+    EXPECT_GT(handler.key_requests.load(), 10);
+    EXPECT_GT(handler.key_frames_sent.load(), 10);
+    EXPECT_GT(decodable_last_quarter.size(), 50u);  // still coming at the end
+    // Every stream was accounted for: completed, or lost and acknowledged as lost.
+    EXPECT_GE(cs.assembler.streams_completed + cs.assembler.streams_lost,
+              static_cast<uint64_t>(total.streams));
+}
+
+TEST(NetTransport, KilledServerSurfacesAsErrorAndTheClientReconnects) {
+    EchoServer first_handler(3000);
+    auto server = startServer(first_handler);
+    const uint16_t port = server->port();
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", port).ok());
+    for (uint32_t f = 1; f <= 5; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+    }
+    EXPECT_EQ(receive(client, 0, 3000, 20, 3s).streams, 20);
+
+    server->stop();  // mid-stream: the client is still requesting
+    server.reset();
+    client.sendFrameRequest(request(6));  // may race with the close; either way no crash
+    const auto deadline = std::chrono::steady_clock::now() + 3s;
+    Status seen = Status::success();
+    while (std::chrono::steady_clock::now() < deadline) {
+        auto s = client.nextStream(50);
+        if (!s.ok()) {
+            seen = makeError(s.error());
+            break;
+        }
+    }
+    ASSERT_FALSE(seen.ok()) << "the client never noticed the server was gone";
+    EXPECT_FALSE(client.connected());
+    EXPECT_FALSE(client.lastError().ok());
+    EXPECT_FALSE(client.sendFrameRequest(request(7)).ok());
+    // Nobody listens now: connecting fails with a message, quickly.
+    const Status refused = client.connect("127.0.0.1", port);
+    EXPECT_FALSE(refused.ok());
+
+    EchoServer second_handler(3000);
+    ServerOptions o;
+    o.port = port;
+    auto second = startServer(second_handler, o);
+    ASSERT_EQ(second->port(), port);
+    ASSERT_TRUE(client.connect("127.0.0.1", port).ok()) << client.lastError().error();
+    for (uint32_t f = 100; f < 105; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+    }
+    const Received r = receive(client, second->clients()[0], 3000, 20, 3s);
+    EXPECT_EQ(r.streams, 20);
+    EXPECT_EQ(r.corrupt, 0);
+    EXPECT_EQ(client.stats().connects, 2u);
+    EXPECT_GE(client.stats().connect_failures, 1u);
+}
+
+TEST(NetTransport, ConnectTimesOutOnASilentServer) {
+    // A listener that accepts and never answers: the handshake deadline ends the wait.
+    asio::io_context io;
+    asio::ip::tcp::acceptor acceptor(io, {asio::ip::make_address("127.0.0.1"), 0});
+    ClientOptions o = clientOptions();
+    o.connect_timeout_ms = 200;
+    Client client(o);
+    const auto start = std::chrono::steady_clock::now();
+    const Status s = client.connect("127.0.0.1", acceptor.local_endpoint().port());
+    const auto took = std::chrono::steady_clock::now() - start;
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().find("timed out"), std::string::npos) << s.error();
+    EXPECT_LT(took, 2s);
+}
+
+TEST(NetTransport, ThroughputFromAcksTracksAShapedLink) {
+    EchoServer handler(60'000);  // 240 KB per frame
+    ServerOptions o;
+    o.link = parseLinkSpec("rate:50").value();
+    auto server = startServer(handler, o);
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok());
+    const ClientId id = server->clients()[0];
+    for (uint32_t f = 1; f <= 8; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+        EXPECT_EQ(receive(client, id, 60'000, 4, 3s).streams, 4);  // one frame at a time
+    }
+    const auto deadline = std::chrono::steady_clock::now() + 2s;
+    while (server->throughputBps(id) == 0 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(5ms);
+    }
+    // 240 KB + headers at 50 Mbit/s take ~40 ms; ack and scheduling delays only lower it.
+    const double mbps = server->throughputBps(id) / 1e6;
+    EXPECT_GT(mbps, 35.0);
+    EXPECT_LT(mbps, 52.0);
+}
+
+TEST(NetTransport, SendStreamRejectsBadArgumentsAndUnknownClients) {
+    EchoServer handler(1000);
+    auto server = startServer(handler);
+    EXPECT_FALSE(server->sendStream(12345, 1, 0, true, std::vector<uint8_t>(10)).ok());
+    EXPECT_FALSE(server->sendStream(12345, 1, kMaxStreams, true, std::vector<uint8_t>(10)).ok());
+    EXPECT_FALSE(server->sendStream(12345, 1, 0, true, {}).ok());
+    EXPECT_FALSE(
+        server->sendStream(12345, 1, 0, true, std::vector<uint8_t>(kMaxStreamFrameBytes + 1)).ok());
+    ServerOptions bad;
+    bad.bind_address = "not-an-address";
+    auto s = Server::start(bad, handler);
+    EXPECT_FALSE(s);
+}
+
+TEST(NetTransport, SlowLinkQueueIsBounded) {
+    EchoServer handler(200'000);  // 800 KB per frame into a 1 Mbit/s link with a 64 KB queue
+    ServerOptions o;
+    o.link = parseLinkSpec("rate:1,queue_kb=64").value();
+    auto server = startServer(handler, o);
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok());
+    const ClientId id = server->clients()[0];
+    ASSERT_TRUE(client.sendFrameRequest(request(1)).ok());
+    const auto deadline = std::chrono::steady_clock::now() + 2s;
+    while (server->linkStats(id).packets_in < 600 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(5ms);
+    }
+    const LinkStats ls = server->linkStats(id);
+    EXPECT_GT(ls.dropped_queue, 500u);
+    EXPECT_LE((ls.packets_in - ls.dropped_queue) * kMaxDatagramBytes, 64u * 1024 + 20'000);
+}
+
+}  // namespace
+}  // namespace qvr::net
