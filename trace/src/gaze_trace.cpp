@@ -1,0 +1,67 @@
+// Gaze traces as CSV both ways (paper §7: one sample per eye-tracker tick).
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "csv_lines.h"
+#include "qvr/core/config.h"
+#include "qvr/trace/gaze_model.h"
+
+namespace qvr {
+
+namespace {
+constexpr std::string_view kGazeHeader = "t_ms,x_deg,y_deg";
+constexpr size_t kMaxRows = 50'000'000;
+constexpr size_t kMaxBytes = size_t{1} << 30;
+}  // namespace
+
+std::string gazeTraceToCsv(const GazeTrace& trace) {
+    std::string out(kGazeHeader);
+    out += '\n';
+    for (const auto& s : trace.samples)
+        out += fmt::format("{:.6f},{:.6f},{:.6f}\n", s.t_ms, s.gaze.x_deg, s.gaze.y_deg);
+    return out;
+}
+
+Status writeGazeCsv(const GazeTrace& trace, const std::string& path) {
+    std::ofstream f(path, std::ios::binary);
+    if (!f)
+        return makeError(fmt::format("cannot write '{}'", path));
+    const std::string text = gazeTraceToCsv(trace);
+    f.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!f)
+        return makeError(fmt::format("error writing '{}'", path));
+    return Status::success();
+}
+
+Expected<GazeTrace> parseGazeCsv(std::string_view text, std::string_view source) {
+    std::vector<std::vector<double>> rows;
+    std::vector<int> lines;
+    if (Status s = detail::csvRows(text, source, kGazeHeader, 3, kMaxRows, rows, lines); !s)
+        return makeError(s.error());
+    GazeTrace trace;
+    trace.samples.reserve(rows.size());
+    for (size_t i = 0; i < rows.size(); ++i) {
+        const auto& r = rows[i];
+        if (!trace.samples.empty() && !(r[0] > trace.samples.back().t_ms))
+            return makeError(
+                fmt::format("{}:{}: t_ms {} does not increase", source, lines[i], r[0]));
+        if (std::fabs(r[1]) > 90.0 || std::fabs(r[2]) > 90.0)
+            return makeError(
+                fmt::format("{}:{}: gaze ({}, {}) deg beyond ±90", source, lines[i], r[1], r[2]));
+        trace.samples.push_back({r[0], Gaze{r[1], r[2]}});
+    }
+    if (trace.samples.empty())
+        return makeError(fmt::format("{}: no samples after the header", source));
+    return trace;
+}
+
+Expected<GazeTrace> loadGazeCsv(const std::string& path) {
+    auto text = readTextFile(path, kMaxBytes);
+    if (!text)
+        return makeError(text.error());
+    return parseGazeCsv(*text, path);
+}
+
+}  // namespace qvr
