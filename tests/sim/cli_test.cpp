@@ -11,6 +11,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "qvr/sim/benches.h"
+#include "qvr/workload/trace_io.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -113,6 +116,25 @@ TEST_F(Cli, SimWritesSummaryWithTheDocumentedFields) {
           "\"latency_ratio_final\""})
         EXPECT_NE(j.find(field), std::string::npos) << field;
     EXPECT_TRUE(fs::exists(m_out / "frames.csv"));
+}
+
+TEST_F(Cli, SimReplaysARecordedTraceFileAndRejectsAMalformedOne) {
+    const fs::path good = fs::temp_directory_path() / ("qvr_cli_trace_" + std::to_string(getpid()));
+    auto trace = qvr::makeSuiteBench("hl2-l", 25);
+    ASSERT_TRUE(trace.ok());
+    ASSERT_TRUE(qvr::saveWorkloadTrace(*trace, good.string()).ok());
+    const Outcome ok =
+        run("sim --trace " + good.string() + " --design dfr --frames 25 --out " + m_out.string());
+    EXPECT_EQ(ok.status, 0) << ok.err;
+    EXPECT_TRUE(fs::exists(m_out / "frames.csv"));
+    {
+        std::ofstream f(good);
+        f << "{\"not\": \"a trace header\"}\n";
+    }
+    const Outcome bad = run("sim --trace " + good.string() + " --out " + m_out.string());
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_FALSE(bad.err.empty());
+    fs::remove(good);
 }
 
 }  // namespace
