@@ -18,7 +18,21 @@
 
 namespace qvr {
 
+namespace detail {
+// The map at the tile corners, shared by the four tiles that meet there: the rendered-image
+// point, the unit direction and its eccentricity, per chroma scale in use.
+struct CornerSample {
+    double px = 0, py = 0;
+    double ux = 0, uy = 0, uz = 0;
+    double e_deg = 0;
+    bool in_front = false;
+};
+
+}  // namespace detail
+
 namespace {
+
+using detail::CornerSample;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegPerRad = 180.0 / kPi;
@@ -158,15 +172,6 @@ uint8_t slotMaskFor(const SlotInfo& s, double lo_deg, double hi_deg) {
     return mask;
 }
 
-// The map at the tile corners, shared by the four tiles that meet there: the rendered-image
-// point, the unit direction and its eccentricity, per chroma scale in use.
-struct CornerSample {
-    double px = 0, py = 0;
-    double ux = 0, uy = 0, uz = 0;
-    double e_deg = 0;
-    bool in_front = false;
-};
-
 void sampleCorner(const EyeJob& job, int point, int lattice_cols, int width, int height,
                   int chroma_count, CornerSample* out) {
     const double x = std::min((point % lattice_cols) * kTilePx, width);
@@ -278,7 +283,8 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
 }
 
 // Classify then shade every tile of every job, in parallel over tiles of both eyes.
-void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options, tbb::task_arena& arena,
+void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options,
+             std::array<std::vector<CornerSample>, 2>& lattices, tbb::task_arena& arena,
              TileStats& stats) {
     const bool simd = options.simd;
     const int width = jobs[0].warp.width();
@@ -297,7 +303,6 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options, tbb::task
     // not wait for composition).
     const int lattice_cols = cols + 1;
     const int lattice_per_eye = lattice_cols * (rows + 1);
-    std::vector<std::vector<CornerSample>> lattices(jobs.size());
     for (size_t e = 0; e < jobs.size(); ++e) {
         const int chroma_count = jobs[e].params.chroma ? 3 : 1;
         if (options.classify_tiles) {
@@ -505,7 +510,7 @@ Expected<ComposeReport> Compositor::compose(const LayerFrame& frame, const Pose&
     ComposeReport report;
     report.frame_index = frame.frame_index;
     report.warp_deg = angleBetweenDeg(frame.render_pose.orientation, display_pose.orientation);
-    runJobs(jobs, m_options, *m_arena, report.tiles);
+    runJobs(jobs, m_options, m_lattices, *m_arena, report.tiles);
     return report;
 }
 
@@ -566,7 +571,7 @@ Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
         compose_jobs.push_back(std::move(j));
     }
     TileStats pass1;
-    runJobs(compose_jobs, m_options, *m_arena, pass1);
+    runJobs(compose_jobs, m_options, m_lattices, *m_arena, pass1);
     // Pass 2: timewarp + lens of the composed buffer, one full-resolution layer.
     LayerRect full_rect;
     full_rect.rect = {0, 0, m_profile.width_px, m_profile.height_px};
@@ -588,7 +593,7 @@ Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
         ensureSize(out[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
         warp_jobs.push_back(std::move(j));
     }
-    runJobs(warp_jobs, m_options, *m_arena, report.tiles);
+    runJobs(warp_jobs, m_options, m_lattices, *m_arena, report.tiles);
     return report;
 }
 

@@ -18,6 +18,10 @@
 
 namespace qvr {
 
+namespace detail {
+struct CornerSample;  // uca.cpp: the map at a tile corner
+}
+
 // The three layer framebuffers of one eye. Texel (j, i) of a layer with rect R and scale s is
 // centred on the full-resolution point (R.x0 + (j + ½)·s, R.y0 + (i + ½)·s); a layer the plan
 // leaves out (0 pixels) has an empty image. Alpha is ignored: the display is opaque.
@@ -116,6 +120,8 @@ private:
     std::array<std::vector<TileKind>, 2> m_tile_kinds;
     std::array<std::vector<uint8_t>, 2> m_tile_masks;
     std::array<ImageRgba8, 2> m_two_pass_buffers;
+    // Per-eye scratch reused across frames, so a frame allocates nothing once sizes settle.
+    std::array<std::vector<detail::CornerSample>, 2> m_lattices;
 };
 
 }  // namespace qvr
