@@ -11,9 +11,9 @@ QVR_PACKAGES=(
     gnuplot-nox
     libasio-dev libsodium-dev  # net: transport (standalone asio), PSK handshake (HMAC-SHA-256)
     # scene: pk3 (zip) archives, glTF/OBJ, JPEG/TGA textures; the OpenArena levels and their
-    # textures; assimp-testmodels for the CMU mocap head motion
+    # textures (assimp-testmodels is listed with trace below)
     libzip-dev libassimp-dev libstb-dev
-    openarena-081-maps openarena-081-textures openarena-data assimp-testmodels
+    openarena-081-maps openarena-081-textures openarena-data
     # codec: H.264 through libavcodec + libx264; trace: CMU motion capture (BVH) for head motion
     libavcodec-dev libavutil-dev libswscale-dev libx264-dev assimp-testmodels
     # render: headless OpenGL 4.5 through EGL (GLVND headers and loaders, Mesa's EGL and llvmpipe)

@@ -178,6 +178,7 @@ private:
     Lump m_shaders, m_vertices, m_indices, m_faces, m_lightmaps, m_entities;
     std::vector<SceneVertex> m_bsp_vertices;
     std::map<int, int> m_texture_of_shader;
+    std::map<std::string, int> m_texture_of_path;
     ShaderLibrary m_shader_library;
     bool m_shader_library_loaded = false;
     uint64_t m_triangles = 0;
@@ -294,14 +295,21 @@ int BspParser::textureFor(int shader, Scene& scene) {
     int index = -1;
     for (const auto& base : bases) {
         for (const char* ext : {".tga", ".jpg", ".png"}) {
-            const auto bytes = m_files->read(base + ext);
+            const std::string path = base + ext;
+            // Shaders sharing one image share one texture.
+            if (const auto it = m_texture_of_path.find(path); it != m_texture_of_path.end()) {
+                index = it->second;
+                break;
+            }
+            const auto bytes = m_files->read(path);
             if (!bytes)
                 continue;
-            auto tex = decodeImage(*bytes, shader_name, m_opts.max_texture_px);
+            auto tex = decodeImage(*bytes, path, m_opts.max_texture_px);
             if (!tex)
                 continue;
             index = static_cast<int>(scene.textures.size());
             scene.textures.push_back(std::move(*tex));
+            m_texture_of_path[path] = index;
             break;
         }
         if (index >= 0)

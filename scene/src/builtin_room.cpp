@@ -66,9 +66,13 @@ SceneTexture makeTexture(const std::string& name,
     t.rgba.resize(static_cast<size_t>(kTextureSide) * kTextureSide * 4);
     for (int y = 0; y < kTextureSide; ++y) {
         for (int x = 0; x < kTextureSide; ++x) {
-            const glm::vec3 c = glm::clamp(shade((static_cast<float>(x) + 0.5f) / kTextureSide,
-                                                 (static_cast<float>(y) + 0.5f) / kTextureSide),
-                                           glm::vec3(0), glm::vec3(1));
+            // Per-texel grain on top of the smooth pattern: real game textures carry detail
+            // down to the texel, and that is what the periphery's video encoder pays for.
+            const float grain = 0.92f + 0.16f * hash2(x, y, 1234);
+            const glm::vec3 c =
+                glm::clamp(grain * shade((static_cast<float>(x) + 0.5f) / kTextureSide,
+                                         (static_cast<float>(y) + 0.5f) / kTextureSide),
+                           glm::vec3(0), glm::vec3(1));
             uint8_t* p = &t.rgba[(static_cast<size_t>(y) * kTextureSide + x) * 4];
             p[0] = static_cast<uint8_t>(c.r * 255.0f + 0.5f);
             p[1] = static_cast<uint8_t>(c.g * 255.0f + 0.5f);
@@ -177,7 +181,9 @@ public:
         grid(m, segments, steps, glm::vec2(2.0f, 1.0f), [&](float u, float v) {
             const float a = 2.0f * kPi * u;
             const glm::vec2 rp = profile(v);
-            const float dt = 1e-3f;
+            // Differences over the neighbouring rows, so the normals follow the tessellated
+            // surface (and its winding) even where the profile has ridges.
+            const float dt = 1.0f / static_cast<float>(steps);
             const glm::vec2 d = profile(std::min(v + dt, 1.0f)) - profile(std::max(v - dt, 0.0f));
             // Outward normal of the profile curve (r, y): rotate its tangent by −90°.
             glm::vec2 n2(d.y, -d.x);
@@ -304,7 +310,7 @@ Scene makeBuiltinRoom(int objects) {
         const int kind = static_cast<int>(hash2(col, row, 99) * 7.0f);
         const float h = 0.45f + 0.35f * hash2(col, row, 7);
         if (kind < 5) {
-            b.lathe(m, c, 64, 48, [kind, h](float t) { return pieceProfile(kind % 4, t, h); });
+            b.lathe(m, c, 64, 64, [kind, h](float t) { return pieceProfile(kind % 4, t, h); });
         } else if (kind == 5) {
             // Sphere on a short pedestal.
             b.lathe(m, c, 48, 8, [h](float t) {

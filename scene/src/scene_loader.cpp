@@ -33,7 +33,18 @@ std::string mapNameOf(const std::string& game_path) {
     return n.substr(0, n.size() - 4);
 }
 
-std::string someMaps(const std::vector<std::string>& bsps) {
+// Up to a dozen map names, those sharing the longest prefix with `wanted` first.
+std::string someMaps(std::vector<std::string> bsps, const std::string& wanted = "") {
+    auto common = [&](const std::string& path) {
+        const std::string n = mapNameOf(path);
+        size_t k = 0;
+        while (k < n.size() && k < wanted.size() && n[k] == wanted[k])
+            ++k;
+        return k;
+    };
+    std::stable_sort(bsps.begin(), bsps.end(), [&](const std::string& a, const std::string& b) {
+        return common(a) > common(b);
+    });
     std::string out;
     const size_t shown = std::min<size_t>(bsps.size(), 12);
     for (size_t i = 0; i < shown; ++i)
@@ -75,7 +86,7 @@ Expected<Scene> loadInstalledMap(const std::string& game, const std::string& dir
     if (!bytes) {
         const auto bsps = files.list("maps/", ".bsp");
         return makeError(fmt::format("{}: no {} in the {} pk3 files of {}; available: {}", name,
-                                     path, files.archiveCount(), dir, someMaps(bsps)));
+                                     path, files.archiveCount(), dir, someMaps(bsps, lower(map))));
     }
     return finish(parseBsp(*bytes, name, &files, opts));
 }
