@@ -1,0 +1,65 @@
+// libFuzzer target for the qvr wire protocol (docs/PROTOCOL.md): whole control messages, header
+// then payload as the transport reads them, media datagrams, and a stream of datagrams through
+// the reassembler. A decoded message must re-encode to bytes that decode again.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "qvr/core/check.h"
+#include "qvr/net/protocol.h"
+#include "qvr/net/stream_assembler.h"
+
+using namespace qvr::net;
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    const std::span<const uint8_t> bytes(data, size);
+
+    ControlMessage message;
+    if (decodeControl(bytes, message) == WireError::kNone) {
+        const auto again = encodeControl(message);
+        ControlMessage back;
+        QVR_CHECK(decodeControl(again, back) == WireError::kNone);
+        QVR_CHECK(encodeControl(back) == again);
+    }
+    // The transport's path: the header alone decides how much payload to read.
+    ControlHeader header;
+    if (decodeControlHeader(bytes, header) == WireError::kNone) {
+        QVR_CHECK(header.payload_bytes <= kMaxControlPayloadBytes);
+        const auto payload = bytes.subspan(kControlHeaderBytes);
+        ControlMessage m;
+        (void)decodeControlPayload(header.type,
+                                   payload.first(std::min<size_t>(payload.size(),
+                                                                  header.payload_bytes)),
+                                   m);
+    }
+
+    MediaPacketView view;
+    if (decodeMediaPacket(bytes, view) == WireError::kNone) {
+        QVR_CHECK(view.payload.size() == view.header.payload_bytes);
+        QVR_CHECK(view.payload.size() <= kMediaChunkBytes);
+    }
+
+    // The input as a sequence of datagrams, each prefixed by a 2-byte length, fed to one
+    // reassembler with a small budget; the clock advances 1 ms per datagram.
+    AssemblerLimits limits;
+    limits.max_buffered_bytes = 256 << 10;
+    StreamAssembler assembler(limits);
+    size_t pos = 0;
+    int64_t now_ns = 0;
+    while (pos + 2 <= size) {
+        const size_t n = std::min<size_t>(size - pos - 2, data[pos] | (data[pos + 1] << 8));
+        const auto datagram = bytes.subspan(pos + 2, n);
+        pos += 2 + n;
+        now_ns += 1'000'000;
+        if (decodeMediaPacket(datagram, view) == WireError::kNone) {
+            assembler.onPacket(view, now_ns);
+        }
+        assembler.expire(now_ns);
+        QVR_CHECK(assembler.bufferedBytes() <= limits.max_buffered_bytes);
+        for (const CompletedStream& s : assembler.takeCompleted()) {
+            QVR_CHECK(s.stream_id < kMaxStreams && !s.bytes.empty());
+        }
+        (void)assembler.takeLost();
+    }
+    return 0;
+}
