@@ -1,5 +1,5 @@
-// The renderer without a device: what tests of frame logic use when they need the counts of a
-// rendering but not its pixels.
+// The renderer without a device, what tests of frame logic use when they need the counts of a
+// rendering but not its pixels; and the device-independent pieces every renderer shares.
 #include <vector>
 
 #include "qvr/render/renderer.h"
@@ -22,6 +22,17 @@ BatchSelection selectBatches(const std::vector<SceneBatch>& batches, const Rende
         s.triangles += b.index_count / 3;
     }
     return s;
+}
+
+Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
+                                  const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
+                                  ImageRgba8& out, const CameraOptions& options) {
+    const LayerRect& layer = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
+    if (layer.empty()) {
+        out.resize(0, 0);
+        return RenderStats{};
+    }
+    return renderer.render(layerView(profile, head, eye, layer, options), out);
 }
 
 namespace {

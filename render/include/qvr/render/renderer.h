@@ -44,6 +44,13 @@ public:
     virtual Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) = 0;
 };
 
+// One layer of a layer plan for one eye: its sub-frustum into an image of the layer's own size
+// (paper §3.2). An empty layer (e.g. no middle layer when the fovea covers the field) gives an
+// empty image and zero stats.
+Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
+                                  const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
+                                  ImageRgba8& out, const CameraOptions& options = {});
+
 // Renders nothing: fills the image with the clear colour and reports the triangles the batches
 // that survive frustum culling hold — the same count the OpenGL renderer submits.
 std::unique_ptr<Renderer> makeNullRenderer();
