@@ -184,8 +184,8 @@ static Registered registerUcaBench(CLI::App& bench) {
         if (o.quality) {
             auto row = [](const char* name, const QualityReport& q) {
                 fmt::print(
-                    "  {:<9} PSNR fovea {:6.2f} dB  periphery {:6.2f} dB  all {:6.2f} dB   "
-                    "SSIM fovea {:.4f}  periphery {:.4f}\n",
+                    "  {:<9} PSNR fovea {:7.3f} dB  periphery {:7.3f} dB  all {:7.3f} dB   "
+                    "SSIM fovea {:.5f}  periphery {:.5f}\n",
                     name, q.fovea.psnr_db, q.periphery.psnr_db, q.all.psnr_db, q.fovea.ssim,
                     q.periphery.ssim);
             };
