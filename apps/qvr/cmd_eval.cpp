@@ -25,6 +25,7 @@ struct EvalCliOptions {
     std::string out;
     std::vector<std::string> mahimahi;
     std::vector<std::string> benches;
+    std::string hardware;
 };
 
 std::string joinArgs(const EvalCliOptions& o) {
@@ -60,7 +61,15 @@ int runEval(const EvalCliOptions& o) {
             return 2;
         }
     }
+    if (!o.hardware.empty()) {
+        auto hw = loadHardwareConfig(o.hardware, 500.0);
+        if (!hw) {
+            std::fprintf(stderr, "qvr eval: %s\n", hw.error().c_str());
+            return 2;
+        }
+    }
     EvalOptions opts;
+    opts.hardware_path = o.hardware;
     opts.mahimahi_traces = o.mahimahi;
     opts.benches = o.benches;
     opts.frames = o.frames;
@@ -112,6 +121,8 @@ static Registered registerEval(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--bench", o->benches,
                     "Run only these suite workloads (repeatable); default: all seven");
+    cmd->add_option("--hardware", o->hardware,
+                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)");
     cmd->add_option("--mahimahi", o->mahimahi,
                     "Mahimahi capacity traces (e.g. ../shared/data/network/*.down) to replay, "
                     "rescaled to 100 Mbps, for ffr, dfr and qvr");

@@ -27,6 +27,7 @@ struct SimOptions {
     int frames = 300;
     std::string out;
     uint64_t seed = 1;
+    std::string hardware;
 };
 
 int runSim(const SimOptions& o) {
@@ -67,10 +68,19 @@ int runSim(const SimOptions& o) {
         std::fprintf(stderr, "qvr sim: the workload has no frames\n");
         return 2;
     }
+    HardwareConfig hardware = defaultHardware(o.gpu_mhz);
+    if (!o.hardware.empty()) {
+        auto hw = loadHardwareConfig(o.hardware, o.gpu_mhz);
+        if (!hw) {
+            std::fprintf(stderr, "qvr sim: %s\n", hw.error().c_str());
+            return 2;
+        }
+        hardware = *hw;
+    }
     SimConfig cfg;
     cfg.bench = trace->header.name;
     cfg.design = *design;
-    cfg.hardware = defaultHardware(o.gpu_mhz);
+    cfg.hardware = hardware;
     cfg.frames = o.frames;
     if (static_cast<size_t>(o.frames) > trace->frames.size())
         std::fprintf(stderr, "qvr sim: the trace has %zu frames; simulating all of them\n",
@@ -133,6 +143,8 @@ static Registered registerSim(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--frames", o->frames, "Frames to simulate (1..1000000)")
         ->capture_default_str();
+    cmd->add_option("--hardware", o->hardware,
+                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)");
     cmd->add_option("--seed", o->seed, "Seed of the network noise")->capture_default_str();
     cmd->add_option("--out", o->out, "Output folder for frames.csv and summary.json")->required();
     return {cmd, [o]() { return runSim(*o); }};

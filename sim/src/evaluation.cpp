@@ -244,6 +244,21 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             for (Design d : trace_designs)
                 jobs.push_back({b, d, kDefaultMhz, net, false});
 
+    // Hardware at each clock, from the defaults or the user's overrides.
+    std::map<double, HardwareConfig> hardware;
+    for (const Job& job : jobs) {
+        if (hardware.count(job.gpu_mhz))
+            continue;
+        if (options.hardware_path.empty()) {
+            hardware[job.gpu_mhz] = defaultHardware(job.gpu_mhz);
+        } else {
+            auto hw = loadHardwareConfig(options.hardware_path, job.gpu_mhz);
+            if (!hw)
+                return makeError(hw.error());
+            hardware[job.gpu_mhz] = *hw;
+        }
+    }
+
     std::vector<JobResult> results(jobs.size());
     std::atomic<size_t> next{0};
     std::atomic<int> done{0};
@@ -274,7 +289,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             SimConfig cfg;
             cfg.bench = benches[job.bench].name;
             cfg.design = job.design;
-            cfg.hardware = defaultHardware(job.gpu_mhz);
+            cfg.hardware = hardware.at(job.gpu_mhz);
             cfg.frames = options.frames;
             if (job.keep_frames)
                 cfg.frames = frames;

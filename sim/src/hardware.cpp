@@ -2,6 +2,8 @@
 // sources: docs/MODEL.md.
 #include "qvr/sim/hardware.h"
 
+#include "qvr/core/config.h"
+
 namespace qvr {
 
 double MobileGpuConfig::samplesPerMs() const {
@@ -29,6 +31,68 @@ HardwareConfig defaultHardware(double gpu_mhz) {
     HardwareConfig hw;
     hw.gpu.render.freq_mhz = gpu_mhz;
     return hw;
+}
+
+Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
+                                             std::string_view source_name, double gpu_mhz) {
+    auto table = parseTomlText(toml_text, source_name);
+    if (!table)
+        return makeError(table.error());
+    HardwareConfig hw = defaultHardware(gpu_mhz);
+    ConfigReader r(*table, std::string(source_name));
+    MobileGpuConfig& g = hw.gpu;
+    g.render.triangles_per_ms_at_500 =
+        r.number("gpu.triangles_per_ms_at_500", g.render.triangles_per_ms_at_500, 1.0, 1e9);
+    g.render.pixels_per_ms_at_500 =
+        r.number("gpu.pixels_per_ms_at_500", g.render.pixels_per_ms_at_500, 1.0, 1e9);
+    g.render.setup_ms = r.number("gpu.setup_ms", g.render.setup_ms, 0.0, 100.0);
+    g.texture_units = r.number("gpu.texture_units", g.texture_units, 1.0, 1024.0);
+    g.samples_per_unit_per_cycle =
+        r.number("gpu.samples_per_unit_per_cycle", g.samples_per_unit_per_cycle, 0.01, 64.0);
+    g.pass_overhead_ms = r.number("gpu.pass_overhead_ms", g.pass_overhead_ms, 0.0, 100.0);
+    g.preempt_overhead_ms = r.number("gpu.preempt_overhead_ms", g.preempt_overhead_ms, 0.0, 100.0);
+    g.atw_samples_per_px = r.number("gpu.atw_samples_per_px", g.atw_samples_per_px, 0.0, 16.0);
+    g.comp_samples_per_px = r.number("gpu.comp_samples_per_px", g.comp_samples_per_px, 0.0, 16.0);
+    g.static_comp_samples_per_px =
+        r.number("gpu.static_comp_samples_per_px", g.static_comp_samples_per_px, 0.0, 16.0);
+    g.dynamic_power_w_at_500 =
+        r.number("gpu.dynamic_power_w_at_500", g.dynamic_power_w_at_500, 0.0, 100.0);
+    g.static_power_w_at_500 =
+        r.number("gpu.static_power_w_at_500", g.static_power_w_at_500, 0.0, 100.0);
+    g.v0 = r.number("gpu.v0", g.v0, 0.0, 2.0);
+    g.v_per_mhz = r.number("gpu.v_per_mhz", g.v_per_mhz, 0.0, 0.01);
+    hw.uca.units = r.integer("uca.units", hw.uca.units, 1, 64);
+    hw.uca.freq_mhz = r.number("uca.freq_mhz", hw.uca.freq_mhz, 1.0, 10000.0);
+    hw.uca.cycles_per_tile = r.number("uca.cycles_per_tile", hw.uca.cycles_per_tile, 1.0, 1e6);
+    hw.uca.tile_px = r.integer("uca.tile_px", hw.uca.tile_px, 4, 256);
+    hw.uca.power_w = r.number("uca.power_w", hw.uca.power_w, 0.0, 100.0);
+    hw.liwc.decision_ms = r.number("liwc.decision_ms", hw.liwc.decision_ms, 0.0, 100.0);
+    hw.liwc.power_w = r.number("liwc.power_w", hw.liwc.power_w, 0.0, 100.0);
+    hw.remote.server_speedup =
+        r.number("remote.server_speedup", hw.remote.server_speedup, 0.01, 1e6);
+    hw.remote.encoder_px_per_ms =
+        r.number("remote.encoder_px_per_ms", hw.remote.encoder_px_per_ms, 1.0, 1e9);
+    hw.remote.decoder_px_per_ms =
+        r.number("remote.decoder_px_per_ms", hw.remote.decoder_px_per_ms, 1.0, 1e9);
+    hw.remote.decode_overhead_ms =
+        r.number("remote.decode_overhead_ms", hw.remote.decode_overhead_ms, 0.0, 100.0);
+    hw.cpu.control_logic_ms =
+        r.number("cpu.control_logic_ms", hw.cpu.control_logic_ms, 0.0, 1000.0);
+    hw.cpu.local_setup_ms = r.number("cpu.local_setup_ms", hw.cpu.local_setup_ms, 0.0, 1000.0);
+    hw.cpu.software_control_ms =
+        r.number("cpu.software_control_ms", hw.cpu.software_control_ms, 0.0, 1000.0);
+    hw.fixed.sensor_ms = r.number("latency.sensor_ms", hw.fixed.sensor_ms, 0.0, 1000.0);
+    hw.fixed.display_ms = r.number("latency.display_ms", hw.fixed.display_ms, 0.0, 1000.0);
+    if (auto st = r.finish(); !st)
+        return makeError(st.error());
+    return hw;
+}
+
+Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz) {
+    auto text = readTextFile(path);
+    if (!text)
+        return makeError(text.error());
+    return parseHardwareConfig(*text, path, gpu_mhz);
 }
 
 }  // namespace qvr

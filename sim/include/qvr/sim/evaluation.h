@@ -19,6 +19,8 @@ struct EvalOptions {
     // Mahimahi capacity traces to replay (rescaled to 100 Mbps) for Q-VR, DFR and FFR; none
     // by default.
     std::vector<std::string> mahimahi_traces;
+    // TOML overrides of the hardware defaults (parseHardwareConfig); empty keeps them.
+    std::string hardware_path;
     // A subset of the suite by name; empty runs all seven.
     std::vector<std::string> benches;
     std::string command_line;                           // recorded in the report

@@ -3,6 +3,10 @@
 // control logic, and a multi-GPU render server. Every constant's source is in docs/MODEL.md.
 #pragma once
 
+#include <string>
+#include <string_view>
+
+#include "qvr/core/expected.h"
 #include "qvr/workload/cost_model.h"
 
 namespace qvr {
@@ -88,5 +92,24 @@ struct HardwareConfig {
 
 // The defaults of docs/MODEL.md at a given GPU clock.
 HardwareConfig defaultHardware(double gpu_mhz = 500.0);
+
+// Overrides of the defaults from TOML, so a researcher can ask about another headset without
+// recompiling. Every key is optional; unknown keys and out-of-range values are errors. The clock
+// stays a command-line choice (`--gpu-mhz`), since `qvr eval` sweeps it. Grammar:
+//   [gpu]     triangles_per_ms_at_500, pixels_per_ms_at_500 (1…1e9), setup_ms (0…100),
+//             texture_units (1…1024), samples_per_unit_per_cycle (0.01…64),
+//             pass_overhead_ms, preempt_overhead_ms (0…100), atw_samples_per_px,
+//             comp_samples_per_px, static_comp_samples_per_px (0…16),
+//             dynamic_power_w_at_500, static_power_w_at_500 (0…100), v0 (0…2), v_per_mhz (0…0.01)
+//   [uca]     units (1…64), freq_mhz (1…10000),
+//             cycles_per_tile (1…1e6), tile_px (4…256), power_w (0…100)
+//   [liwc]    decision_ms (0…100), power_w (0…100)
+//   [remote]  server_speedup (0.01…1e6), encoder_px_per_ms, decoder_px_per_ms (1…1e9),
+//             decode_overhead_ms (0…100)
+//   [cpu]     control_logic_ms, local_setup_ms, software_control_ms (0…1000)
+//   [latency] sensor_ms, display_ms (0…1000)
+Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
+                                             std::string_view source_name, double gpu_mhz);
+Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);
 
 }  // namespace qvr
