@@ -20,9 +20,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadPerDeg = kPi / 180.0;
 constexpr uint32_t kLeafTriangles = 4;
-// Node-level decisions keep this far (radians) from ring and cone boundaries, so rounding in
-// the bound computations can never disagree with the per-triangle test.
-constexpr double kAngleMargin = 1e-7;
 constexpr int kMaxClipVertices = 16;
 
 struct Plane {
@@ -136,68 +133,198 @@ void checkView(const EyeView& v) {
 }
 
 // The part of a world-space triangle inside the frustum, in eye space.
-Polygon clipToView(const glm::vec3* tri, const EyeView& view, const std::array<Plane, 6>& eye) {
-    const glm::dquat inv = glm::conjugate(view.orientation);
-    Polygon poly;
-    poly.count = 3;
-    for (int k = 0; k < 3; ++k)
-        poly.v[static_cast<size_t>(k)] = inv * (glm::dvec3(tri[k]) - view.position_m);
-    for (const Plane& p : eye)
-        clip(poly, p);
-    return poly;
-}
+// Rings are classified by cosines against precomputed boundaries, and bounding spheres' angular
+// extents are computed without trigonometric calls: both run for every node a query visits.
+// Node-level decisions keep kCosMargin away from a boundary so that rounding can never make
+// them disagree with the exact per-triangle test.
+constexpr double kCosMargin = 1e-9;
 
-struct ConeFrame {
-    glm::dvec3 apex;
-    glm::dvec3 axis;  // unit
-    double half_angle;
-    double near_m, far_m;
+// Angular extent about a unit axis of a sphere seen from the origin, as cosines: every point
+// of the sphere lies at an angle whose cosine is within [cos_hi, cos_lo]. Not valid when the
+// sphere contains the origin.
+struct CosRange {
+    double cos_lo = 1.0;
+    double cos_hi = -1.0;
+    bool valid = false;
 };
 
-ConeFrame coneFrame(const ViewCone& c) {
-    QVR_CHECK_MSG(c.half_angle_deg > 0.0 && c.half_angle_deg < 90.0,
-                  "cone half-angle must be in (0, 90) degrees");
-    QVR_CHECK_MSG(glm::length(c.direction) > 0.0, "cone direction is zero");
-    QVR_CHECK_MSG(c.near_m >= 0.0 && c.far_m > c.near_m, "cone needs 0 ≤ near < far");
-    return {c.apex_m, glm::normalize(c.direction), c.half_angle_deg * kRadPerDeg, c.near_m,
-            c.far_m};
+CosRange sphereCosRange(const glm::dvec3& center, double radius, const glm::dvec3& axis) {
+    CosRange r;
+    const double d2 = glm::dot(center, center);
+    if (d2 <= radius * radius)
+        return r;
+    const double d = std::sqrt(d2);
+    const double c = glm::dot(axis, center) / d;                 // cos θ of the centre
+    const double s = glm::length(glm::cross(axis, center)) / d;  // sin θ
+    const double sd = radius / d;                                // sin δ, the half-extent
+    const double cd = std::sqrt(std::max(0.0, 1.0 - sd * sd));
+    r.valid = true;
+    // θ − δ ∈ [−π/2, π]: it is ≤ 0 exactly when its sine is.
+    if (s * cd - c * sd > 0.0)
+        r.cos_lo = c * cd + s * sd;
+    // θ + δ ∈ [0, 3π/2]: it stays ≤ π exactly when its sine is ≥ 0.
+    if (s * cd + c * sd >= 0.0)
+        r.cos_hi = c * cd - s * sd;
+    return r;
 }
 
-bool triangleInCone(const glm::vec3* tri, const ConeFrame& c) {
-    Polygon poly;
-    poly.count = 3;
-    for (int k = 0; k < 3; ++k)
-        poly.v[static_cast<size_t>(k)] = glm::dvec3(tri[k]) - c.apex;
-    clip(poly, Plane{c.axis, -c.near_m});
-    clip(poly, Plane{-c.axis, c.far_m});
-    if (poly.count == 0)
-        return false;
-    return minAngle(poly, c.axis) <= c.half_angle;
-}
+// Ring k covers angles [k·ring, (k + 1)·ring); the last ring is open-ended.
+class RingBounds {
+public:
+    RingBounds(double ring_rad, int rings) : m_ring_rad(ring_rad), m_rings(rings) {
+        for (int j = 1; j < rings && j * ring_rad < kPi; ++j)
+            m_cos.push_back(std::cos(j * ring_rad));
+    }
+    // The defining classification, from an angle.
+    int ofAngle(double angle_rad) const {
+        const double k = std::floor(angle_rad / m_ring_rad);
+        return k >= static_cast<double>(m_rings - 1) ? m_rings - 1 : static_cast<int>(k);
+    }
+    // From a cosine: the number of boundaries the angle has reached.
+    int ofCos(double c) const {
+        int k = 0;
+        const int n = static_cast<int>(m_cos.size());
+        while (k < n && m_cos[static_cast<size_t>(k)] >= c)
+            ++k;
+        return k;
+    }
+    // The ring all of a range lies in, or −1 when it may span two.
+    int ofRange(const CosRange& r) const {
+        if (!r.valid)
+            return -1;
+        const int lo = ofCos(std::min(1.0, r.cos_lo + kCosMargin));
+        const int hi = ofCos(r.cos_hi - kCosMargin);
+        return lo == hi ? lo : -1;
+    }
 
-int ringOf(double angle_rad, double ring_rad, int rings) {
-    const double k = std::floor(angle_rad / ring_rad);
-    return k >= static_cast<double>(rings - 1) ? rings - 1 : static_cast<int>(k);
-}
-
-// The range of angles from axis (unit) under which a bounding sphere is seen from the origin.
-struct AngleRange {
-    double lo, hi;
+private:
+    double m_ring_rad;
+    int m_rings;
+    std::vector<double> m_cos;  // cos(j·ring) for the boundaries j = 1 … below 180°
 };
-AngleRange sphereAngles(const glm::dvec3& center, double radius, const glm::dvec3& axis) {
-    const double dist = glm::length(center);
-    if (dist <= radius)
-        return {0.0, kPi};
-    const double theta = angleBetween(axis, center);
-    const double delta = std::asin(std::min(1.0, radius / dist));
-    return {std::max(0.0, theta - delta), std::min(kPi, theta + delta)};
+
+// Bounding sphere of three points (centroid-centred: looser than minimal, cheaper).
+void triangleSphere(const glm::dvec3* v, glm::dvec3& center, double& radius) {
+    center = (v[0] + v[1] + v[2]) / 3.0;
+    radius = std::sqrt(std::max({glm::dot(v[0] - center, v[0] - center),
+                                 glm::dot(v[1] - center, v[1] - center),
+                                 glm::dot(v[2] - center, v[2] - center)})) *
+             (1.0 + 1e-12);
 }
+
+// A frustum query prepared once: eye-space planes, the world-to-eye rotation, the gaze.
+class ViewQuery {
+public:
+    ViewQuery(const EyeView& view, const glm::dvec3& gaze_dir_eye, double ring_deg, int rings)
+        : m_view(view),
+          m_eye(eyeFrustum(view)),
+          m_world_to_eye(glm::mat3_cast(glm::conjugate(view.orientation))),
+          m_gaze(glm::normalize(gaze_dir_eye)),
+          m_rings(ring_deg * kRadPerDeg, rings),
+          m_ring_count(rings) {}
+
+    const RingBounds& rings() const { return m_rings; }
+    int ringCount() const { return m_ring_count; }
+
+    // The ring of a world-space triangle, −1 when it misses the frustum. exact_only skips the
+    // shortcuts (no clipping when all vertices are inside, ring from the bounding sphere when
+    // unambiguous) and applies the definition directly, for the brute-force twin.
+    int classify(const glm::vec3* tri, bool exact_only) const {
+        Polygon poly;
+        poly.count = 3;
+        for (size_t k = 0; k < 3; ++k)
+            poly.v[k] = m_world_to_eye * (glm::dvec3(tri[k]) - m_view.position_m);
+        bool inside = !exact_only;
+        for (const Plane& p : m_eye) {
+            if (!inside)
+                break;
+            for (size_t k = 0; k < 3; ++k)
+                inside = inside && p.distance(poly.v[k]) >= 0.0;
+        }
+        if (!inside) {
+            for (const Plane& p : m_eye)
+                clip(poly, p);
+            if (poly.count == 0)
+                return -1;
+        }
+        if (m_ring_count == 1)
+            return 0;
+        if (inside) {
+            glm::dvec3 center;
+            double radius;
+            triangleSphere(poly.v.data(), center, radius);
+            const int ring = m_rings.ofRange(sphereCosRange(center, radius, m_gaze));
+            if (ring >= 0)
+                return ring;
+        }
+        return m_rings.ofAngle(minAngle(poly, m_gaze));
+    }
+
+private:
+    EyeView m_view;
+    std::array<Plane, 6> m_eye;
+    glm::dmat3 m_world_to_eye;
+    glm::dvec3 m_gaze;
+    RingBounds m_rings;
+    int m_ring_count;
+};
+
+// A cone query prepared once.
+class ConeQuery {
+public:
+    explicit ConeQuery(const ViewCone& c) {
+        QVR_CHECK_MSG(c.half_angle_deg > 0.0 && c.half_angle_deg < 90.0,
+                      "cone half-angle must be in (0, 90) degrees");
+        QVR_CHECK_MSG(glm::length(c.direction) > 0.0, "cone direction is zero");
+        QVR_CHECK_MSG(c.near_m >= 0.0 && c.far_m > c.near_m, "cone needs 0 ≤ near < far");
+        apex = c.apex_m;
+        axis = glm::normalize(c.direction);
+        half_angle = c.half_angle_deg * kRadPerDeg;
+        cos_half = std::cos(half_angle);
+        near_m = c.near_m;
+        far_m = c.far_m;
+    }
+
+    bool contains(const glm::vec3* tri, bool exact_only) const {
+        Polygon poly;
+        poly.count = 3;
+        bool inside = !exact_only;
+        for (size_t k = 0; k < 3; ++k) {
+            poly.v[k] = glm::dvec3(tri[k]) - apex;
+            const double along = glm::dot(poly.v[k], axis);
+            inside = inside && along >= near_m && along <= far_m;
+        }
+        if (inside) {
+            glm::dvec3 center;
+            double radius;
+            triangleSphere(poly.v.data(), center, radius);
+            const CosRange r = sphereCosRange(center, radius, axis);
+            if (r.valid && r.cos_lo < cos_half - kCosMargin)
+                return false;
+            if (r.valid && r.cos_hi > cos_half + kCosMargin)
+                return true;
+        } else {
+            clip(poly, Plane{axis, -near_m});
+            clip(poly, Plane{-axis, far_m});
+            if (poly.count == 0)
+                return false;
+        }
+        return minAngle(poly, axis) <= half_angle;
+    }
+
+    glm::dvec3 apex, axis;
+    double half_angle, cos_half, near_m, far_m;
+};
 
 enum class BoxSide { kOutside, kInside, kStraddles };
 
-BoxSide boxAgainst(const glm::vec3& mn, const glm::vec3& mx, const Plane* planes, int count) {
-    bool all_inside = true;
+// Tests a box against the planes whose bit is set in *mask and clears the bits of planes the
+// box lies entirely inside, so a subtree never re-tests a plane its ancestor already cleared.
+BoxSide boxAgainst(const glm::vec3& mn, const glm::vec3& mx, const Plane* planes, int count,
+                   uint32_t* mask) {
     for (int i = 0; i < count; ++i) {
+        if ((*mask & (1u << i)) == 0)
+            continue;
         const Plane& p = planes[i];
         // The box corner farthest along the normal, and the nearest one.
         const glm::dvec3 far_c(p.n.x >= 0 ? mx.x : mn.x, p.n.y >= 0 ? mx.y : mn.y,
@@ -208,10 +335,10 @@ BoxSide boxAgainst(const glm::vec3& mn, const glm::vec3& mx, const Plane* planes
         const double slack = 1e-9 * (1.0 + std::fabs(p.d));
         if (p.distance(far_c) < -slack)
             return BoxSide::kOutside;
-        if (p.distance(near_c) < slack)
-            all_inside = false;
+        if (p.distance(near_c) >= slack)
+            *mask &= ~(1u << i);
     }
-    return all_inside ? BoxSide::kInside : BoxSide::kStraddles;
+    return *mask == 0 ? BoxSide::kInside : BoxSide::kStraddles;
 }
 
 }  // namespace
@@ -312,113 +439,129 @@ void TriangleBvh::build(const std::vector<glm::vec3>& positions,
     }
 }
 
-uint64_t TriangleBvh::countTrianglesInCone(const ViewCone& cone) const {
-    const ConeFrame c = coneFrame(cone);
+namespace {
+
+// Node bounding sphere from its box.
+void nodeSphere(const glm::vec3& mn, const glm::vec3& mx, glm::dvec3& center, double& radius) {
+    center = 0.5 * (glm::dvec3(mn) + glm::dvec3(mx));
+    radius = 0.5 * glm::length(glm::dvec3(mx) - glm::dvec3(mn)) * (1.0 + 1e-12);
+}
+
+}  // namespace
+
+uint64_t TriangleBvh::countTrianglesInCone(const ViewCone& cone, BvhQueryStats* stats) const {
+    BvhQueryStats local;
+    BvhQueryStats& st = stats != nullptr ? *stats : local;
+    const ConeQuery q(cone);
     if (m_tri_count == 0)
         return 0;
-    const Plane slab[2] = {Plane{c.axis, -c.near_m - glm::dot(c.axis, c.apex)},
-                           Plane{-c.axis, c.far_m + glm::dot(c.axis, c.apex)}};
+    const Plane slab[2] = {Plane{q.axis, -q.near_m - glm::dot(q.axis, q.apex)},
+                           Plane{-q.axis, q.far_m + glm::dot(q.axis, q.apex)}};
     uint64_t count = 0;
-    uint32_t stack[64];
+    // (node, planes still to test) pairs.
+    std::pair<uint32_t, uint32_t> stack[64];
     int top = 0;
-    stack[top++] = 0;
+    stack[top++] = {0u, (1u << 2) - 1};
     while (top > 0) {
-        const Node& node = m_nodes[stack[--top]];
-        const BoxSide side = boxAgainst(node.min, node.max, slab, 2);
+        auto [node_index, mask] = stack[--top];
+        const Node& node = m_nodes[node_index];
+        ++st.nodes_visited;
+        const BoxSide side = boxAgainst(node.min, node.max, slab, 2, &mask);
         if (side == BoxSide::kOutside)
             continue;
-        const glm::dvec3 center = 0.5 * (glm::dvec3(node.min) + glm::dvec3(node.max));
-        const double radius = 0.5 * glm::length(glm::dvec3(node.max) - glm::dvec3(node.min));
-        const AngleRange r = sphereAngles(center - c.apex, radius, c.axis);
-        if (r.lo > c.half_angle + kAngleMargin)
-            continue;
-        if (side == BoxSide::kInside && r.hi < c.half_angle - kAngleMargin &&
-            glm::length(center - c.apex) > radius * (1.0 + 1e-9) + 1e-9) {
+        glm::dvec3 center;
+        double radius;
+        nodeSphere(node.min, node.max, center, radius);
+        const CosRange r = sphereCosRange(center - q.apex, radius, q.axis);
+        if (r.valid && r.cos_lo < q.cos_half - kCosMargin)
+            continue;  // entirely outside the cone
+        if (side == BoxSide::kInside && r.valid && r.cos_hi > q.cos_half + kCosMargin) {
             // The whole subtree lies inside the cone: count it without visiting.
             count += node.end - node.begin;
+            ++st.nodes_accepted_whole;
             continue;
         }
         if (node.left == 0) {
+            st.triangles_tested += node.end - node.begin;
             for (uint32_t i = node.begin; i < node.end; ++i)
-                count += triangleInCone(&m_tri[3 * static_cast<size_t>(i)], c) ? 1 : 0;
+                count += q.contains(&m_tri[3 * static_cast<size_t>(i)], false) ? 1 : 0;
         } else {
             QVR_CHECK(top + 2 <= 64);
-            stack[top++] = node.left;
-            stack[top++] = node.left + 1;
+            stack[top++] = {node.left, mask};
+            stack[top++] = {node.left + 1, mask};
         }
     }
     return count;
 }
 
 uint64_t TriangleBvh::countTrianglesInConeBruteForce(const ViewCone& cone) const {
-    const ConeFrame c = coneFrame(cone);
+    const ConeQuery q(cone);
     uint64_t count = 0;
     for (size_t t = 0; t < m_tri_count; ++t)
-        count += triangleInCone(&m_tri[3 * t], c) ? 1 : 0;
+        count += q.contains(&m_tri[3 * t], true) ? 1 : 0;
     return count;
 }
 
-uint64_t TriangleBvh::countTrianglesInFrustum(const EyeView& view) const {
-    const std::vector<uint64_t> rings = trianglesPerRing(view, glm::dvec3(0, 0, -1), 180.0, 1);
-    return rings[0];
+uint64_t TriangleBvh::countTrianglesInFrustum(const EyeView& view, BvhQueryStats* stats) const {
+    return trianglesPerRing(view, glm::dvec3(0, 0, -1), 180.0, 1, stats)[0];
 }
 
 uint64_t TriangleBvh::countTrianglesInFrustumBruteForce(const EyeView& view) const {
-    checkView(view);
-    const auto eye = eyeFrustum(view);
-    uint64_t count = 0;
-    for (size_t t = 0; t < m_tri_count; ++t)
-        count += clipToView(&m_tri[3 * t], view, eye).count > 0 ? 1 : 0;
-    return count;
+    return trianglesPerRingBruteForce(view, glm::dvec3(0, 0, -1), 180.0, 1)[0];
 }
 
 std::vector<uint64_t> TriangleBvh::trianglesPerRing(const EyeView& view,
                                                     const glm::dvec3& gaze_dir_eye, double ring_deg,
-                                                    int rings) const {
+                                                    int rings, BvhQueryStats* stats) const {
+    BvhQueryStats local;
+    BvhQueryStats& st = stats != nullptr ? *stats : local;
     checkView(view);
     QVR_CHECK_MSG(rings >= 1 && ring_deg > 0.0, "need rings ≥ 1 and ring_deg > 0");
     QVR_CHECK_MSG(glm::length(gaze_dir_eye) > 0.0, "gaze direction is zero");
     std::vector<uint64_t> hist(static_cast<size_t>(rings), 0);
     if (m_tri_count == 0)
         return hist;
-    const auto eye = eyeFrustum(view);
+    const ViewQuery q(view, gaze_dir_eye, ring_deg, rings);
     const auto world = worldFrustum(view);
-    const glm::dvec3 g_eye = glm::normalize(gaze_dir_eye);
-    const glm::dvec3 g_world = view.orientation * g_eye;
-    const double ring_rad = ring_deg * kRadPerDeg;
-    uint32_t stack[64];
+    const glm::dvec3 g_world = view.orientation * glm::normalize(gaze_dir_eye);
+    // (node, planes still to test) pairs.
+    std::pair<uint32_t, uint32_t> stack[64];
     int top = 0;
-    stack[top++] = 0;
+    stack[top++] = {0u, (1u << 6) - 1};
     while (top > 0) {
-        const Node& node = m_nodes[stack[--top]];
-        const BoxSide side = boxAgainst(node.min, node.max, world.data(), 6);
+        auto [node_index, mask] = stack[--top];
+        const Node& node = m_nodes[node_index];
+        ++st.nodes_visited;
+        const BoxSide side = boxAgainst(node.min, node.max, world.data(), 6, &mask);
         if (side == BoxSide::kOutside)
             continue;
         if (side == BoxSide::kInside) {
             // Entirely inside the frustum: if its bounding sphere's angular range lies within
             // one ring, every triangle below lands in that ring.
-            const glm::dvec3 center = 0.5 * (glm::dvec3(node.min) + glm::dvec3(node.max));
-            const double radius = 0.5 * glm::length(glm::dvec3(node.max) - glm::dvec3(node.min));
-            const AngleRange r = sphereAngles(center - view.position_m, radius, g_world);
-            const int lo = ringOf(std::max(0.0, r.lo - kAngleMargin), ring_rad, rings);
-            const int hi = ringOf(r.hi + kAngleMargin, ring_rad, rings);
-            if (lo == hi && glm::length(center - view.position_m) > radius) {
-                hist[static_cast<size_t>(lo)] += node.end - node.begin;
+            int ring = 0;
+            if (rings > 1) {
+                glm::dvec3 center;
+                double radius;
+                nodeSphere(node.min, node.max, center, radius);
+                ring = q.rings().ofRange(sphereCosRange(center - view.position_m, radius, g_world));
+            }
+            if (ring >= 0) {
+                hist[static_cast<size_t>(ring)] += node.end - node.begin;
+                ++st.nodes_accepted_whole;
                 continue;
             }
         }
         if (node.left == 0) {
+            st.triangles_tested += node.end - node.begin;
             for (uint32_t i = node.begin; i < node.end; ++i) {
-                const Polygon poly = clipToView(&m_tri[3 * static_cast<size_t>(i)], view, eye);
-                if (poly.count == 0)
-                    continue;
-                const int ring = rings == 1 ? 0 : ringOf(minAngle(poly, g_eye), ring_rad, rings);
-                ++hist[static_cast<size_t>(ring)];
+                const int ring = q.classify(&m_tri[3 * static_cast<size_t>(i)], false);
+                if (ring >= 0)
+                    ++hist[static_cast<size_t>(ring)];
             }
         } else {
             QVR_CHECK(top + 2 <= 64);
-            stack[top++] = node.left;
-            stack[top++] = node.left + 1;
+            stack[top++] = {node.left, mask};
+            stack[top++] = {node.left + 1, mask};
         }
     }
     return hist;
@@ -429,16 +572,13 @@ std::vector<uint64_t> TriangleBvh::trianglesPerRingBruteForce(const EyeView& vie
                                                               double ring_deg, int rings) const {
     checkView(view);
     QVR_CHECK_MSG(rings >= 1 && ring_deg > 0.0, "need rings ≥ 1 and ring_deg > 0");
+    QVR_CHECK_MSG(glm::length(gaze_dir_eye) > 0.0, "gaze direction is zero");
     std::vector<uint64_t> hist(static_cast<size_t>(rings), 0);
-    const auto eye = eyeFrustum(view);
-    const glm::dvec3 g_eye = glm::normalize(gaze_dir_eye);
-    const double ring_rad = ring_deg * kRadPerDeg;
+    const ViewQuery q(view, gaze_dir_eye, ring_deg, rings);
     for (size_t t = 0; t < m_tri_count; ++t) {
-        const Polygon poly = clipToView(&m_tri[3 * t], view, eye);
-        if (poly.count == 0)
-            continue;
-        ++hist[static_cast<size_t>(rings == 1 ? 0
-                                              : ringOf(minAngle(poly, g_eye), ring_rad, rings))];
+        const int ring = q.classify(&m_tri[3 * t], true);
+        if (ring >= 0)
+            ++hist[static_cast<size_t>(ring)];
     }
     return hist;
 }

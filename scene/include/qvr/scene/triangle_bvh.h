@@ -53,6 +53,13 @@ struct ViewCone {
     double far_m = 1e30;
 };
 
+// What one query cost: for benchmarks and for checking that traversal prunes.
+struct BvhQueryStats {
+    uint64_t nodes_visited = 0;
+    uint64_t nodes_accepted_whole = 0;  // subtrees counted without visiting their triangles
+    uint64_t triangles_tested = 0;      // exact per-triangle tests
+};
+
 class TriangleBvh {
 public:
     // Builds over the scene's triangles (positions copied; the scene may go away afterwards).
@@ -63,14 +70,15 @@ public:
     size_t nodeCount() const { return m_nodes.size(); }
 
     // Triangles intersecting the cone.
-    uint64_t countTrianglesInCone(const ViewCone& cone) const;
+    uint64_t countTrianglesInCone(const ViewCone& cone, BvhQueryStats* stats = nullptr) const;
     // Triangles intersecting the frustum.
-    uint64_t countTrianglesInFrustum(const EyeView& view) const;
+    uint64_t countTrianglesInFrustum(const EyeView& view, BvhQueryStats* stats = nullptr) const;
     // Triangles intersecting the frustum by ring of eccentricity around gaze_dir_eye (a direction
     // in eye space, e.g. EyeGeometry::gazeDirection): rings entries, ring k covering
     // [k·ring_deg, (k + 1)·ring_deg), the last one open-ended.
     std::vector<uint64_t> trianglesPerRing(const EyeView& view, const glm::dvec3& gaze_dir_eye,
-                                           double ring_deg, int rings) const;
+                                           double ring_deg, int rings,
+                                           BvhQueryStats* stats = nullptr) const;
 
     // Brute-force twins: the same definitions, every triangle tested.
     uint64_t countTrianglesInConeBruteForce(const ViewCone& cone) const;
