@@ -142,12 +142,8 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                 return;
             }
             const uint16_t media_port = c.media.local_endpoint(e).port();
-            const auto fail_write = [&, where](const asio::error_code& we) {
-                finish(makeError("connect " + where + ": " + we.message()));
-            };
-            c.writer.push(c.control, encodeControl(ClientHello{client_nonce, media_port}),
-                          fail_write);
-            c.reader.read(c.control, [&, media_port, fail_write](detail::ReadResult r) {
+            c.writer.push(c.control, encodeControl(ClientHello{client_nonce, media_port}));
+            c.reader.read(c.control, [&, media_port](detail::ReadResult r) {
                 if (r.ec || r.error != WireError::kNone) {
                     finish(makeError("connect " + where + ": no valid challenge from the server (" +
                                      (r.ec ? r.ec.message() : std::string(wireErrorName(r.error))) +
@@ -176,11 +172,9 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                                      ": the server does not hold the pre-shared key"));
                     return;
                 }
-                c.writer.push(c.control,
-                              encodeControl(ClientAuth{
-                                  clientProof(options.key, client_nonce, challenge.server_nonce,
-                                              challenge.session_id, media_port)}),
-                              fail_write);
+                c.writer.push(c.control, encodeControl(ClientAuth{clientProof(
+                                             options.key, client_nonce, challenge.server_nonce,
+                                             challenge.session_id, media_port)}));
                 c.reader.read(c.control, [&](detail::ReadResult w) {
                     if (w.ec) {
                         finish(makeError("connect " + where +
@@ -215,6 +209,10 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
             });
         });
 
+    // Replaced by the connection's handler before the network thread starts (startLoops).
+    c.writer.setErrorHandler([&finish, where](const asio::error_code& we) {
+        finish(makeError("connect " + where + ": " + we.message()));
+    });
     const auto deadline =
         std::chrono::steady_clock::now() + std::chrono::milliseconds(options.connect_timeout_ms);
     while (!st.done && !c.io.stopped()) {
@@ -264,11 +262,7 @@ void Client::Impl::sendControl(Connection& c, const ControlMessage& m) {
     if (c.closed) {
         return;
     }
-    Connection* cp = &c;
-    const bool queued =
-        c.writer.push(c.control, encodeControl(m), [this, cp](const asio::error_code& e) {
-            fail(*cp, makeError("connection to the server lost: " + e.message()));
-        });
+    const bool queued = c.writer.push(c.control, encodeControl(m));
     if (!queued) {
         fail(c, makeError("the server stopped reading control messages"));
     }
@@ -397,6 +391,9 @@ void Client::Impl::handleAssembler(Connection& c, int64_t now_ns) {
 }
 
 void Client::Impl::startLoops(Connection& c) {
+    c.writer.setErrorHandler([this, &c](const asio::error_code& e) {
+        fail(c, makeError("connection to the server lost: " + e.message()));
+    });
     readControl(c);
     readMedia(c);
     armExpiry(c);

@@ -5,6 +5,7 @@
 
 #include <asio.hpp>
 #include <deque>
+#include <functional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -66,20 +67,23 @@ private:
     std::array<uint8_t, kMaxControlPayloadBytes> m_payload{};
 };
 
-// A bounded queue of outgoing messages with one write in flight at a time.
+// A bounded queue of outgoing messages with one write in flight at a time. One error handler
+// for the whole queue, set by the owner: a write can complete after the code that queued it
+// has moved on (the handshake), so per-message callbacks could outlive what they refer to.
 class ControlWriter {
 public:
+    using ErrorHandler = std::function<void(const asio::error_code&)>;
     explicit ControlWriter(size_t max_queued) : m_max_queued(max_queued) {}
 
-    // False when the queue is full (the peer stopped reading). on_error(ec) runs on failure.
-    template <typename OnError>
-    bool push(asio::ip::tcp::socket& socket, std::vector<uint8_t> bytes, OnError on_error) {
+    void setErrorHandler(ErrorHandler on_error) { m_on_error = std::move(on_error); }
+    // False when the queue is full (the peer stopped reading).
+    bool push(asio::ip::tcp::socket& socket, std::vector<uint8_t> bytes) {
         if (m_queue.size() >= m_max_queued) {
             return false;
         }
         m_queue.push_back(std::move(bytes));
         if (!m_busy) {
-            writeNext(socket, std::move(on_error));
+            writeNext(socket);
         }
         return true;
     }
@@ -89,30 +93,32 @@ public:
     }
 
 private:
-    template <typename OnError>
-    void writeNext(asio::ip::tcp::socket& socket, OnError on_error) {
+    void writeNext(asio::ip::tcp::socket& socket) {
         if (m_queue.empty()) {
             m_busy = false;
             return;
         }
         m_busy = true;
         asio::async_write(socket, asio::buffer(m_queue.front()),
-                          [this, &socket, on_error](const asio::error_code& ec, size_t) mutable {
+                          [this, &socket](const asio::error_code& ec, size_t) {
                               if (ec) {
                                   m_busy = false;
-                                  on_error(ec);
+                                  if (ec != asio::error::operation_aborted && m_on_error) {
+                                      m_on_error(ec);
+                                  }
                                   return;
                               }
                               if (!m_queue.empty()) {
                                   m_queue.pop_front();
                               }
-                              writeNext(socket, std::move(on_error));
+                              writeNext(socket);
                           });
     }
 
     size_t m_max_queued;
     std::deque<std::vector<uint8_t>> m_queue;
     bool m_busy = false;
+    ErrorHandler m_on_error;
 };
 
 }  // namespace qvr::net::detail

@@ -39,6 +39,8 @@ struct Server::Impl {
     udp::socket udp_socket;
     std::thread thread;
     bool stopped = false;
+    uint16_t port = 0;  // fixed at start, read by any thread
+    uint16_t media_port = 0;
 
     mutable std::mutex mutex;  // guards clients, stats; sessions' own state is io-thread only
     std::map<ClientId, std::shared_ptr<Session>> clients;
@@ -60,6 +62,12 @@ struct Session : std::enable_shared_from_this<Session> {
           estimator(s.options.throughput_alpha) {}
 
     void start() {
+        // weak: the writer lives in the session, a strong pointer would keep it alive forever.
+        writer.setErrorHandler([weak = weak_from_this()](const asio::error_code&) {
+            if (auto self = weak.lock()) {
+                self->close();
+            }
+        });
         handshake_timer.expires_after(
             std::chrono::milliseconds(server.options.handshake_timeout_ms));
         handshake_timer.async_wait([self = shared_from_this()](const asio::error_code& ec) {
@@ -182,7 +190,7 @@ struct Session : std::enable_shared_from_this<Session> {
         }
         // Media goes only to the address that authenticated, at the port it named.
         media_endpoint = udp::endpoint(peer.address(), media_port);
-        if (!send(Welcome{session_id, server.udp_socket.local_endpoint().port()})) {
+        if (!send(Welcome{session_id, server.media_port})) {
             return false;
         }
         server.handler.onClientConnected(session_id);
@@ -214,9 +222,7 @@ struct Session : std::enable_shared_from_this<Session> {
     }
 
     bool send(const ControlMessage& m) {
-        const bool queued =
-            writer.push(socket, encodeControl(m),
-                        [self = shared_from_this()](const asio::error_code&) { self->close(); });
+        const bool queued = writer.push(socket, encodeControl(m));
         if (!queued) {
             // The client stopped reading its control channel: drop it rather than grow.
             count([](ServerStats& st) { ++st.protocol_errors; });
@@ -413,6 +419,8 @@ Expected<std::unique_ptr<Server>> Server::start(ServerOptions options, ServerHan
     if (ec) {
         return makeError("server: cannot open the media socket: " + ec.message());
     }
+    impl->port = impl->acceptor.local_endpoint(ec).port();
+    impl->media_port = impl->udp_socket.local_endpoint(ec).port();
     impl->accept();
     Impl* raw = impl.get();
     impl->thread = std::thread([raw] { raw->io.run(); });
@@ -445,15 +453,11 @@ void Server::stop() {
 }
 
 uint16_t Server::port() const {
-    asio::error_code ec;
-    const auto ep = m_impl->acceptor.local_endpoint(ec);
-    return ec ? 0 : ep.port();
+    return m_impl->port;
 }
 
 uint16_t Server::mediaPort() const {
-    asio::error_code ec;
-    const auto ep = m_impl->udp_socket.local_endpoint(ec);
-    return ec ? 0 : ep.port();
+    return m_impl->media_port;
 }
 
 Status Server::sendStream(ClientId client, uint32_t frame_id, uint8_t stream_id, bool key_frame,
