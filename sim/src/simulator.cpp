@@ -259,7 +259,8 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
         r.render_work_ms = render_work_ms;
         // What the headset measures: submission to completion, so time spent behind or
         // preempted by composition and ATW passes counts (Fig. 4-③).
-        r.t_local_ms = render_work_ms > 0.0 ? slot.end_ms - ls_end : 0.0;
+        const double measured_from = config.t_local_from_submission ? ls_end : slot.start_ms;
+        r.t_local_ms = render_work_ms > 0.0 ? slot.end_ms - measured_from : 0.0;
         r.preemptions = slot.preemptions;
 
         if (remote.valid) {

@@ -51,8 +51,9 @@ TEST(Evaluation, WritesEveryExperimentAndASummaryOfEveryRun) {
     auto result = runEvaluation(opts);
     ASSERT_TRUE(result.ok()) << result.error();
     EXPECT_EQ(last_done, total);
-    // 2 benches × (7 designs + 8 Q-VR clock×network points + 2 local clocks + 3 trace designs).
-    EXPECT_EQ(result->runs.size(), 2u * (7 + 8 + 2 + 3));
+    // 2 benches × (7 designs + DFR with GPU-timestamp T_local + 8 Q-VR clock×network points +
+    // 2 local clocks + 3 trace designs).
+    EXPECT_EQ(result->runs.size(), 2u * (7 + 1 + 8 + 2 + 3));
     for (const char* f : {"fig12_speedup.csv", "fig13_data_resolution.csv",
                           "fig14_latency_ratio.csv", "fig14_fps.csv", "table4_e1.csv",
                           "fig15_energy.csv", "mahimahi_lte.csv", "summary.json", "report.html"})
