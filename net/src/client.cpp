@@ -88,6 +88,7 @@ struct Client::Impl {
     mutable std::mutex mutex;  // guards everything below
     std::condition_variable cv;
     std::deque<CompletedStream> ready;
+    std::deque<LostStream> lost;
     bool connected = false;
     Status last_error = makeError("never connected");
     ClientStats stats;
@@ -342,7 +343,8 @@ void Client::Impl::handleAssembler(Connection& c, int64_t now_ns) {
     uint8_t need_key = c.assembler.takeLossMask();
     uint32_t trigger_frame = 0;
     std::vector<MediaAck> acks;
-    for (const LostStream& l : c.assembler.takeLost()) {
+    const std::vector<LostStream> lost_now = c.assembler.takeLost();
+    for (const LostStream& l : lost_now) {
         acks.push_back({l.frame_id, l.stream_id, false, l.packets_received, l.bytes_received,
                         static_cast<uint64_t>(l.first_rx_ns), static_cast<uint64_t>(l.last_rx_ns)});
         trigger_frame = l.frame_id;
@@ -385,6 +387,12 @@ void Client::Impl::handleAssembler(Connection& c, int64_t now_ns) {
         }
         ready.push_back(std::move(s));
     }
+    for (const LostStream& l : lost_now) {
+        if (lost.size() >= options.max_ready_streams) {
+            lost.pop_front();
+        }
+        lost.push_back(l);
+    }
     if (!completed.empty()) {
         cv.notify_all();
     }
@@ -423,6 +431,7 @@ Status Client::connect(const std::string& host, uint16_t port) {
         impl.last_error = Status::success();
         impl.throughput_bps = 0.0;
         impl.ready.clear();
+        impl.lost.clear();
     }
     Connection* cp = c.get();
     c->io.restart();
@@ -513,6 +522,13 @@ Expected<std::optional<CompletedStream>> Client::nextStream(int timeout_ms) {
                                               : impl.last_error.error());
     }
     return std::optional<CompletedStream>();
+}
+
+std::vector<LostStream> Client::takeLost() {
+    std::lock_guard lock(m_impl->mutex);
+    std::vector<LostStream> out(m_impl->lost.begin(), m_impl->lost.end());
+    m_impl->lost.clear();
+    return out;
 }
 
 double Client::throughputBps() const {

@@ -397,6 +397,7 @@ TEST(NetTransport, FivePercentLossKeepsFramesComingWithKeyFrameRequests) {
     EXPECT_GT(total.streams, 1200 * 0.70);
     EXPECT_GT(total.decodable, 1200 * 0.55);
     EXPECT_GT(cs.assembler.streams_lost, 0u);
+    EXPECT_FALSE(client.takeLost().empty());  // the caller learns which streams to stop awaiting
     EXPECT_GT(cs.key_frame_requests_sent, 10u);
     EXPECT_GT(handler.key_requests.load(), 10);
     EXPECT_GT(handler.key_frames_sent.load(), 10);

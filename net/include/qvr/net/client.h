@@ -39,6 +39,7 @@ struct ClientStats {
     uint64_t ready_streams_dropped = 0;  // the caller did not keep up
 };
 
+// Used from one thread (the headset's frame loop); the network thread is internal.
 class Client {
 public:
     explicit Client(ClientOptions options);
@@ -59,6 +60,10 @@ public:
     // The next complete stream, waiting up to timeout_ms: nullopt on timeout, an error once
     // the connection is gone and every stream received before has been taken.
     Expected<std::optional<CompletedStream>> nextStream(int timeout_ms);
+
+    // Streams declared lost since the last call (oldest first, at most max_ready_streams kept):
+    // the caller stops waiting for them and re-warps older layers instead (§4.2 frame reuse).
+    std::vector<LostStream> takeLost();
 
     // The server's latest ack-based estimate, 0 before the first.
     double throughputBps() const;
