@@ -132,6 +132,32 @@ bool gnuplotAvailable() {
     return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
 }
 
+std::string htmlEscape(const std::string& text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '&':
+                out += "&amp;";
+                break;
+            case '\'':
+                out += "&#39;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            default:
+                out += c;
+        }
+    }
+    return out;
+}
+
 std::string fmtNum(double v, int prec = 2) {
     return fmt::format("{:.{}f}", v, prec);
 }
@@ -686,10 +712,12 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         "collapse}}td,th{{border:1px solid #999;padding:3px 7px;text-align:right}}"
         ".bad{{text-decoration:underline;color:#b00}}.no{{color:#b00}}.yes{{color:#070}}"
         "</style></head><body><h1>Q-VR simulator evaluation</h1><p>Command: <code>{}</code>"
-        "<br>Frames per run: {} (Fig. 14: {}); runs: {}; {}.<br>Workloads are the seeded "
+        "<br>Frames per run: {} (Q-VR at the default point: {}, of which Fig. 14 plots the "
+        "first 300); runs: {}; {}.<br>Workloads are the seeded "
         "<b>synthetic</b> stand-ins for Table 3's games, not the games. Models and constants: "
         "docs/MODEL.md.</p>",
-        options.command_line, options.frames, frames, output.runs.size(), output.plot_note);
+        htmlEscape(options.command_line), options.frames, frames, output.runs.size(),
+        output.plot_note);
     html +=
         "<h2>Headline figures: paper vs. this simulator</h2><table><tr><th>metric</th>"
         "<th>paper</th><th>ours</th></tr>";
@@ -697,11 +725,12 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         html += fmt::format(
             "<tr><td style='text-align:left'>{}</td><td>{}{}</td><td>{}{}</td>"
             "</tr>",
-            h.metric, fmtNum(h.paper, 2), h.unit, fmtNum(h.ours, 2), h.unit);
+            htmlEscape(h.metric), fmtNum(h.paper, 2), h.unit, fmtNum(h.ours, 2), h.unit);
     html += "</table><h2>Qualitative findings</h2><ul>";
     for (const auto& f : output.findings)
-        html += fmt::format("<li><b>{}</b>: <span class='{}'>{}</span> — {}</li>", f.name,
-                            f.holds ? "yes" : "no", f.holds ? "holds" : "does not hold", f.detail);
+        html += fmt::format("<li><b>{}</b>: <span class='{}'>{}</span> — {}</li>",
+                            htmlEscape(f.name), f.holds ? "yes" : "no",
+                            f.holds ? "holds" : "does not hold", htmlEscape(f.detail));
     html += "</ul>";
     {
         // The measured mechanism behind DFR vs FFR, from this run's own numbers.
@@ -734,7 +763,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             "because the layer plan (Eq. 1 with Guenter's MAR) leaves 4-8% of the frame's "
             "pixels to shade and a periphery of tens of KB, where the paper's 41% resolution "
             "reduction implies a much heavier periphery. The static design's background + "
-            "depth is about twice the remote frame here (the workload part's encoding), not "
+            "depth is 1.6-2.3x the remote frame here (the workload part's encoding), not "
             "equal to it as in Fig. 13, so FPS over static is far above 4.1x.</li>"
             "<li><b>Energy by network.</b> Radio energy uses Huang et al.'s (MobiSys 2012) "
             "measured power models, where Wi-Fi's per-bit cost (138 nJ/bit) exceeds LTE's (71 "
