@@ -9,6 +9,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -28,7 +30,8 @@ toml::table parseOk(std::string_view text) {
 std::filesystem::path scratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     auto dir = std::filesystem::temp_directory_path() /
-               (std::string("qvr_core_test_") + info->test_suite_name() + "_" + info->name());
+               (std::string("qvr_core_test_") + info->test_suite_name() + "_" + info->name() + "_" +
+                std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;

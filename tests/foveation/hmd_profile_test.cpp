@@ -7,6 +7,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -172,7 +174,8 @@ TEST(HmdProfileByName, ReturnsBuiltInProfilesWhenNamed) {
 }
 
 TEST(HmdProfileByName, LoadsFileWhenGivenPath) {
-    const auto dir = std::filesystem::temp_directory_path() / "qvr_foveation_profile_test";
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("qvr_foveation_profile_test_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const auto path = dir / "mine.toml";
     {

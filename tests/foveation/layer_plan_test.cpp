@@ -47,12 +47,18 @@ double bruteForceMinCost(const HmdProfile& p, const EyeGeometry& geo, const Gaze
 }
 
 TEST(LayerPlanner, FindsBruteForceMinimumWhenOptimisingE2) {
-    const std::vector<double> e1s = {0.5, 1, 2, 3.5, 5, 8, 12, 17, 23, 30, 38, 47, 60};
+    const std::vector<double> e1s = {0.5, 1, 2, 3, 3.5, 5, 8, 12, 17, 23, 30, 38, 47, 60};
+    // Besides the usual gazes, ones near the edges and corners, where the discs clip against the
+    // image and Eq. 1's objective has more than one valley (a 4° coarse scan misses the minimum
+    // at gaze (45, 0), e1 30 and at gaze (30, 50), e1 3).
+    std::vector<Gaze> gazes = planGazes();
+    for (const Gaze g : {Gaze{45, 0}, Gaze{-45, 0}, Gaze{30, 50}, Gaze{-30, -50}, Gaze{-40, 25}})
+        gazes.push_back(g);
     int cases = 0;
     for (const HmdProfile& p : profiles()) {
         const LayerPlanner planner(p);
         const EyeGeometry& geo = planner.geometry();
-        for (const Gaze& g : planGazes()) {
+        for (const Gaze& g : gazes) {
             const double cover = geo.coverEccentricityDeg(g);
             for (double e1 : e1s) {
                 if (e1 >= cover)
@@ -62,8 +68,10 @@ TEST(LayerPlanner, FindsBruteForceMinimumWhenOptimisingE2) {
                 EXPECT_LE(e2, cover + 1e-9) << describe(p, g, e1);
                 const double found = peripheryCost(p, geo, g, e1, e2);
                 const double brute = bruteForceMinCost(p, geo, g, e1);
-                // Ties make the argmin non-unique, so compare costs, not angles.
-                EXPECT_LE(found, brute * (1.0 + 1e-3)) << describe(p, g, e1) << " e2 " << e2;
+                // Ties make the argmin non-unique, so compare costs, not angles. 1e-4: the
+                // refined search never lost to the 0.01° grid in 978 probed cases, while the
+                // 0.5° scan alone, without its refinement, loses by up to 0.13%.
+                EXPECT_LE(found, brute * (1.0 + 1e-4)) << describe(p, g, e1) << " e2 " << e2;
                 // Nothing on the grid should be beaten by more than the grid's own resolution.
                 EXPECT_GE(found, brute * (1.0 - 1e-3)) << describe(p, g, e1) << " e2 " << e2;
                 // plan() uses the same e2*.
@@ -72,7 +80,7 @@ TEST(LayerPlanner, FindsBruteForceMinimumWhenOptimisingE2) {
             }
         }
     }
-    EXPECT_GE(cases, 100);
+    EXPECT_GE(cases, 200);
 }
 
 TEST(PeripheryCost, MatchesClosedFormWhenE2IsInsideField) {

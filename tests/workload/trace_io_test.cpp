@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -165,7 +167,8 @@ TEST(WorkloadTrace, PreservesSyntheticTraceWhenSavedToFile) {
     SyntheticSpec spec = defaultSyntheticSpec();
     spec.frames = 12;
     const WorkloadTrace t = generateSyntheticWorkload(spec);
-    const auto path = std::filesystem::temp_directory_path() / "qvr_workload_trace_test.jsonl";
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("qvr_workload_trace_test_" + std::to_string(::getpid()) + ".jsonl");
     ASSERT_TRUE(saveWorkloadTrace(t, path.string()).ok());
     auto back = loadWorkloadTrace(path.string());
     ASSERT_TRUE(back.ok()) << back.error();
@@ -191,7 +194,11 @@ TEST(SaveWorkloadTrace, FailsWhenTraceIsInvalidOrPathUnwritable) {
     WorkloadTrace t = handMadeTrace();
     EXPECT_FALSE(saveWorkloadTrace(t, "/nonexistent/dir/x.jsonl").ok());
     t.frames[1].time_ms = -5.0;
-    EXPECT_FALSE(saveWorkloadTrace(t, "/tmp/qvr_never_written.jsonl").ok());
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("qvr_never_written_" + std::to_string(::getpid()) + ".jsonl");
+    EXPECT_FALSE(saveWorkloadTrace(t, path.string()).ok());
+    // An invalid trace is refused before the file is created.
+    EXPECT_FALSE(std::filesystem::exists(path));
 }
 
 // Checks that text is rejected with an error naming line `line` (1-based) and mentioning `what`.
