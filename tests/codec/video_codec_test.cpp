@@ -192,6 +192,46 @@ TEST_P(CodecBackends, WellFramedGarbageMidStreamIsAnErrorAndAKeyframeRecovers) {
     EXPECT_GT(psnrRgb(detailedImage(170, 190, 2), *dec), kMinPsnrDb);
 }
 
+TEST(X264Codec, MutatedPayloadsWithValidFramingNeverCrash) {
+    // Bit errors that a transport checksum missed (re-framed with a matching CRC) reach
+    // libavcodec: each decode must end in an error or a picture of the right size.
+    Pair p = makePair();
+    std::vector<EncodedFrame> frames;
+    for (int i = 0; i < 3; ++i) {
+        auto enc = p.encoder->encode(detailedImage(170, 190, i * 3), false);
+        ASSERT_TRUE(enc.ok());
+        frames.push_back(std::move(enc).value());
+    }
+    std::mt19937 rng(17);
+    int errors = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        auto decoder = makeVideoDecoder(CodecConfig{});
+        ASSERT_TRUE(decoder.ok());
+        const size_t target = static_cast<size_t>(trial) % frames.size();
+        for (size_t f = 0; f <= target; ++f) {
+            auto parsed = parseFrame(frames[f].bytes);
+            ASSERT_TRUE(parsed.ok());
+            std::vector<uint8_t> payload(parsed->payload.begin(), parsed->payload.end());
+            if (f == target) {
+                std::uniform_int_distribution<size_t> pos(0, payload.size() - 1);
+                for (int k = 0; k < 1 + trial % 8; ++k)
+                    payload[pos(rng)] ^= static_cast<uint8_t>(1u << (rng() % 8));
+            }
+            auto dec = (*decoder)->decode(packFrame(parsed->header, payload));
+            if (f < target) {
+                ASSERT_TRUE(dec.ok()) << dec.error();
+            } else if (dec.ok()) {
+                EXPECT_EQ(dec->width(), 170);
+                EXPECT_EQ(dec->height(), 190);
+            } else {
+                ++errors;
+                EXPECT_FALSE(dec.error().empty());
+            }
+        }
+    }
+    EXPECT_GT(errors, 0);
+}
+
 TEST_P(CodecBackends, TruncatedPacketsGiveAnError) {
     Pair p = makePair(config());
     auto enc = p.encoder->encode(detailedImage(170, 190), false);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <random>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -249,6 +250,27 @@ TEST(GazeCsv, RejectsMalformedFilesWithALineNumber) {
         EXPECT_THAT(r.error(), HasSubstr(message)) << text;
     }
     EXPECT_TRUE(parseGazeCsv(h + "0,1,2\r\n8,1,2\r\n\n", "gaze.csv").ok());
+}
+
+TEST(GazeCsv, SurvivesRandomMutation) {
+    const std::string good = gazeTraceToCsv(generate(2, 50));
+    std::mt19937 rng(12);
+    std::uniform_int_distribution<size_t> pos(0, good.size() - 1);
+    std::uniform_int_distribution<int> byte(0, 255);
+    int rejected = 0;
+    for (int trial = 0; trial < 1000; ++trial) {
+        std::string s = good;
+        s[pos(rng)] = static_cast<char>(byte(rng));
+        auto r = parseGazeCsv(s, "mutated.csv");
+        if (!r.ok()) {
+            ++rejected;
+            EXPECT_THAT(r.error(), HasSubstr("mutated.csv"));
+        } else {
+            for (const auto& g : r->samples)
+                ASSERT_LE(std::fabs(g.gaze.x_deg), 90.0);
+        }
+    }
+    EXPECT_GT(rejected, 500);
 }
 
 }  // namespace
