@@ -315,8 +315,10 @@ int BspParser::textureFor(int shader, Scene& scene) {
         if (index >= 0)
             break;
     }
-    if (index < 0)
+    if (index < 0) {
         ++m_stats.shaders_without_image;
+        m_stats.missing_images.push_back(shader_name);
+    }
     m_texture_of_shader[shader] = index;
     return index;
 }

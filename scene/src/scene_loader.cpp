@@ -65,7 +65,7 @@ Expected<Scene> finish(Expected<Scene> scene) {
 
 Expected<Scene> loadInstalledMap(const std::string& game, const std::string& dir,
                                  const std::string& package_hint, const std::string& map,
-                                 const SceneLoadOptions& opts) {
+                                 const SceneLoadOptions& opts, BspStats* stats) {
     const std::string name = game + ":" + map;
     std::error_code ec;
     if (!std::filesystem::is_directory(dir, ec))
@@ -88,7 +88,7 @@ Expected<Scene> loadInstalledMap(const std::string& game, const std::string& dir
         return makeError(fmt::format("{}: no {} in the {} pk3 files of {}; available: {}", name,
                                      path, files.archiveCount(), dir, someMaps(bsps, lower(map))));
     }
-    return finish(parseBsp(*bytes, name, &files, opts));
+    return finish(parseBsp(*bytes, name, &files, opts, stats));
 }
 
 Expected<std::vector<uint8_t>> readFile(const std::string& path) {
@@ -122,16 +122,18 @@ void addTextureSources(GameFileSystem& files, const std::string& bsp_path,
     files.addLooseDirectory(dir.empty() ? "." : dir.string());
 }
 
-Expected<Scene> loadBspFile(const std::string& path, const SceneLoadOptions& opts) {
+Expected<Scene> loadBspFile(const std::string& path, const SceneLoadOptions& opts,
+                            BspStats* stats) {
     auto bytes = readFile(path);
     if (!bytes)
         return makeError(bytes.error());
     GameFileSystem files;
     addTextureSources(files, path, opts);
-    return finish(parseBsp(*bytes, path, &files, opts));
+    return finish(parseBsp(*bytes, path, &files, opts, stats));
 }
 
-Expected<Scene> loadPk3File(const std::string& path, const SceneLoadOptions& opts) {
+Expected<Scene> loadPk3File(const std::string& path, const SceneLoadOptions& opts,
+                            BspStats* stats) {
     auto archive = Pk3Archive::open(path);
     if (!archive)
         return makeError(archive.error());
@@ -154,20 +156,31 @@ Expected<Scene> loadPk3File(const std::string& path, const SceneLoadOptions& opt
     if (std::filesystem::is_directory(opts.openarena_dir, ec))
         (void)files.addPk3Directory(opts.openarena_dir);
     files.addArchive(std::move(*archive));  // the level's own files win
-    return finish(parseBsp(*bytes, path, &files, opts));
+    return finish(parseBsp(*bytes, path, &files, opts, stats));
 }
 
 }  // namespace
 
-Expected<Scene> loadScene(const std::string& name, const SceneLoadOptions& opts) {
-    if (name.rfind("openarena:", 0) == 0)
+Expected<Scene> loadScene(const std::string& name, const SceneLoadOptions& opts,
+                          SceneLoadReport* report) {
+    SceneLoadReport local;
+    SceneLoadReport& r = report != nullptr ? *report : local;
+    r = SceneLoadReport{};
+    if (name.rfind("openarena:", 0) == 0) {
+        r.format = "ibsp46";
         return loadInstalledMap("openarena", opts.openarena_dir,
                                 "openarena-081-maps openarena-081-textures openarena-data",
-                                name.substr(10), opts);
-    if (name.rfind("nexuiz:", 0) == 0)
-        return loadInstalledMap("nexuiz", opts.nexuiz_dir, "nexuiz-data", name.substr(7), opts);
-    if (name.rfind("builtin:", 0) == 0)
+                                name.substr(10), opts, &r.bsp);
+    }
+    if (name.rfind("nexuiz:", 0) == 0) {
+        r.format = "ibsp46";
+        return loadInstalledMap("nexuiz", opts.nexuiz_dir, "nexuiz-data", name.substr(7), opts,
+                                &r.bsp);
+    }
+    if (name.rfind("builtin:", 0) == 0) {
+        r.format = "builtin";
         return finish(makeBuiltinScene(name.substr(8), opts.builtin_objects));
+    }
     std::error_code ec;
     if (!std::filesystem::is_regular_file(name, ec))
         return makeError(
@@ -175,10 +188,11 @@ Expected<Scene> loadScene(const std::string& name, const SceneLoadOptions& opts)
                         "builtin:room[?objects=N] or a .bsp/.pk3/.gltf/.glb/.obj file",
                         name));
     const std::string ext = lower(std::filesystem::path(name).extension().string());
-    if (ext == ".bsp")
-        return loadBspFile(name, opts);
-    if (ext == ".pk3")
-        return loadPk3File(name, opts);
+    if (ext == ".bsp" || ext == ".pk3") {
+        r.format = "ibsp46";
+        return ext == ".bsp" ? loadBspFile(name, opts, &r.bsp) : loadPk3File(name, opts, &r.bsp);
+    }
+    r.format = "assimp";
     return finish(loadAssimpScene(name, opts));
 }
 

@@ -22,17 +22,6 @@ inline constexpr float kQuakeSpawnEyeUnits = 9.0f + 26.0f;
 // Bézier patch control grids larger than this per side are rejected (q3map's MAX_PATCH_SIZE is 32).
 inline constexpr int kMaxPatchSide = 65;
 
-// What a parse skipped, for `qvr scene info` and tests.
-struct BspStats {
-    int faces = 0;
-    int faces_drawn = 0;
-    int faces_sky_or_nodraw = 0;  // SURF_SKY / SURF_NODRAW / SURF_SKIP / SURF_HINT shaders
-    int faces_bad_shader = 0;     // shader index outside the texture lump
-    int faces_flare_or_unknown = 0;
-    int faces_empty = 0;
-    int shaders_without_image = 0;  // drawn with vertex colour instead
-};
-
 // Parses a BSP held in memory. files supplies textures and shader scripts (may be null: no
 // textures). The returned scene is named scene_name.
 Expected<Scene> parseBsp(std::span<const uint8_t> bytes, const std::string& scene_name,

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "qvr/core/expected.h"
 #include "qvr/scene/scene.h"
@@ -30,9 +31,28 @@ struct SceneLoadOptions {
     int builtin_objects = 32;
 };
 
+// What a parse skipped, for `qvr scene info` and tests.
+struct BspStats {
+    int faces = 0;
+    int faces_drawn = 0;
+    int faces_sky_or_nodraw = 0;  // SURF_SKY / SURF_NODRAW / SURF_SKIP / SURF_HINT shaders
+    int faces_bad_shader = 0;     // shader index outside the texture lump
+    int faces_flare_or_unknown = 0;
+    int faces_empty = 0;
+    int shaders_without_image = 0;            // drawn with vertex colour instead
+    std::vector<std::string> missing_images;  // their shader names
+};
+
+// What a load did besides the scene, for `qvr scene info` and tests.
+struct SceneLoadReport {
+    std::string format;  // "ibsp46", "assimp", "builtin"
+    BspStats bsp;        // Quake III levels only
+};
+
 // Names: "openarena:MAP", "nexuiz:MAP", "builtin:room[?objects=N]", or a path to a .bsp, a .pk3
 // holding one level, or a .gltf/.glb/.obj file. Errors name what was missing and what exists.
-Expected<Scene> loadScene(const std::string& name, const SceneLoadOptions& opts = {});
+Expected<Scene> loadScene(const std::string& name, const SceneLoadOptions& opts = {},
+                          SceneLoadReport* report = nullptr);
 
 // Triangles by origin: Quake III face types 1 and 3 (and every non-BSP triangle) versus
 // tessellated Bézier patches (type 2), from the batches' is_patch flags.
