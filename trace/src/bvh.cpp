@@ -32,7 +32,7 @@ struct Token {
 // Splits the hierarchy section into tokens (braces are tokens even when glued to a word).
 class HierarchyLexer {
 public:
-    HierarchyLexer(std::string_view text) : m_text(text) {}
+    explicit HierarchyLexer(std::string_view text) : m_text(text) {}
 
     bool next(Token& t) {
         while (m_pos < m_text.size()) {

@@ -24,8 +24,9 @@ struct PoseTrace {
 // first and last samples outside the trace. The trace must not be empty.
 Pose poseAt(const PoseTrace& trace, double t_ms);
 
-// Samples the trace at rate_hz from its first timestamp: frames poses at t0 + k·1000/rate_hz.
-// Fails if the trace is shorter than the frames asked for (frames = 0: as many as fit).
+// Samples the trace at rate_hz from its first timestamp (source times t0 + k·1000/rate_hz; the
+// output's t_ms start at 0). Fails if the trace is shorter than the frames asked for
+// (frames = 0: as many as fit).
 Expected<PoseTrace> resamplePoses(const PoseTrace& trace, double rate_hz, int frames);
 
 // Gaussian smoothing in time (sigma in ms) of positions and orientations: removes mocap jitter.
