@@ -2,7 +2,9 @@
 // e1 = 15° and a 2.3° pose change, through UCA, its scalar twin, the two-pass reference and (when
 // built) the OpenCV anchor; items are display pixels, bytes are UCA's reads + writes.
 #include <array>
+#include <cstring>
 #include <memory>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
@@ -90,6 +92,21 @@ BENCHMARK(BM_TwoPass)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The bandwidth floor's yardstick: a copy far larger than the caches on one thread; bytes are
+// read + written, so UCA's floor is its bytes divided by this rate.
+void BM_CopyBandwidth(benchmark::State& state) {
+    const size_t bytes = size_t{256} << 20;
+    std::vector<uint8_t> src(bytes, 1), dst(bytes, 0);
+    for (auto _ : state) {
+        std::memcpy(dst.data(), src.data(), bytes);
+        benchmark::DoNotOptimize(dst.data());
+        benchmark::ClobberMemory();
+    }
+    state.SetBytesProcessed(static_cast<int64_t>(state.iterations()) * 2 *
+                            static_cast<int64_t>(bytes));
+}
+BENCHMARK(BM_CopyBandwidth)->Unit(benchmark::kMillisecond);
+
 #if defined(QVR_COMPOSE_HAVE_OPENCV)
 void BM_OpenCvTwoPass(benchmark::State& state) {
     const Scene& s = scene();
@@ -107,6 +124,7 @@ void BM_OpenCvTwoPass(benchmark::State& state) {
 }
 BENCHMARK(BM_OpenCvTwoPass)
     ->ArgName("threads")
+    ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -253,8 +253,12 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
                                          smallAngleBoundRad(unit(k[1]), unit(k[2])));
         bool channel_empty = front == 0;
         if (front == 4) {
-            const double diag_px = std::max(std::hypot(k[3]->px - k[0]->px, k[3]->py - k[0]->py),
-                                            std::hypot(k[2]->px - k[1]->px, k[2]->py - k[1]->py));
+            // sqrt of squares: libm's hypot guards against overflow at several times the cost.
+            auto dist = [](const CornerSample* a, const CornerSample* b) {
+                return std::sqrt((a->px - b->px) * (a->px - b->px) +
+                                 (a->py - b->py) * (a->py - b->py));
+            };
+            const double diag_px = std::max(dist(k[0], k[3]), dist(k[1], k[2]));
             const double margin = 0.25 * diag_px + 2.0;
             const double x_min = std::min({k[0]->px, k[1]->px, k[2]->px, k[3]->px}) - margin;
             const double x_max = std::max({k[0]->px, k[1]->px, k[2]->px, k[3]->px}) + margin;
