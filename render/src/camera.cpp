@@ -9,6 +9,17 @@
 
 namespace qvr {
 
+namespace {
+LayerRect fullLayer(const HmdProfile& profile) {
+    LayerRect full;
+    full.rect = {0, 0, profile.width_px, profile.height_px};
+    full.scale = 1.0;
+    full.width_px = profile.width_px;
+    full.height_px = profile.height_px;
+    return full;
+}
+}  // namespace
+
 Pose eyePose(const Pose& head, Eye eye, double ipd_m) {
     const float half = static_cast<float>(0.5 * ipd_m) * (eye == Eye::kLeft ? -1.0f : 1.0f);
     Pose p = head;
@@ -55,12 +66,33 @@ RenderView layerView(const HmdProfile& profile, const Pose& head, Eye eye, const
 
 RenderView fullFrameView(const HmdProfile& profile, const Pose& head, Eye eye,
                          const CameraOptions& options) {
-    LayerRect full;
-    full.rect = {0, 0, profile.width_px, profile.height_px};
-    full.scale = 1.0;
-    full.width_px = profile.width_px;
-    full.height_px = profile.height_px;
-    return layerView(profile, head, eye, full, options);
+    return layerView(profile, head, eye, fullLayer(profile), options);
+}
+
+EyeView eyeViewOf(const HmdProfile& profile, const Pose& head, Eye eye, const LayerRect& layer,
+                  const CameraOptions& options) {
+    const Pose ep = eyePose(head, eye, options.ipd_m);
+    const double fx = profile.focalXPx();
+    const double fy = profile.focalYPx();
+    const double cx = 0.5 * profile.width_px;
+    const double cy = 0.5 * profile.height_px;
+    const double x0 = layer.rect.x0;
+    const double y0 = layer.rect.y0;
+    EyeView v;
+    v.position_m = glm::dvec3(ep.position_m);
+    v.orientation = glm::dquat(glm::normalize(ep.orientation));
+    v.tan_left = (cx - x0) / fx;
+    v.tan_right = (x0 + layer.width_px * layer.scale - cx) / fx;
+    v.tan_up = (cy - y0) / fy;
+    v.tan_down = (y0 + layer.height_px * layer.scale - cy) / fy;
+    v.near_m = options.near_m;
+    v.far_m = options.far_m;
+    return v;
+}
+
+EyeView fullFrameEyeView(const HmdProfile& profile, const Pose& head, Eye eye,
+                         const CameraOptions& options) {
+    return eyeViewOf(profile, head, eye, fullLayer(profile), options);
 }
 
 Pose poseFromSpawn(const SpawnPoint& spawn) {

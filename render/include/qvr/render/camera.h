@@ -11,6 +11,7 @@
 #include "qvr/foveation/hmd_profile.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/scene/scene.h"
+#include "qvr/scene/triangle_bvh.h"
 
 namespace qvr {
 
@@ -73,6 +74,13 @@ RenderView layerView(const HmdProfile& profile, const Pose& head, Eye eye, const
                      const CameraOptions& options = {});
 // The whole eye image at full resolution: the reference each layer is a piece of.
 RenderView fullFrameView(const HmdProfile& profile, const Pose& head, Eye eye,
+                         const CameraOptions& options = {});
+
+// The same view in the form the scene part's CPU triangle counter takes (TriangleBvh): eye pose
+// and the tangents of the four edges of the layer's texel grid, with the same near and far.
+EyeView eyeViewOf(const HmdProfile& profile, const Pose& head, Eye eye, const LayerRect& layer,
+                  const CameraOptions& options = {});
+EyeView fullFrameEyeView(const HmdProfile& profile, const Pose& head, Eye eye,
                          const CameraOptions& options = {});
 
 // Standing at a spawn point, looking level along its yaw.
