@@ -567,6 +567,25 @@ std::vector<uint64_t> TriangleBvh::trianglesPerRing(const EyeView& view,
     return hist;
 }
 
+uint64_t TriangleBvh::countTrianglesByOutcodes(const EyeView& view) const {
+    checkView(view);
+    const auto eye = eyeFrustum(view);
+    const glm::dmat3 world_to_eye = glm::mat3_cast(glm::conjugate(view.orientation));
+    uint64_t count = 0;
+    for (size_t t = 0; t < m_tri_count; ++t) {
+        uint32_t outside_all = 0x3f;  // planes every vertex so far lies outside of
+        for (size_t k = 0; k < 3; ++k) {
+            const glm::dvec3 p = world_to_eye * (glm::dvec3(m_tri[3 * t + k]) - view.position_m);
+            uint32_t outside = 0;
+            for (size_t i = 0; i < eye.size(); ++i)
+                outside |= eye[i].distance(p) < 0.0 ? (1u << i) : 0u;
+            outside_all &= outside;
+        }
+        count += outside_all == 0 ? 1 : 0;
+    }
+    return count;
+}
+
 std::vector<uint64_t> TriangleBvh::trianglesPerRingBruteForce(const EyeView& view,
                                                               const glm::dvec3& gaze_dir_eye,
                                                               double ring_deg, int rings) const {

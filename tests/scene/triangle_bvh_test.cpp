@@ -206,6 +206,24 @@ TEST(TriangleBvh, ATriangleCrossingTheNearPlaneCounts) {
     EXPECT_EQ(t.countTrianglesInFrustum(up), 0u);
 }
 
+TEST(TriangleBvh, OutcodeCountsBracketTheExactCountFromAbove) {
+    // Beside the top-left corner of a 90°×90° frustum: no vertex set shares an outside plane,
+    // yet the triangle misses the frustum.
+    std::vector<glm::vec3> p = {{-30, 5, -10}, {-5, 30, -10}, {-30, 30, -10}};
+    const TriangleBvh corner(p, {0, 1, 2});
+    const EyeView v = EyeView::symmetric({0, 0, 0}, glm::dquat(1, 0, 0, 0), 90, 90, 0.1, 100);
+    EXPECT_EQ(corner.countTrianglesInFrustum(v), 0u);
+    EXPECT_EQ(corner.countTrianglesByOutcodes(v), 1u);
+    // On random views the outcode count is never below the exact one.
+    const Soup s = randomSoup(5000, 9);
+    const TriangleBvh bvh(s.positions, s.indices);
+    std::mt19937 rng(10);
+    for (int i = 0; i < 20; ++i) {
+        const EyeView rv = randomView(rng);
+        EXPECT_GE(bvh.countTrianglesByOutcodes(rv), bvh.countTrianglesInFrustum(rv));
+    }
+}
+
 TEST(TriangleBvh, BuiltinRoomCountsFromTheSpawnPoint) {
     const Scene scene = makeBuiltinRoom(64);
     const TriangleBvh bvh(scene);

@@ -87,6 +87,12 @@ public:
                                                      const glm::dvec3& gaze_dir_eye,
                                                      double ring_deg, int rings) const;
 
+    // What a GPU's trivial-reject test keeps: triangles not having all three vertices outside
+    // one frustum plane (clip-space outcodes). A superset of countTrianglesInFrustum (it adds
+    // triangles that pass beside a frustum corner); the two bracket what a clipper-stage
+    // pipeline-statistics query reports. Brute force; for cross-checks against OpenGL.
+    uint64_t countTrianglesByOutcodes(const EyeView& view) const;
+
 private:
     struct Node {
         glm::vec3 min, max;
