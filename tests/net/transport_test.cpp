@@ -485,9 +485,10 @@ TEST(NetTransport, ThroughputFromAcksTracksAShapedLink) {
     while (server->throughputBps(id) == 0 && std::chrono::steady_clock::now() < deadline) {
         std::this_thread::sleep_for(5ms);
     }
-    // 240 KB + headers at 50 Mbit/s take ~40 ms; ack and scheduling delays only lower it.
+    // 240 KB + headers at 50 Mbit/s take ~40 ms; ack and scheduling delays only lower it (the
+    // lower bound leaves room for a loaded machine: 2 cores shared by many builds).
     const double mbps = server->throughputBps(id) / 1e6;
-    EXPECT_GT(mbps, 35.0);
+    EXPECT_GT(mbps, 25.0);
     EXPECT_LT(mbps, 52.0);
 }
 
