@@ -145,6 +145,11 @@ public:
         return static_cast<uint32_t>(m_scene.vertices.size() - 1);
     }
     void triangle(Material m, uint32_t a, uint32_t b, uint32_t c) {
+        // Lathe poles collapse a grid row to one point; those triangles have no area.
+        const auto& v = m_scene.vertices;
+        if (v[a].position == v[b].position || v[b].position == v[c].position ||
+            v[a].position == v[c].position)
+            return;
         m_indices[m].insert(m_indices[m].end(), {a, b, c});
     }
     // A grid of (nu+1)×(nv+1) vertices from f(u, v) → (position, normal); CCW seen from the
@@ -302,15 +307,27 @@ Scene makeBuiltinRoom(int objects) {
     b.quad(kBoard, corner + glm::vec3(0, 0, board_d), {0, -top, 0}, {board_w, 0, 0}, 1, 1,
            {0.1f, 4.0f});
 
+    // The first 32 objects stand as a chess game starts: back ranks and pawn ranks, dark on
+    // the far side; further objects fill the middle rows, then rows added behind the board.
+    constexpr int kRowOrder[8] = {0, 7, 1, 6, 2, 5, 3, 4};
+    constexpr int kBackRank[8] = {1, 6, 2, 3, 4, 2, 6, 1};  // rook, knight, bishop, queen, king…
     for (int i = 0; i < objects; ++i) {
-        const int col = i % kBoardColumns, row = i / kBoardColumns;
+        const int col = i % kBoardColumns, slot = i / kBoardColumns;
+        const int row = slot < 8 ? kRowOrder[slot] : slot;
         const glm::vec3 c = corner + glm::vec3((static_cast<float>(col) + 0.5f) * kSquareM, 0,
                                                (static_cast<float>(row) + 0.5f) * kSquareM);
-        const Material m = (row + col) % 2 == 0 ? kLightPiece : kDarkPiece;
-        const int kind = static_cast<int>(hash2(col, row, 99) * 7.0f);
-        const float h = 0.45f + 0.35f * hash2(col, row, 7);
+        const Material m = row < 4 || (row >= 8 && row % 2 == 0) ? kDarkPiece : kLightPiece;
+        int kind = static_cast<int>(hash2(col, row, 99) * 7.0f);  // middle and extra rows
+        if (row == 0 || row == 7)
+            kind = kBackRank[col];
+        else if (row == 1 || row == 6)
+            kind = 0;
+        // Kinds: 0 pawn, 1 rook, 2 bishop, 3 queen, 4 king, 5 sphere, 6 torus ("knight").
+        constexpr float kHeights[7] = {0.45f, 0.55f, 0.65f, 0.75f, 0.8f, 0.55f, 0.6f};
+        const float h = kHeights[kind] * (0.95f + 0.1f * hash2(col, row, 7));
         if (kind < 5) {
-            b.lathe(m, c, 64, 64, [kind, h](float t) { return pieceProfile(kind % 4, t, h); });
+            b.lathe(m, c, 64, 64,
+                    [kind, h](float t) { return pieceProfile(std::min(kind, 3), t, h); });
         } else if (kind == 5) {
             // Sphere on a short pedestal.
             b.lathe(m, c, 48, 8, [h](float t) {
