@@ -128,6 +128,11 @@ static Registered registerUcaBench(CLI::App& bench) {
                                 {"two_pass", qualityJson(b.two_pass_quality)}};
                 if (b.opencv_quality)
                     j["quality"]["opencv_two_pass"] = qualityJson(*b.opencv_quality);
+                j["quality_vs_layers"] = {{"uca", qualityJson(b.uca_vs_layers)},
+                                          {"two_pass", qualityJson(b.two_pass_vs_layers)}};
+                if (b.opencv_vs_layers) {
+                    j["quality_vs_layers"]["opencv_two_pass"] = qualityJson(*b.opencv_vs_layers);
+                }
             }
             j["uca_min_ms"] = b.uca_min_ms;
             j["two_pass_min_ms"] = b.two_pass_min_ms;
@@ -189,10 +194,16 @@ static Registered registerUcaBench(CLI::App& bench) {
                     name, q.fovea.psnr_db, q.periphery.psnr_db, q.all.psnr_db, q.fovea.ssim,
                     q.periphery.ssim);
             };
+            fmt::print("  against the full-resolution render warped in double (ground truth):\n");
             row("UCA", b.uca_quality);
             row("two-pass", b.two_pass_quality);
             if (b.opencv_quality)
                 row("OpenCV", *b.opencv_quality);
+            fmt::print("  against the layers' own Eq. 4 in double (filtering error alone):\n");
+            row("UCA", b.uca_vs_layers);
+            row("two-pass", b.two_pass_vs_layers);
+            if (b.opencv_vs_layers)
+                row("OpenCV", *b.opencv_vs_layers);
         }
         return 0;
     };

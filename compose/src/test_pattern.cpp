@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "qvr/compose/warp.h"
+#include "uca_kernel.h"
 
 namespace qvr {
 
@@ -219,6 +220,81 @@ ImageRgbD groundTruthWarp(const HmdProfile& profile, const ImageRgba8& full_rend
         }
     });
     return truth;
+}
+
+namespace {
+
+// Bilinear, clamp-to-edge, in double: channel c of a layer at a rendered-image point.
+double sampleLayerD(const ImageRgba8& img, const LayerRect& r, double px, double py, int c) {
+    const double lx = std::clamp((px - r.rect.x0) / r.scale - 0.5, 0.0, img.width() - 1.0);
+    const double ly = std::clamp((py - r.rect.y0) / r.scale - 0.5, 0.0, img.height() - 1.0);
+    const int x0 = static_cast<int>(lx);
+    const int y0 = static_cast<int>(ly);
+    const int x1 = std::min(x0 + 1, img.width() - 1);
+    const int y1 = std::min(y0 + 1, img.height() - 1);
+    const double wx = lx - x0;
+    const double wy = ly - y0;
+    const double top = (1 - wx) * img.at(x0, y0, c) + wx * img.at(x1, y0, c);
+    const double bot = (1 - wx) * img.at(x0, y1, c) + wx * img.at(x1, y1, c);
+    return (1 - wy) * top + wy * bot;
+}
+
+}  // namespace
+
+ImageRgbD layerReferenceWarp(const HmdProfile& profile, const LayerFrame& frame, int eye,
+                             const Pose& display_pose, double blend_band_texels,
+                             bool chromatic_aberration) {
+    const EyeWarp warp(profile, frame.render_pose.orientation, display_pose.orientation);
+    const detail::SlotInfo slots = detail::slotBands(profile, frame.plan, eye, blend_band_texels);
+    const EyeLayers& rects = frame.plan.eyes[static_cast<size_t>(eye)];
+    const EyeLayerImages& images = frame.eyes[static_cast<size_t>(eye)];
+    const LayerRect* slot_rect[3];
+    const ImageRgba8* slot_image[3];
+    for (int k = 0; k < slots.count; ++k) {
+        const int l = slots.layer[k];
+        slot_rect[k] = l == 0 ? &rects.fovea : (l == 1 ? &rects.middle : &rects.outer);
+        slot_image[k] = l == 0 ? &images.fovea : (l == 1 ? &images.middle : &images.outer);
+    }
+    const double gx = std::tan(frame.plan.gaze.x_deg * kPi / 180.0);
+    const double gy = std::tan(frame.plan.gaze.y_deg * kPi / 180.0);
+    const double g_norm = std::sqrt(gx * gx + gy * gy + 1.0);
+    const double scales[3] = {chromatic_aberration ? profile.lens.chroma_red_scale : 1.0, 1.0,
+                              chromatic_aberration ? profile.lens.chroma_blue_scale : 1.0};
+    ImageRgbD out(profile.width_px, profile.height_px);
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, profile.height_px, 8), [&](const tbb::blocked_range<int>& rows) {
+            for (int y = rows.begin(); y < rows.end(); ++y) {
+                for (int x = 0; x < profile.width_px; ++x) {
+                    for (int c = 0; c < 3; ++c) {
+                        const WarpSample s = warp.map(x + 0.5, y + 0.5, scales[c]);
+                        if (!s.inside) {
+                            out.at(x, y, c) = 0.0;
+                            continue;
+                        }
+                        const double len =
+                            std::sqrt(s.dir.x * s.dir.x + s.dir.y * s.dir.y + s.dir.z * s.dir.z);
+                        const double cos_e =
+                            (gx * s.dir.x + gy * s.dir.y - s.dir.z) / (len * g_norm);
+                        double t[2] = {0.0, 0.0};
+                        for (int k = 0; k + 1 < slots.count && k < 2; ++k) {
+                            const double hi =
+                                std::cos((slots.radius_deg[k] - slots.band_deg[k]) * kPi / 180.0);
+                            const double lo = std::cos(slots.radius_deg[k] * kPi / 180.0);
+                            t[k] = std::clamp((hi - cos_e) / (hi - lo), 0.0, 1.0);
+                        }
+                        const double w[3] = {1.0 - t[0], t[0] * (1.0 - t[1]), t[0] * t[1]};
+                        double v = 0.0;
+                        for (int k = 0; k < slots.count; ++k) {
+                            if (w[k] > 0.0)
+                                v += w[k] *
+                                     sampleLayerD(*slot_image[k], *slot_rect[k], s.px, s.py, c);
+                        }
+                        out.at(x, y, c) = v;
+                    }
+                }
+            }
+        });
+    return out;
 }
 
 }  // namespace qvr

@@ -51,14 +51,7 @@ const LayerRect& layerRect(const EyeLayers& e, int k) {
     return k == 0 ? e.fovea : (k == 1 ? e.middle : e.outer);
 }
 
-// The present layers of one eye from the inside out, with the eccentricity where each ends and
-// the width of the blend band just inside that end.
-struct SlotInfo {
-    int count = 0;
-    int layer[3] = {0, 0, 0};
-    double radius_deg[3] = {kInf, kInf, kInf};
-    double band_deg[3] = {0, 0, 0};
-};
+using detail::SlotInfo;
 
 SlotInfo slotsOf(const HmdProfile& profile, const LayerPlan& plan, int eye, double band_texels) {
     SlotInfo s;
@@ -629,6 +622,11 @@ KernelParams timewarpParams(const HmdProfile& profile, const Pose& render_pose,
     KernelParams p;
     setWarpParams(p, warp, gaze, false);
     return p;
+}
+
+SlotInfo slotBands(const HmdProfile& profile, const LayerPlan& plan, int eye,
+                   double blend_band_texels) {
+    return slotsOf(profile, plan, eye, blend_band_texels);
 }
 
 void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count) {

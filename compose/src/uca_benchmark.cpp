@@ -162,6 +162,15 @@ Expected<UcaBenchResult> runUcaBenchmark(const UcaBenchOptions& o) {
             res.opencv_quality =
                 measureQuality(o.profile, plan, render_pose, display_pose, opencv_out[0], truth);
         }
+        const ImageRgbD layers = layerReferenceWarp(o.profile, frame, 0, display_pose);
+        res.uca_vs_layers =
+            measureQuality(o.profile, plan, render_pose, display_pose, uca_out[0], layers);
+        res.two_pass_vs_layers =
+            measureQuality(o.profile, plan, render_pose, display_pose, two_pass_out[0], layers);
+        if (!opencv_ms.empty()) {
+            res.opencv_vs_layers =
+                measureQuality(o.profile, plan, render_pose, display_pose, opencv_out[0], layers);
+        }
     }
     return res;
 }

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "qvr/compose/uca.h"
 #include "qvr/foveation/hmd_profile.h"
@@ -65,6 +66,18 @@ KernelParams composeParams(const HmdProfile& profile, const LayerFrame& frame, i
 // The lens + timewarp map of one eye (no slots): what a remap-based path needs to build its maps.
 KernelParams timewarpParams(const HmdProfile& profile, const Pose& render_pose,
                             const Pose& display_pose, const Gaze& gaze);
+// The present layers of one eye from the inside out, with the eccentricity where each ends and
+// the width of the Eq. 4 blend band just inside that end (docs/UCA.md).
+struct SlotInfo {
+    int count = 0;
+    int layer[3] = {0, 0, 0};  // 0 fovea, 1 middle, 2 outer
+    double radius_deg[3] = {std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::infinity(),
+                            std::numeric_limits<double>::infinity()};
+    double band_deg[3] = {0, 0, 0};
+};
+SlotInfo slotBands(const HmdProfile& profile, const LayerPlan& plan, int eye,
+                   double blend_band_texels);
 // Which plan layer (0 fovea, 1 middle, 2 outer) each kernel slot holds.
 void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count);
 void ucaTileSimd(const KernelParams& p, const TileJob& job);

@@ -71,6 +71,19 @@ TEST(ComposeQuality, UcaIsAtLeastAsGoodAsTwoPassInFoveaAndPeriphery) {
     EXPECT_GE(qu.periphery.psnr_db, qt.periphery.psnr_db);
     EXPECT_GE(qu.fovea.ssim, qt.fovea.ssim - 1e-4);
     EXPECT_GE(qu.periphery.ssim, qt.periphery.ssim);
+    // Against the layers' own Eq. 4 in double, only filtering and rounding remain: UCA filters
+    // each layer once, the two-pass path twice with an 8-bit buffer between, so UCA must be
+    // clearly closer, everywhere.
+    const ImageRgbD ideal = layerReferenceWarp(profile, frame, 0, display);
+    const QualityReport lu = measureQuality(profile, plan, render, display, uca[0], ideal);
+    const QualityReport lt = measureQuality(profile, plan, render, display, two_pass[0], ideal);
+    std::printf("vs layers: UCA fovea %.2f periphery %.2f dB; two-pass %.2f %.2f dB\n",
+                lu.fovea.psnr_db, lu.periphery.psnr_db, lt.fovea.psnr_db, lt.periphery.psnr_db);
+    EXPECT_GT(lu.fovea.psnr_db, 50.0);
+    EXPECT_GT(lu.periphery.psnr_db, 50.0);
+    EXPECT_GT(lu.fovea.psnr_db, lt.fovea.psnr_db + 1.0);
+    EXPECT_GT(lu.periphery.psnr_db, lt.periphery.psnr_db + 1.0);
+    EXPECT_GE(lu.periphery.ssim, lt.periphery.ssim);
     // Inside the fovea, clear of the blend band, UCA's only error is float maths and 8-bit
     // rounding: a wrong map or filter would show here first.
     LayerPlan core = plan;

@@ -33,4 +33,12 @@ ImageRgbD groundTruthWarp(const HmdProfile& profile, const ImageRgba8& full_rend
                           const Pose& render_pose, const Pose& display_pose,
                           bool chromatic_aberration = true);
 
+// The ideal display image of the layers themselves: Eq. 4 evaluated at every display pixel in
+// double precision (the same map, slots and blend band as UCA; bilinear per layer; no 8-bit
+// rounding). Against it, each path's error is its own filtering and rounding, without the
+// detail the foveated layers never held.
+ImageRgbD layerReferenceWarp(const HmdProfile& profile, const LayerFrame& frame, int eye,
+                             const Pose& display_pose, double blend_band_texels = 2.0,
+                             bool chromatic_aberration = true);
+
 }  // namespace qvr

@@ -43,6 +43,11 @@ struct UcaBenchResult {
     QualityReport uca_quality;       // left eye
     QualityReport two_pass_quality;  // left eye
     std::optional<QualityReport> opencv_quality;
+    // The same, against the layers' own double-precision Eq. 4 (layerReferenceWarp): each path's
+    // filtering error alone.
+    QualityReport uca_vs_layers;
+    QualityReport two_pass_vs_layers;
+    std::optional<QualityReport> opencv_vs_layers;
     int threads = 0;
     std::string simd_target;
 };
