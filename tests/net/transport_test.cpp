@@ -492,6 +492,30 @@ TEST(NetTransport, ThroughputFromAcksTracksAShapedLink) {
     EXPECT_LT(mbps, 52.0);
 }
 
+TEST(NetTransport, ServesFramesOverATraceDrivenLinkWithDelayAndJitter) {
+    EchoServer handler(20'000);
+    ServerOptions o;
+    auto link = parseLinkSpec("trace:" + std::string(QVR_SHARED_DIR) +
+                              "/data/network/TMobile-LTE-short.down@100,delay_ms=10,jitter_ms=3");
+    ASSERT_TRUE(link) << link.error();
+    o.link = link.value();
+    auto server = startServer(handler, o);
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok());
+    const ClientId id = server->clients()[0];
+    const auto start = std::chrono::steady_clock::now();
+    for (uint32_t f = 1; f <= 10; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+    }
+    const Received r = receive(client, id, 20'000, 40, 5s);
+    const auto took = std::chrono::steady_clock::now() - start;
+    EXPECT_EQ(r.streams, 40);
+    EXPECT_EQ(r.corrupt, 0);
+    // 800 KB at a mean of 100 Mbit/s is 64 ms, plus 10 ± 3 ms: the link really shaped it.
+    EXPECT_GT(took, 60ms);
+    EXPECT_EQ(server->linkStats(id).dropped_loss, 0u);
+}
+
 TEST(NetTransport, SendStreamRejectsBadArgumentsAndUnknownClients) {
     EchoServer handler(1000);
     auto server = startServer(handler);

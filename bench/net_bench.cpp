@@ -1,0 +1,132 @@
+// net benchmarks: protocol encode/decode, packetize + reassemble, the link emulator's own cost,
+// and end-to-end frame transfer between a server and a client on 127.0.0.1 (bytes/s), unshaped
+// and through the paper's link profiles. Numbers and command: docs/NETWORK.md.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <thread>
+
+#include "qvr/foveation/hmd_profile.h"
+#include "qvr/net/client.h"
+#include "qvr/net/link_emulator.h"
+#include "qvr/net/server.h"
+#include "qvr/net/stream_assembler.h"
+
+namespace qvr::net {
+namespace {
+
+FrameRequest sampleRequest(uint32_t frame_id) {
+    static const LayerPlanner planner(defaultHmdProfile());
+    return makeFrameRequest(frame_id, 0, Pose{}, planner.plan(Gaze{3.0, 2.0}, 12.0));
+}
+
+void BM_FrameRequestEncodeDecode(benchmark::State& state) {
+    const FrameRequest request = sampleRequest(1);
+    for (auto _ : state) {
+        const auto wire = encodeControl(request);
+        ControlMessage back;
+        benchmark::DoNotOptimize(decodeControl(wire, back));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FrameRequestEncodeDecode);
+
+void BM_PacketizeReassemble(benchmark::State& state) {
+    const std::vector<uint8_t> frame(static_cast<size_t>(state.range(0)), 0x5A);
+    StreamAssembler assembler;
+    uint32_t seq = 0, frame_id = 0;
+    for (auto _ : state) {
+        const auto packets = packetizeStream(1, seq, ++frame_id, 0, true, frame);
+        for (const auto& p : packets) {
+            MediaPacketView v;
+            decodeMediaPacket(p, v);
+            assembler.onPacket(v, 0);
+        }
+        benchmark::DoNotOptimize(assembler.takeCompleted());
+    }
+    state.SetBytesProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_PacketizeReassemble)->Arg(100'000)->Arg(1'000'000);
+
+void BM_LinkEmulatorPerPacket(benchmark::State& state) {
+    LinkConfig c = parseLinkSpec("wifi,delay_ms=5,jitter_ms=1,loss=0.01").value();
+    LinkEmulator link(c);
+    std::vector<std::vector<uint8_t>> out;
+    int64_t now_ns = 0;
+    for (auto _ : state) {
+        link.send(std::vector<uint8_t>(kMaxDatagramBytes), now_ns);
+        now_ns += 50'000;  // 1232 B every 50 µs ≈ 197 Mbit/s, just under the link
+        out.clear();
+        link.deliver(now_ns, out);
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_LinkEmulatorPerPacket);
+
+// One frame = four streams of range(0) bytes, requested and received one at a time, like a
+// client that waits for each frame: bytes/s is the goodput a frame sees on loopback.
+class Echo : public ServerHandler {
+public:
+    Server* server = nullptr;
+    size_t stream_bytes = 0;
+    void onFrameRequest(ClientId id, const FrameRequest& r) override {
+        for (uint8_t s = 0; s < kMaxStreams; ++s) {
+            server->sendStream(id, r.frame_id, s, true, std::vector<uint8_t>(stream_bytes, s));
+        }
+    }
+};
+
+void loopbackTransfer(benchmark::State& state, const char* link_spec) {
+    Echo echo;
+    echo.stream_bytes = static_cast<size_t>(state.range(0));
+    ServerOptions so;
+    so.key = PresharedKey::random();
+    so.link = parseLinkSpec(link_spec).value();
+    auto server = Server::start(so, echo);
+    if (!server) {
+        state.SkipWithError(server.error().c_str());
+        return;
+    }
+    echo.server = server->get();
+    ClientOptions co;
+    co.key = so.key;
+    Client client(co);
+    if (!client.connect("127.0.0.1", (*server)->port()).ok()) {
+        state.SkipWithError("connect failed");
+        return;
+    }
+    uint32_t frame_id = 0;
+    int64_t complete = 0, incomplete = 0;
+    for (auto _ : state) {
+        client.sendFrameRequest(sampleRequest(++frame_id));
+        int got = 0;
+        while (got < kMaxStreams) {
+            auto s = client.nextStream(500);
+            if (!s.ok() || !s->has_value()) {
+                break;
+            }
+            got += (*s)->frame_id == frame_id ? 1 : 0;
+        }
+        (got == kMaxStreams ? complete : incomplete) += 1;
+    }
+    state.SetBytesProcessed(complete * kMaxStreams * state.range(0));
+    state.counters["frames_incomplete"] = static_cast<double>(incomplete);
+    state.counters["ack_estimate_Mbps"] = client.throughputBps() / 1e6;
+}
+
+void BM_LoopbackFrames_Unshaped(benchmark::State& state) {
+    loopbackTransfer(state, "none");
+}
+void BM_LoopbackFrames_Wifi(benchmark::State& state) {
+    loopbackTransfer(state, "wifi");
+}
+void BM_LoopbackFrames_5g(benchmark::State& state) {
+    loopbackTransfer(state, "5g");
+}
+BENCHMARK(BM_LoopbackFrames_Unshaped)->Arg(25'000)->Arg(250'000)->UseRealTime();
+BENCHMARK(BM_LoopbackFrames_Wifi)->Arg(25'000)->Arg(250'000)->UseRealTime();
+BENCHMARK(BM_LoopbackFrames_5g)->Arg(250'000)->UseRealTime();
+
+}  // namespace
+}  // namespace qvr::net
