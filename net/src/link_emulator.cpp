@@ -142,14 +142,14 @@ double LinkEmulator::opportunityNs(int64_t index) const {
     const int64_t loop = index / n;
     const double ms = static_cast<double>(stamps[static_cast<size_t>(index % n)]) +
                       static_cast<double>(loop) * static_cast<double>(m_config.trace->period_ms);
-    return ms * m_trace_ns_per_ms;
+    return m_trace_origin_ns + ms * m_trace_ns_per_ms;
 }
 
 int64_t LinkEmulator::firstOpportunityAtOrAfter(double t_ns) const {
     const auto& stamps = m_config.trace->stamps_ms;
     const int64_t n = static_cast<int64_t>(stamps.size());
     const double period_ms = static_cast<double>(m_config.trace->period_ms);
-    const double t_ms = std::max(0.0, t_ns / m_trace_ns_per_ms);
+    const double t_ms = std::max(0.0, (t_ns - m_trace_origin_ns) / m_trace_ns_per_ms);
     int64_t loop = static_cast<int64_t>(std::floor(t_ms / period_ms));
     int64_t index = loop * n;
     // Within the loop, the first stamp whose time is not before t; rounding can put t a hair
@@ -167,6 +167,12 @@ int64_t LinkEmulator::firstOpportunityAtOrAfter(double t_ns) const {
 
 double LinkEmulator::departureNs(double start_ns, int64_t bytes) {
     if (m_config.trace) {
+        if (!m_trace_started) {
+            // The trace starts with the link's first packet, not at the clock's epoch, so a
+            // session always sees the trace from its beginning.
+            m_trace_started = true;
+            m_trace_origin_ns = start_ns;
+        }
         if (opportunityNs(m_opp_index) < start_ns) {
             // Opportunities that passed with nothing queued are lost, as in Mahimahi.
             m_opp_index = firstOpportunityAtOrAfter(start_ns);

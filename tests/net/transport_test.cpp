@@ -493,11 +493,32 @@ TEST(NetTransport, ThroughputFromAcksTracksAShapedLink) {
 }
 
 TEST(NetTransport, ServesFramesOverATraceDrivenLinkWithDelayAndJitter) {
+    const std::string spec = "trace:" + std::string(QVR_SHARED_DIR) +
+                             "/data/network/TMobile-LTE-short.down@100,delay_ms=10,jitter_ms=3";
+    auto link = parseLinkSpec(spec);
+    ASSERT_TRUE(link) << link.error();
+    // The fastest the link can carry the 40 streams: all datagrams queued at its first instant
+    // (later sends only lose opportunities), plus the smallest delay, 10 − 3 ms.
+    int64_t fastest_ns = 0;
+    {
+        LinkConfig bare = link.value();
+        bare.delay_ms = bare.jitter_ms = 0;
+        LinkEmulator model(bare);
+        uint32_t seq = 0;
+        for (int s = 0; s < 40; ++s) {
+            for (auto& p : packetizeStream(1, seq, 1, 0, true, std::vector<uint8_t>(20'000))) {
+                ASSERT_TRUE(model.send(std::move(p), 0));
+            }
+        }
+        std::vector<std::vector<uint8_t>> out;
+        while (auto next = model.nextDeliveryNs()) {
+            fastest_ns = *next;
+            model.deliver(*next, out);
+        }
+        fastest_ns += 7'000'000;
+    }
     EchoServer handler(20'000);
     ServerOptions o;
-    auto link = parseLinkSpec("trace:" + std::string(QVR_SHARED_DIR) +
-                              "/data/network/TMobile-LTE-short.down@100,delay_ms=10,jitter_ms=3");
-    ASSERT_TRUE(link) << link.error();
     o.link = link.value();
     auto server = startServer(handler, o);
     Client client(clientOptions());
@@ -511,8 +532,8 @@ TEST(NetTransport, ServesFramesOverATraceDrivenLinkWithDelayAndJitter) {
     const auto took = std::chrono::steady_clock::now() - start;
     EXPECT_EQ(r.streams, 40);
     EXPECT_EQ(r.corrupt, 0);
-    // 800 KB at a mean of 100 Mbit/s is 64 ms, plus 10 ± 3 ms: the link really shaped it.
-    EXPECT_GT(took, 60ms);
+    EXPECT_GT(fastest_ns, 7'000'000 + 20'000'000);  // 820 KB at ~100 Mbit/s: tens of ms
+    EXPECT_GE(took, std::chrono::nanoseconds(fastest_ns) - 1ms);  // the link really shaped it
     EXPECT_EQ(server->linkStats(id).dropped_loss, 0u);
 }
 

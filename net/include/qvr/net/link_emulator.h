@@ -37,6 +37,7 @@ struct LinkConfig {
 // "none", "wifi" (200 Mbit/s), "lte" (100), "5g" (500) — paper Table 2 — "rate:MBPS", or
 // "trace:PATH[@MBPS]" (a Mahimahi file, rescaled to MBPS when given), followed by options
 // ",delay_ms=D", ",jitter_ms=J", ",loss=P" (0 ≤ P < 1), ",queue_kb=Q", ",seed=S".
+// A trace starts (its time 0) with the first packet sent through the link.
 Expected<LinkConfig> parseLinkSpec(const std::string& spec);
 const std::vector<std::string>& linkProfileNames();
 
@@ -98,6 +99,8 @@ private:
     int64_t m_opp_index = 0;       // trace mode: the opportunity being filled
     int64_t m_opp_left_bytes = 0;  // bytes left in it
     double m_trace_ns_per_ms = 1e6;
+    bool m_trace_started = false;
+    double m_trace_origin_ns = 0.0;  // the time of the first packet: trace time 0
     int64_t m_last_deliver_ns = 0;
     std::deque<Queued> m_queue;  // departure times of packets still in the bottleneck
     int64_t m_queue_bytes = 0;
