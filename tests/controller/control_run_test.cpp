@@ -89,6 +89,20 @@ TEST(Summarize, AveragesFrameTimeAsMaxOfLocalAndRemoteWhenSummarising) {
     EXPECT_DOUBLE_EQ(s.prediction_error_remote_pct, 0.0);
 }
 
+TEST(Summarize, TakesNearestRankP99WhenFramesVary) {
+    // Frame times 1…200 ms in a scrambled order: the 99th percentile by nearest rank is the
+    // ceil(0.99·200) = 198th smallest, 198 ms.
+    std::vector<ControlFrame> frames;
+    for (int i = 0; i < 200; ++i) {
+        const double ms = static_cast<double>((i * 77) % 200 + 1);
+        frames.push_back(frameWith(ms, ms / 2.0));
+    }
+    const ControlSummary s = summarize(frames);
+    EXPECT_DOUBLE_EQ(s.frame_ms_p99, 198.0);
+    EXPECT_DOUBLE_EQ(s.frame_ms_mean, 100.5);
+    EXPECT_DOUBLE_EQ(summarize({frameWith(3, 9)}).frame_ms_p99, 9.0);
+}
+
 class SyntheticDefault : public ::testing::Test {
 protected:
     SyntheticDefault()

@@ -102,6 +102,27 @@ TEST(SoftwareReactivePolicy, MovesTowardsBalanceByBoundedStepsWhenRemoteIsSlow) 
     EXPECT_GT(prev, c.e1_initial_deg);
 }
 
+TEST(SoftwareReactivePolicy, ShrinksFoveaByBoundedStepsWhenLocalIsSlow) {
+    const WorkloadHeader h = defaultHeader();
+    SoftwareReactiveConfig c;
+    c.e1_initial_deg = 30.0;
+    auto sw = makeSoftwareReactivePolicy(h, c);
+    double prev = c.e1_initial_deg;
+    for (int i = 0; i < 8; ++i) {
+        const Decision d = sw->decide(bareFrame(i));
+        EXPECT_LE(std::fabs(d.e1_deg - prev), c.max_step_deg + 1e-9);
+        EXPECT_LE(d.e1_deg, prev + 1e-9) << "a local-bound frame must not grow the fovea";
+        EXPECT_GE(d.e1_deg, c.e1_min_deg);
+        prev = d.e1_deg;
+        FrameMeasurement m = remoteBound(i, d.e1_deg);
+        m.t_local_ms = 50.0;
+        m.t_remote_ms = 1.0;
+        m.middle_bytes = m.outer_bytes = 6'250.0;  // 1 ms at 100 Mbit/s
+        sw->observe(m);
+    }
+    EXPECT_LT(prev, c.e1_initial_deg - c.max_step_deg);
+}
+
 TEST(SoftwareReactivePolicy, KeepsInitialE1WhenNothingIsMeasured) {
     auto sw = makeSoftwareReactivePolicy(defaultHeader());
     for (int i = 0; i < 5; ++i)
