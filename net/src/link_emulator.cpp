@@ -120,7 +120,8 @@ LinkEmulator::LinkEmulator(LinkConfig config)
       m_loss_rng(m_config.seed * 0x9E3779B97F4A7C15ull + 1),
       m_jitter_rng(m_config.seed * 0xBF58476D1CE4E5B9ull + 2) {
     QVR_CHECK(m_config.rate_bps >= 0 && m_config.delay_ms >= 0 && m_config.jitter_ms >= 0);
-    QVR_CHECK(m_config.loss >= 0 && m_config.loss < 1 && m_config.queue_bytes > 0);
+    QVR_CHECK(m_config.loss >= 0 && m_config.loss < 1 && m_config.queue_bytes > 0 &&
+              m_config.max_in_flight_bytes > 0);
     if (m_config.trace) {
         QVR_CHECK(m_config.trace->period_ms > 0 && !m_config.trace->stamps_ms.empty());
         // Dividing every stamp by target / mean compresses time so the mean becomes the target.
@@ -222,7 +223,8 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         return false;
     }
     drainQueue(now_ns);
-    if (m_queue_bytes + bytes > m_config.queue_bytes) {
+    if (m_queue_bytes + bytes > m_config.queue_bytes ||
+        m_flight_bytes + bytes > m_config.max_in_flight_bytes) {
         ++m_stats.dropped_queue;
         return false;
     }
@@ -241,6 +243,7 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         std::max(m_last_deliver_ns, static_cast<int64_t>(std::llround(departure + delay_ns)));
     m_last_deliver_ns = deliver_ns;
     m_flight.push_back({std::move(packet), deliver_ns});
+    m_flight_bytes += bytes;
     return true;
 }
 
@@ -248,6 +251,7 @@ void LinkEmulator::deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& ou
     while (!m_flight.empty() && m_flight.front().deliver_ns <= now_ns) {
         ++m_stats.packets_delivered;
         m_stats.bytes_delivered += m_flight.front().bytes.size();
+        m_flight_bytes -= static_cast<int64_t>(m_flight.front().bytes.size());
         out.push_back(std::move(m_flight.front().bytes));
         m_flight.pop_front();
     }

@@ -162,6 +162,22 @@ TEST(NetLinkEmulator, DropTailQueueBoundsTheBacklog) {
     EXPECT_EQ(accepted, 15);
 }
 
+TEST(NetLinkEmulator, DelayLineIsBoundedWithoutARateLimit) {
+    LinkConfig c;
+    c.delay_ms = 1000.0;  // no rate: nothing waits in the queue, everything in the delay line
+    c.max_in_flight_bytes = 100'000;
+    LinkEmulator link(c);
+    int accepted = 0;
+    for (int i = 0; i < 200; ++i) {
+        accepted += link.send(packet(1000), 0) ? 1 : 0;
+    }
+    EXPECT_EQ(accepted, 100);
+    std::vector<std::vector<uint8_t>> out;
+    link.deliver(1'000'000'000, out);
+    EXPECT_EQ(out.size(), 100u);
+    EXPECT_TRUE(link.send(packet(1000), 1'000'000'000));  // room again once delivered
+}
+
 TEST(NetLinkEmulator, ParsesProfilesAndOptions) {
     auto wifi = parseLinkSpec("wifi");
     ASSERT_TRUE(wifi) << wifi.error();

@@ -27,6 +27,7 @@ struct LinkConfig {
     double jitter_ms = 0.0;                      // uniform in [-jitter, +jitter], order kept
     double loss = 0.0;                           // per-packet drop probability before the queue
     int64_t queue_bytes = 4 << 20;               // drop-tail bottleneck buffer
+    int64_t max_in_flight_bytes = 64 << 20;      // the delay line (rate × delay) is bounded too
     uint64_t seed = 1;
     bool shaped() const {
         return rate_bps > 0.0 || trace != nullptr || delay_ms > 0.0 || jitter_ms > 0.0 ||
@@ -45,7 +46,7 @@ struct LinkStats {
     uint64_t packets_in = 0;
     uint64_t packets_delivered = 0;
     uint64_t dropped_loss = 0;   // random loss
-    uint64_t dropped_queue = 0;  // the bottleneck buffer was full
+    uint64_t dropped_queue = 0;  // the bottleneck buffer (or the delay line) was full
     uint64_t bytes_in = 0;
     uint64_t bytes_delivered = 0;
 };
@@ -105,6 +106,7 @@ private:
     std::deque<Queued> m_queue;  // departure times of packets still in the bottleneck
     int64_t m_queue_bytes = 0;
     std::deque<InFlight> m_flight;  // ordered by deliver_ns
+    int64_t m_flight_bytes = 0;
     LinkStats m_stats;
 };
 
