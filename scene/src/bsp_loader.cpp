@@ -571,6 +571,9 @@ void BspParser::readEntities(Scene& scene) {
 Expected<Scene> BspParser::run(const std::string& name) {
     if (m_opts.patch_level < 1 || m_opts.patch_level > 64)
         return makeError(fmt::format("patch level {} is outside 1…64", m_opts.patch_level));
+    if (m_opts.lightmap_overbright_bits < 0 || m_opts.lightmap_overbright_bits > 4)
+        return makeError(fmt::format("lightmap overbright bits {} is outside 0…4",
+                                     m_opts.lightmap_overbright_bits));
     if (Status s = readHeader(); !s)
         return makeError(s.error());
     const std::pair<int, size_t> lumps[] = {

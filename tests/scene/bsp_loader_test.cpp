@@ -56,6 +56,13 @@ TEST(BspLoader, PatchTriangleCountFollowsTheTessellationLevel) {
     }
     EXPECT_FALSE(parse(makeSampleBsp().bytes(), noTextures(0)).ok());
     EXPECT_FALSE(parse(makeSampleBsp().bytes(), noTextures(65)).ok());
+    SceneLoadOptions o = noTextures();
+    o.lightmap_overbright_bits = 9;
+    EXPECT_FALSE(parse(makeSampleBsp().bytes(), o).ok());
+    o.lightmap_overbright_bits = 0;  // unbrightened: the lump's bytes as they are
+    const auto raw = parse(makeSampleBsp().bytes(), o);
+    ASSERT_TRUE(raw.ok()) << raw.error();
+    EXPECT_EQ(raw->lightmaps[0].rgba[2], 200);
 }
 
 TEST(BspLoader, PatchSurfacePassesThroughItsCornersAndBulgesAQuarterOfTheMiddlePoint) {

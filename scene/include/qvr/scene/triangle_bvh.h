@@ -60,6 +60,7 @@ struct BvhQueryStats {
     uint64_t triangles_tested = 0;      // exact per-triangle tests
 };
 
+// Built once per scene; queries are const and may run concurrently from several threads.
 class TriangleBvh {
 public:
     // Builds over the scene's triangles (positions copied; the scene may go away afterwards).
