@@ -2,12 +2,34 @@
 // renderer, the codec and the compositor.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <new>
 #include <vector>
 
 #include "qvr/core/check.h"
 
 namespace qvr {
+
+// Pixel storage starts on a 64-byte cache line, so that vector kernels can use aligned and
+// streaming (non-temporal) stores on rows whose byte offset is a multiple of 64.
+inline constexpr size_t kImageAlignment = 64;
+
+template <typename T>
+struct CacheLineAllocator {
+    using value_type = T;
+    CacheLineAllocator() = default;
+    template <typename U>
+    CacheLineAllocator(const CacheLineAllocator<U>&) {}  // NOLINT: rebinding is implicit
+    T* allocate(size_t n) {
+        return static_cast<T*>(::operator new (n * sizeof(T), std::align_val_t{kImageAlignment}));
+    }
+    void deallocate(T* p, size_t) { ::operator delete (p, std::align_val_t{kImageAlignment}); }
+    template <typename U>
+    bool operator==(const CacheLineAllocator<U>&) const {
+        return true;
+    }
+};
 
 template <typename T, int kChannels>
 class Image {
@@ -42,7 +64,7 @@ public:
 private:
     int m_width = 0;
     int m_height = 0;
-    std::vector<T> m_data;
+    std::vector<T, CacheLineAllocator<T>> m_data;
 };
 
 using ImageRgba8 = Image<uint8_t, 4>;
