@@ -139,6 +139,9 @@ struct EyeJob {
     ImageRgba8* out = nullptr;
     std::vector<TileKind>* kinds = nullptr;
     std::vector<uint8_t>* masks = nullptr;
+    // The display image streams past the caches; the two-pass eye buffer, read right back by
+    // its second pass, does not.
+    bool stream_output = true;
 };
 
 double angleRad(const glm::dvec3& a, const glm::dvec3& b) {
@@ -345,6 +348,7 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options,
                                   t.slot_mask = (*j.masks)[static_cast<size_t>(tile)];
                                   t.out = j.out->data();
                                   t.out_stride_px = static_cast<size_t>(j.out->width());
+                                  t.stream = j.stream_output;
                                   if (simd) {
                                       detail::ucaTileSimd(j.params, t);
                                   } else {
@@ -565,6 +569,7 @@ Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
         }
         setBorders(j.params, j.slots);
         ensureSize(buffers[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
+        j.stream_output = false;
         compose_jobs.push_back(std::move(j));
     }
     TileStats pass1;

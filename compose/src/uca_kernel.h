@@ -54,6 +54,9 @@ struct TileJob {
     uint8_t slot_mask = 0;
     uint8_t* out = nullptr;
     size_t out_stride_px = 0;
+    // Write with streaming (non-temporal) stores where aligned: the display image is written
+    // once and read by someone else, so it need not displace the layers from the caches.
+    bool stream = false;
 };
 
 inline constexpr uint32_t kOpaqueBlack = 0xFF000000u;

@@ -5,6 +5,7 @@
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "uca_kernel_hwy.cpp"
+#include <hwy/cache_control.h>
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
@@ -266,6 +267,7 @@ void UcaTile(const KernelParams& p, const TileJob& job) {
     const int lanes = static_cast<int>(hn::Lanes(df));
     const VF iota = hn::Iota(df, 0.0f);
     HWY_ALIGN uint32_t tail[HWY_MAX_BYTES / sizeof(uint32_t)];
+    const uintptr_t vector_bytes = static_cast<uintptr_t>(lanes) * sizeof(uint32_t);
     for (int y = job.y0; y < job.y1; ++y) {
         auto* row =
             reinterpret_cast<uint32_t*>(job.out) + static_cast<size_t>(y) * job.out_stride_px;
@@ -279,13 +281,21 @@ void UcaTile(const KernelParams& p, const TileJob& job) {
                 packed = shadePacked(p, u, v, job.slot_mask);
             }
             if (x + lanes <= job.x1) {
-                hn::StoreU(packed, du, row + x);
+                if (job.stream &&
+                    (reinterpret_cast<uintptr_t>(row + x) & (vector_bytes - 1)) == 0) {
+                    hn::Stream(packed, du, row + x);
+                } else {
+                    hn::StoreU(packed, du, row + x);
+                }
             } else {
                 hn::Store(packed, du, tail);
                 std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
             }
         }
     }
+    // Streaming stores are weakly ordered: make them visible before the tile counts as done.
+    if (job.stream)
+        hwy::FlushStream();
 }
 
 const char* TargetName() {
