@@ -20,6 +20,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kRadPerDeg = kPi / 180.0;
 constexpr uint32_t kLeafTriangles = 4;
+constexpr int kSahBins = 16;
 constexpr int kMaxClipVertices = 16;
 
 struct Plane {
@@ -421,10 +422,74 @@ void TriangleBvh::build(const std::vector<glm::vec3>& positions,
         if (n <= kLeafTriangles || (ext.x <= 0 && ext.y <= 0 && ext.z <= 0))
             continue;
         const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-        const uint32_t mid = job.begin + n / 2;
-        std::nth_element(
-            order.begin() + job.begin, order.begin() + mid, order.begin() + job.end,
-            [&](uint32_t a, uint32_t b) { return centroid[a][axis] < centroid[b][axis]; });
+        // Binned surface-area heuristic along the longest centroid axis: tight boxes keep
+        // queries from descending into nodes that only brush a ring or plane.
+        struct Bin {
+            glm::vec3 mn{1e30f}, mx{-1e30f};
+            uint32_t count = 0;
+        };
+        std::array<Bin, kSahBins> bins;
+        const float lo = cmn[axis];
+        const float scale = static_cast<float>(kSahBins) / ext[axis];
+        auto binOf = [&](uint32_t t) {
+            return std::min(kSahBins - 1, static_cast<int>((centroid[t][axis] - lo) * scale));
+        };
+        for (uint32_t i = job.begin; i < job.end; ++i) {
+            const uint32_t t = order[i];
+            Bin& b = bins[static_cast<size_t>(binOf(t))];
+            ++b.count;
+            for (int k = 0; k < 3; ++k) {
+                b.mn = glm::min(b.mn, positions[indices[3 * t + static_cast<uint32_t>(k)]]);
+                b.mx = glm::max(b.mx, positions[indices[3 * t + static_cast<uint32_t>(k)]]);
+            }
+        }
+        auto area = [](const glm::vec3& a, const glm::vec3& b) {
+            const glm::vec3 e = glm::max(b - a, glm::vec3(0));
+            return e.x * e.y + e.y * e.z + e.z * e.x;
+        };
+        std::array<float, kSahBins> left_cost{};
+        glm::vec3 amn(1e30f), amx(-1e30f);
+        uint32_t acount = 0;
+        for (int i = 0; i < kSahBins - 1; ++i) {
+            amn = glm::min(amn, bins[static_cast<size_t>(i)].mn);
+            amx = glm::max(amx, bins[static_cast<size_t>(i)].mx);
+            acount += bins[static_cast<size_t>(i)].count;
+            left_cost[static_cast<size_t>(i)] =
+                acount == 0 ? 0.0f : area(amn, amx) * static_cast<float>(acount);
+        }
+        int best = -1;
+        float best_cost = 1e38f;
+        amn = glm::vec3(1e30f);
+        amx = glm::vec3(-1e30f);
+        acount = 0;
+        for (int i = kSahBins - 1; i >= 1; --i) {
+            amn = glm::min(amn, bins[static_cast<size_t>(i)].mn);
+            amx = glm::max(amx, bins[static_cast<size_t>(i)].mx);
+            acount += bins[static_cast<size_t>(i)].count;
+            const uint32_t left_count = n - acount;
+            if (acount == 0 || left_count == 0)
+                continue;
+            const float cost =
+                left_cost[static_cast<size_t>(i - 1)] + area(amn, amx) * static_cast<float>(acount);
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = i;
+            }
+        }
+        uint32_t mid = job.begin + n / 2;
+        if (best > 0) {
+            mid = static_cast<uint32_t>(
+                std::partition(order.begin() + job.begin, order.begin() + job.end,
+                               [&](uint32_t t) { return binOf(t) < best; }) -
+                order.begin());
+        }
+        if (best <= 0 || mid == job.begin || mid == job.end) {
+            // Every centroid in one bin: fall back to the median.
+            mid = job.begin + n / 2;
+            std::nth_element(
+                order.begin() + job.begin, order.begin() + mid, order.begin() + job.end,
+                [&](uint32_t a, uint32_t b) { return centroid[a][axis] < centroid[b][axis]; });
+        }
         const uint32_t left = static_cast<uint32_t>(m_nodes.size());
         node.left = left;
         m_nodes.push_back(Node{});
