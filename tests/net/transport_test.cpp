@@ -392,10 +392,13 @@ TEST(NetTransport, FivePercentLossKeepsFramesComingWithKeyFrameRequests) {
     const double loss = static_cast<double>(ls.dropped_loss) / static_cast<double>(ls.packets_in);
     EXPECT_NEAR(loss, 0.05, 0.02);
     EXPECT_EQ(total.corrupt, 0);
-    // ≈ 0.95^4 = 81% of 1200 streams complete; most are decodable because a key frame follows
-    // each loss within a frame or two.
+    // ≈ 0.95^4 = 81% of 1200 streams complete. A loss (18.5% of stream frames) leaves its
+    // stream undecodable until a key frame arrives — detection at the next frame, the request,
+    // the key frame a frame later, itself lost 18.5% of the time — so ~55% stay decodable.
+    // Without key-frame requests a stream would never decode again after its first loss
+    // (a few percent of 1200), so the bound below shows recovery, not luck.
     EXPECT_GT(total.streams, 1200 * 0.70);
-    EXPECT_GT(total.decodable, 1200 * 0.55);
+    EXPECT_GT(total.decodable, 1200 * 0.35);
     EXPECT_GT(cs.assembler.streams_lost, 0u);
     EXPECT_FALSE(client.takeLost().empty());  // the caller learns which streams to stop awaiting
     EXPECT_GT(cs.key_frame_requests_sent, 10u);
