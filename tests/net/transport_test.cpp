@@ -11,6 +11,10 @@
 #include <mutex>
 #include <thread>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include "qvr/foveation/hmd_profile.h"
 #include "qvr/net/auth.h"
 #include "qvr/net/client.h"
@@ -455,6 +459,67 @@ TEST(NetTransport, KilledServerSurfacesAsErrorAndTheClientReconnects) {
     EXPECT_EQ(r.corrupt, 0);
     EXPECT_EQ(client.stats().connects, 2u);
     EXPECT_GE(client.stats().connect_failures, 1u);
+}
+
+// The same with a real process death: the server runs in a child process that gets SIGKILL
+// mid-stream, so nothing in it says goodbye; the kernel closing its sockets is all the client
+// sees. Then a new server takes the port and the client reconnects.
+TEST(NetTransport, SigkilledServerProcessSurfacesAsErrorAndTheClientReconnects) {
+    int pipe_fds[2];
+    ASSERT_EQ(pipe(pipe_fds), 0);
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        // Child: serve until killed. Only async-signal-safe exits from here on.
+        close(pipe_fds[0]);
+        EchoServer handler(3000);
+        ServerOptions o;
+        o.key = testKey();
+        auto server = Server::start(o, handler);
+        uint16_t port = server ? (*server)->port() : 0;
+        if (server) {
+            handler.server = server->get();
+        }
+        if (write(pipe_fds[1], &port, sizeof(port)) != sizeof(port)) {
+            _exit(2);
+        }
+        for (int i = 0; i < 100; ++i) {  // at most 10 s, should the parent die first
+            std::this_thread::sleep_for(100ms);
+        }
+        _exit(0);
+    }
+    close(pipe_fds[1]);
+    uint16_t port = 0;
+    ASSERT_EQ(read(pipe_fds[0], &port, sizeof(port)), static_cast<ssize_t>(sizeof(port)));
+    close(pipe_fds[0]);
+    ASSERT_NE(port, 0);
+
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", port).ok()) << client.lastError().error();
+    for (uint32_t f = 1; f <= 5; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+    }
+    EXPECT_EQ(receive(client, 0, 3000, 20, 3s).streams, 20);
+    ASSERT_EQ(kill(child, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFSIGNALED(status));
+
+    const auto deadline = std::chrono::steady_clock::now() + 3s;
+    bool saw_error = false;
+    while (!saw_error && std::chrono::steady_clock::now() < deadline) {
+        saw_error = !client.nextStream(50).ok();
+    }
+    ASSERT_TRUE(saw_error) << "the client never noticed the server process died";
+    EXPECT_FALSE(client.connected());
+
+    EchoServer handler(3000);
+    ServerOptions o;
+    o.port = port;
+    auto second = startServer(handler, o);
+    ASSERT_TRUE(client.connect("127.0.0.1", port).ok()) << client.lastError().error();
+    ASSERT_TRUE(client.sendFrameRequest(request(50)).ok());
+    EXPECT_EQ(receive(client, second->clients()[0], 3000, 4, 3s).streams, 4);
 }
 
 TEST(NetTransport, ConnectTimesOutOnASilentServer) {
