@@ -167,6 +167,11 @@ TEST(Pk3, InstalledGameNamesGiveClearErrors) {
     const auto nex = loadScene("nexuiz:x", o);
     ASSERT_FALSE(nex.ok());
     EXPECT_THAT(nex.error(), HasSubstr("nexuiz-data"));
+    // Nexuiz levels are the same format, found the same way in their own directory.
+    o.nexuiz_dir = dir.file("");
+    const auto nex_ok = loadScene("nexuiz:beta", o);
+    ASSERT_TRUE(nex_ok.ok()) << nex_ok.error();
+    EXPECT_EQ(nex_ok->name, "nexuiz:beta");
     const auto nofile = loadScene("/nonexistent/level.bsp", o);
     ASSERT_FALSE(nofile.ok());
     EXPECT_THAT(nofile.error(), HasSubstr("no such file"));
