@@ -133,7 +133,6 @@ void setBorders(detail::KernelParams& p, const SlotInfo& s) {
 // One eye of one pass: the map, the kernel parameters and the slots for classification.
 struct EyeJob {
     EyeWarp warp;
-    Gaze gaze;
     SlotInfo slots;
     detail::KernelParams params;
     ImageRgba8* out = nullptr;
@@ -490,7 +489,6 @@ Expected<ComposeReport> Compositor::compose(const LayerFrame& frame, const Pose&
     jobs.reserve(2);
     for (int eye = 0; eye < 2; ++eye) {
         EyeJob j{EyeWarp(m_profile, frame.render_pose.orientation, display_pose.orientation),
-                 frame.plan.gaze,
                  slotsOf(m_profile, frame.plan, eye, m_options.blend_band_texels),
                  {},
                  &out[static_cast<size_t>(eye)],
@@ -552,7 +550,6 @@ Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
     std::vector<EyeJob> compose_jobs;
     for (int eye = 0; eye < 2; ++eye) {
         EyeJob j{EyeWarp(flat, frame.render_pose.orientation, frame.render_pose.orientation),
-                 frame.plan.gaze,
                  slotsOf(m_profile, frame.plan, eye, m_options.blend_band_texels),
                  {},
                  &buffers[static_cast<size_t>(eye)],
@@ -581,7 +578,6 @@ Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
     std::vector<EyeJob> warp_jobs;
     for (int eye = 0; eye < 2; ++eye) {
         EyeJob j{EyeWarp(m_profile, frame.render_pose.orientation, display_pose.orientation),
-                 frame.plan.gaze,
                  SlotInfo{},
                  {},
                  &out[static_cast<size_t>(eye)],
