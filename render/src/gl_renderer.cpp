@@ -19,6 +19,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "egl_context.h"
+#include "qvr/render/draw_list.h"
 
 namespace qvr {
 
@@ -158,6 +159,7 @@ struct GlRenderer::Impl {
     std::vector<GLuint> textures;
     std::vector<GLuint> lightmaps;
     std::vector<SceneBatch> batches;
+    DrawList draw_list;
     // Layers of a plan alternate between a few sizes; one framebuffer per size avoids
     // reallocating them every frame.
     std::map<std::pair<int, int>, Framebuffer> framebuffers;
@@ -192,6 +194,7 @@ struct GlRenderer::Impl {
         glDeleteBuffers(1, &index_buffer);
         vertex_buffer = index_buffer = 0;
         batches.clear();
+        draw_list = {};
     }
 
     static void releaseFramebuffer(Framebuffer& fb) {
@@ -334,25 +337,9 @@ struct GlRenderer::Impl {
     }
 
     Status upload(const Scene& scene) {
-        for (const SceneBatch& b : scene.batches) {
-            const uint64_t end = static_cast<uint64_t>(b.first_index) + b.index_count;
-            if (end > scene.indices.size() || b.index_count % 3 != 0)
-                return makeError(
-                    fmt::format("render: scene '{}' has a batch of indices [{}, {}) of {} indices",
-                                scene.name, b.first_index, end, scene.indices.size()));
-            if (b.texture >= static_cast<int>(scene.textures.size()) ||
-                b.lightmap >= static_cast<int>(scene.lightmaps.size()))
-                return makeError(
-                    fmt::format("render: scene '{}' has a batch with texture {} of "
-                                "{} and lightmap {} of {}",
-                                scene.name, b.texture, scene.textures.size(), b.lightmap,
-                                scene.lightmaps.size()));
-        }
-        for (uint32_t i : scene.indices) {
-            if (i >= scene.vertices.size())
-                return makeError(fmt::format("render: scene '{}' has vertex index {} of {}",
-                                             scene.name, i, scene.vertices.size()));
-        }
+        if (Status s = checkDrawable(scene); !s)
+            return s;
+        DrawList list = buildDrawList(scene);
         if (Status s = egl->makeCurrent(); !s)
             return s;
         releaseScene();
@@ -376,12 +363,13 @@ struct GlRenderer::Impl {
                                                                              sizeof(SceneVertex))),
                              scene.vertices.empty() ? nullptr : scene.vertices.data(), 0);
         glNamedBufferStorage(index_buffer,
-                             std::max<GLsizeiptr>(1, static_cast<GLsizeiptr>(scene.indices.size() *
+                             std::max<GLsizeiptr>(1, static_cast<GLsizeiptr>(list.indices.size() *
                                                                              sizeof(uint32_t))),
-                             scene.indices.empty() ? nullptr : scene.indices.data(), 0);
+                             list.indices.empty() ? nullptr : list.indices.data(), 0);
         glVertexArrayVertexBuffer(vao, 0, vertex_buffer, 0, sizeof(SceneVertex));
         glVertexArrayElementBuffer(vao, index_buffer);
         batches = scene.batches;
+        draw_list = std::move(list);
         return checkGl("scene upload");
     }
 
@@ -475,20 +463,20 @@ struct GlRenderer::Impl {
         glUniform1f(1, options.lightmap_gain);
         glBindVertexArray(vao);
 
-        const BatchSelection selection = selectBatches(batches, view);
+        const DrawSelection selection = selectDraws(draw_list, view);
         glBeginQuery(GL_TIME_ELAPSED, query_time);
         glBeginQuery(GL_PRIMITIVES_GENERATED, query_primitives);
         if (info.pipeline_statistics) {
             glBeginQuery(kClippingInputPrimitives, query_clip_in);
             glBeginQuery(kClippingOutputPrimitives, query_clip_out);
         }
-        for (uint32_t index : selection.batches) {
-            const SceneBatch& b = batches[index];
+        for (const DrawRange& d : selection.draws) {
+            const SceneBatch& b = batches[d.batch];
             glBindTextureUnit(0, b.texture >= 0 ? textures[static_cast<size_t>(b.texture)] : white);
             glBindTextureUnit(1,
                               b.lightmap >= 0 ? lightmaps[static_cast<size_t>(b.lightmap)] : white);
-            const uintptr_t offset = static_cast<uintptr_t>(b.first_index) * sizeof(uint32_t);
-            glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(b.index_count), GL_UNSIGNED_INT,
+            const uintptr_t offset = static_cast<uintptr_t>(d.first_index) * sizeof(uint32_t);
+            glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(d.index_count), GL_UNSIGNED_INT,
                            reinterpret_cast<const void*>(offset));
         }
         if (info.pipeline_statistics) {
@@ -529,8 +517,9 @@ struct GlRenderer::Impl {
             stats.clipping_input_primitives = clip_in;
             stats.clipping_output_primitives = clip_out;
         }
-        stats.batches_drawn = static_cast<uint32_t>(selection.batches.size());
-        stats.batches_culled = selection.culled;
+        stats.clusters_drawn = selection.clusters_drawn;
+        stats.clusters_culled = selection.clusters_culled;
+        stats.draw_calls = static_cast<uint32_t>(selection.draws.size());
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         if (Status s = checkGl("rendering"); !s)
             return Error{s.error()};

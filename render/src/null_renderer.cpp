@@ -2,27 +2,10 @@
 // rendering but not its pixels; and the device-independent pieces every renderer shares.
 #include <vector>
 
+#include "qvr/render/draw_list.h"
 #include "qvr/render/renderer.h"
 
 namespace qvr {
-
-BatchSelection selectBatches(const std::vector<SceneBatch>& batches, const RenderView& view) {
-    BatchSelection s;
-    const FrustumPlanes planes = frustumPlanes(view.viewProjection());
-    s.batches.reserve(batches.size());
-    for (size_t i = 0; i < batches.size(); ++i) {
-        const SceneBatch& b = batches[i];
-        if (b.index_count < 3)
-            continue;
-        if (!boxMayBeVisible(planes, b.bounds)) {
-            ++s.culled;
-            continue;
-        }
-        s.batches.push_back(static_cast<uint32_t>(i));
-        s.triangles += b.index_count / 3;
-    }
-    return s;
-}
 
 Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
                                   const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
@@ -42,7 +25,9 @@ public:
     std::string name() const override { return "null"; }
 
     Status upload(const Scene& scene) override {
-        m_batches = scene.batches;
+        if (Status s = checkDrawable(scene); !s)
+            return s;
+        m_draw_list = buildDrawList(scene);
         return Status::success();
     }
 
@@ -55,16 +40,17 @@ public:
             for (int c = 0; c < 4; ++c)
                 p[c] = kClearRgba[c];
         }
-        const BatchSelection sel = selectBatches(m_batches, view);
+        const DrawSelection sel = selectDraws(m_draw_list, view);
         RenderStats stats;
         stats.primitives_generated = sel.triangles;
-        stats.batches_drawn = static_cast<uint32_t>(sel.batches.size());
-        stats.batches_culled = sel.culled;
+        stats.clusters_drawn = sel.clusters_drawn;
+        stats.clusters_culled = sel.clusters_culled;
+        stats.draw_calls = static_cast<uint32_t>(sel.draws.size());
         return stats;
     }
 
 private:
-    std::vector<SceneBatch> m_batches;
+    DrawList m_draw_list;
 };
 
 }  // namespace

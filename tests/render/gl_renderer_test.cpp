@@ -179,7 +179,8 @@ TEST(GlRenderer, PrimitivesGeneratedEqualTheTrianglesSubmitted) {
         ASSERT_TRUE(g) << g.error();
         ASSERT_TRUE(n);
         EXPECT_EQ(g->primitives_generated, n->primitives_generated) << "yaw " << yaw;
-        EXPECT_EQ(g->batches_drawn, n->batches_drawn);
+        EXPECT_EQ(g->clusters_drawn, n->clusters_drawn);
+        EXPECT_EQ(g->draw_calls, n->draw_calls);
         if (gl->info().pipeline_statistics) {
             EXPECT_EQ(g->clipping_input_primitives, g->primitives_generated);
         }

@@ -33,14 +33,14 @@ TEST(NullRenderer, CountsTrianglesOfTheBatchesInsideTheFrustum) {
     auto ahead = r->render(fullFrameView(profile, Pose{}, Eye::kLeft), img);
     ASSERT_TRUE(ahead);
     EXPECT_EQ(ahead->primitives_generated, room.triangleCount() - 2);
-    EXPECT_EQ(ahead->batches_culled, 1u);
+    EXPECT_EQ(ahead->clusters_culled, 1u);
     // Turned round: the far wall and the three faces of the box are behind.
     Pose back;
     back.orientation = quatFromEulerDeg({180.0, 0.0, 0.0});
     auto behind = r->render(fullFrameView(profile, back, Eye::kLeft), img);
     ASSERT_TRUE(behind);
     EXPECT_EQ(behind->primitives_generated, room.triangleCount() - 8);
-    EXPECT_EQ(behind->batches_drawn, 5u);
+    EXPECT_EQ(behind->clusters_drawn, 5u);
 }
 
 TEST(NullRenderer, EmptySceneAndEmptyViewAreNotErrors) {

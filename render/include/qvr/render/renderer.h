@@ -22,14 +22,15 @@ struct RenderStats {
     double render_ms = 0.0;
     // Wall-clock time of copying the framebuffer into the image.
     double readback_ms = 0.0;
-    // Triangles submitted after the CPU's per-batch frustum culling (GL_PRIMITIVES_GENERATED).
+    // Triangles submitted after the CPU's per-cluster frustum culling (GL_PRIMITIVES_GENERATED).
     uint64_t primitives_generated = 0;
     // Triangles that reached the clipper and that left it (ARB_pipeline_statistics_query);
     // 0 when the driver does not offer the statistics.
     uint64_t clipping_input_primitives = 0;
     uint64_t clipping_output_primitives = 0;
-    uint32_t batches_drawn = 0;
-    uint32_t batches_culled = 0;
+    uint32_t clusters_drawn = 0;  // spatial clusters of the draw list (draw_list.h)
+    uint32_t clusters_culled = 0;
+    uint32_t draw_calls = 0;
 };
 
 class Renderer {
@@ -51,17 +52,9 @@ Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
                                   const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
                                   ImageRgba8& out, const CameraOptions& options = {});
 
-// Renders nothing: fills the image with the clear colour and reports the triangles the batches
-// that survive frustum culling hold — the same count the OpenGL renderer submits.
+// Renders nothing: fills the image with the clear colour and reports the triangles of the
+// clusters that survive frustum culling — the same count the OpenGL renderer submits.
 std::unique_ptr<Renderer> makeNullRenderer();
-
-// The batches of `scene` a view draws after per-batch frustum culling, and their triangles.
-struct BatchSelection {
-    std::vector<uint32_t> batches;
-    uint64_t triangles = 0;
-    uint32_t culled = 0;
-};
-BatchSelection selectBatches(const std::vector<SceneBatch>& batches, const RenderView& view);
 
 // The colour of pixels no triangle covers: a dark blue that no test texture uses.
 inline constexpr uint8_t kClearRgba[4] = {20, 24, 40, 255};
