@@ -53,18 +53,15 @@ void clip(Polygon& poly, const Plane& plane) {
     poly = out;
 }
 
-double angleBetween(const glm::dvec3& a, const glm::dvec3& b) {
-    return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
-}
-
-// Smallest angle (radians) between the unit direction g and the directions from the origin to
-// points of the convex planar polygon, all of which lie strictly on one side of a plane through
-// the origin (in front of the eye), or at the origin (angle 0).
-double minAngle(const Polygon& poly, const glm::dvec3& g) {
+// The cosine of the smallest angle between the unit direction g and the directions from the
+// origin to points of the convex planar polygon, all of which lie strictly on one side of a
+// plane through the origin (in front of the eye) or at the origin (cosine 1). Cosines rather
+// than angles: no inverse trigonometry on the per-triangle path.
+double maxCos(const Polygon& poly, const glm::dvec3& g) {
     const int n = poly.count;
     for (int i = 0; i < n; ++i) {
         if (glm::dot(poly.v[static_cast<size_t>(i)], poly.v[static_cast<size_t>(i)]) < 1e-24)
-            return 0.0;
+            return 1.0;
     }
     if (n >= 3) {
         // Does the gaze ray hit the polygon? Newell normal, ray-plane hit, edge tests.
@@ -86,26 +83,27 @@ double minAngle(const Polygon& poly, const glm::dvec3& g) {
                     inside = glm::dot(glm::cross(b - a, p - a), normal) >= 0.0;
                 }
                 if (inside)
-                    return 0.0;
+                    return 1.0;
             }
         }
     }
-    // Otherwise the nearest direction lies on an edge: the great-circle arc between its ends.
-    double best = kPi;
+    // Otherwise the nearest direction lies on an edge: the great-circle arc between its ends,
+    // either at an end or where g's projection into the arc's plane falls within the arc
+    // (there the cosine is the projection's length).
+    double best = -1.0;
     for (int i = 0; i < n; ++i) {
         const glm::dvec3& a = poly.v[static_cast<size_t>(i)];
         const glm::dvec3& b = poly.v[static_cast<size_t>((i + 1) % n)];
-        best = std::min(best, angleBetween(g, a));
+        best = std::max(best, glm::dot(g, a) / glm::length(a));
         const glm::dvec3 c = glm::cross(a, b);
         const double cl = glm::length(c);
         if (cl < 1e-300)
             continue;
         const glm::dvec3 cn = c / cl;
-        const double off = glm::dot(g, cn);
-        const glm::dvec3 gp = g - off * cn;  // g projected into the arc's plane
+        const glm::dvec3 gp = g - glm::dot(g, cn) * cn;  // g projected into the arc's plane
         if (glm::dot(glm::cross(a, gp), cn) >= 0.0 && glm::dot(glm::cross(gp, b), cn) >= 0.0 &&
             glm::dot(gp, a + b) > 0.0)
-            best = std::min(best, std::atan2(std::fabs(off), glm::length(gp)));
+            best = std::max(best, glm::length(gp));
     }
     return best;
 }
@@ -172,16 +170,11 @@ CosRange sphereCosRange(const glm::dvec3& center, double radius, const glm::dvec
 // Ring k covers angles [k·ring, (k + 1)·ring); the last ring is open-ended.
 class RingBounds {
 public:
-    RingBounds(double ring_rad, int rings) : m_ring_rad(ring_rad), m_rings(rings) {
+    RingBounds(double ring_rad, int rings) {
         for (int j = 1; j < rings && j * ring_rad < kPi; ++j)
             m_cos.push_back(std::cos(j * ring_rad));
     }
-    // The defining classification, from an angle.
-    int ofAngle(double angle_rad) const {
-        const double k = std::floor(angle_rad / m_ring_rad);
-        return k >= static_cast<double>(m_rings - 1) ? m_rings - 1 : static_cast<int>(k);
-    }
-    // From a cosine: the number of boundaries the angle has reached.
+    // The ring of an angle given by its cosine: the number of boundaries it has reached.
     int ofCos(double c) const {
         int k = 0;
         const int n = static_cast<int>(m_cos.size());
@@ -199,8 +192,6 @@ public:
     }
 
 private:
-    double m_ring_rad;
-    int m_rings;
     std::vector<double> m_cos;  // cos(j·ring) for the boundaries j = 1 … below 180°
 };
 
@@ -258,7 +249,7 @@ public:
             if (ring >= 0)
                 return ring;
         }
-        return m_rings.ofAngle(minAngle(poly, m_gaze));
+        return m_rings.ofCos(maxCos(poly, m_gaze));
     }
 
 private:
@@ -310,7 +301,7 @@ public:
             if (poly.count == 0)
                 return false;
         }
-        return minAngle(poly, axis) <= half_angle;
+        return maxCos(poly, axis) >= cos_half;
     }
 
     glm::dvec3 apex, axis;
