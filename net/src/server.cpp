@@ -28,7 +28,7 @@ struct Session;
 
 struct Server::Impl {
     Impl(ServerOptions o, ServerHandler& h)
-        : options(std::move(o)), handler(h), acceptor(io), udp_socket(io) {}
+        : options(std::move(o)), handler(h), acceptor(io), udp_socket(io), accept_retry(io) {}
     void accept();
     void onAccepted(tcp::socket socket);
 
@@ -37,6 +37,7 @@ struct Server::Impl {
     asio::io_context io;
     tcp::acceptor acceptor;
     udp::socket udp_socket;
+    asio::steady_timer accept_retry;
     std::thread thread;
     bool stopped = false;
     uint16_t port = 0;  // fixed at start, read by any thread
@@ -348,7 +349,14 @@ void Server::Impl::accept() {
     acceptor.async_accept([this](const asio::error_code& ec, tcp::socket socket) {
         if (ec) {
             if (ec != asio::error::operation_aborted && !stopped) {
-                accept();  // e.g. EMFILE: keep serving the clients we have
+                // e.g. EMFILE: keep serving the clients we have and try again shortly, rather
+                // than spin on an error that repeats at once.
+                accept_retry.expires_after(std::chrono::milliseconds(100));
+                accept_retry.async_wait([this](const asio::error_code& tec) {
+                    if (!tec && !stopped) {
+                        accept();
+                    }
+                });
             }
             return;
         }
@@ -436,6 +444,7 @@ void Server::stop() {
         impl->stopped = true;
         asio::error_code ec;
         impl->acceptor.close(ec);
+        impl->accept_retry.cancel();
         std::vector<std::shared_ptr<Session>> sessions;
         {
             std::lock_guard lock(impl->mutex);
