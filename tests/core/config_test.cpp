@@ -42,7 +42,7 @@ void writeFile(const std::filesystem::path& p, const std::string& bytes) {
     out << bytes;
 }
 
-TEST(ParseTomlText, ParsesValidText) {
+TEST(ParseTomlText, ParsesTablesWhenTextIsValid) {
     auto t = parseTomlText("a = 1\n[b]\nc = \"x\"\n", "ok.toml");
     ASSERT_TRUE(t.ok());
     EXPECT_EQ(t->at_path("a").value<int64_t>(), 1);
@@ -85,7 +85,7 @@ TEST(ConfigReader, ReturnsValuesAndDefaultsWhenWellFormed) {
     EXPECT_TRUE(r.finish().ok());
 }
 
-TEST(ConfigReader, AcceptsIntegerWhereNumberExpected) {
+TEST(ConfigReader, AcceptsIntegerWhenNumberIsExpected) {
     const auto table = parseOk("[display]\nrefresh_hz = 90\n");
     ConfigReader r(table, "int.toml");
     EXPECT_DOUBLE_EQ(r.number("display.refresh_hz", 1.0, 1.0, 1000.0), 90.0);
