@@ -127,6 +127,7 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
             }
             asio::error_code e;
             c.control.set_option(tcp::no_delay(true), e);
+            detail::enableKeepAlive(c.control);
             // Media arrives on the local address the control connection uses.
             const auto local = c.control.local_endpoint(e);
             c.media.open(local.protocol() == tcp::v4() ? udp::v4() : udp::v6(), e);

@@ -368,6 +368,7 @@ void Server::Impl::accept() {
 void Server::Impl::onAccepted(tcp::socket socket) {
     asio::error_code ec;
     socket.set_option(tcp::no_delay(true), ec);  // small control messages must not wait
+    detail::enableKeepAlive(socket);
     std::shared_ptr<Session> session;
     {
         std::lock_guard lock(mutex);
