@@ -29,6 +29,7 @@ struct RenderBenchOptions {
     double e1_deg = 15.0;
     std::string gaze = "0,0";
     int frames = 5;
+    int msaa = 1;
     bool json = false;
 };
 
@@ -190,6 +191,9 @@ static Registered registerRenderBench(CLI::App& bench) {
     cmd->add_option("--frames", opts->frames, "Timed frames per scene (median reported)")
         ->check(CLI::Range(1, 10000))
         ->capture_default_str();
+    cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
+        ->check(CLI::Range(1, 32))
+        ->capture_default_str();
     cmd->add_flag("--json", opts->json, "Print machine-readable JSON");
     Action action = [opts]() -> int {
         double gx = 0, gy = 0;
@@ -213,7 +217,9 @@ static Registered registerRenderBench(CLI::App& bench) {
             else if (!opts->json)
                 fmt::print("(OpenArena not installed: benchmarking builtin:room only)\n");
         }
-        auto gl = GlRenderer::create();
+        GlRendererOptions gl_options;
+        gl_options.msaa_samples = opts->msaa;
+        auto gl = GlRenderer::create(gl_options);
         if (!gl) {
             std::fprintf(stderr, "%s: %s\n", kCmd, gl.error().c_str());
             return 1;
@@ -223,9 +229,10 @@ static Registered registerRenderBench(CLI::App& bench) {
         if (!opts->json) {
             fmt::print(
                 "render benchmark: {} ({}x{} per eye), e1 {:.1f} s1 {:.2f} s2 {:.2f}; {}; "
-                "LP_NUM_THREADS {}; load average {:.2f}\n",
+                "{} sample(s) per pixel; LP_NUM_THREADS {}; load average {:.2f}\n",
                 profile->name, profile->width_px, profile->height_px, plan.e1_deg, plan.s1, plan.s2,
-                (*gl)->name(), lp_threads ? lp_threads : "unset (all cores)", loadAvg1());
+                (*gl)->name(), opts->msaa, lp_threads ? lp_threads : "unset (all cores)",
+                loadAvg1());
             fmt::print("ms: wall time from first command to glFinish, before read-back\n");
         }
         nlohmann::json results = nlohmann::json::array();
@@ -244,6 +251,7 @@ static Registered registerRenderBench(CLI::App& bench) {
             j["s2"] = plan.s2;
             j["renderer"] = (*gl)->name();
             j["frames"] = opts->frames;
+            j["msaa_samples"] = opts->msaa;
             j["load_average"] = loadAvg1();
             j["scenes"] = results;
             std::printf("%s\n", j.dump(2).c_str());

@@ -28,6 +28,7 @@ struct RenderOptions {
     std::string profile = "default";
     double ipd_mm = 64.0;
     double lightmap_gain = 1.0;
+    int msaa = 1;
     std::string out_dir;
     bool json = false;
 };
@@ -110,6 +111,7 @@ int run(const RenderOptions& o) {
 
     GlRendererOptions gl_options;
     gl_options.lightmap_gain = static_cast<float>(o.lightmap_gain);
+    gl_options.msaa_samples = o.msaa;
     auto renderer = GlRenderer::create(gl_options);
     if (!renderer) {
         std::fprintf(stderr, "%s: %s\n", kCmd, renderer.error().c_str());
@@ -239,6 +241,9 @@ static Registered registerRender(CLI::App& app) {
     cmd->add_option("--lightmap-gain", opts->lightmap_gain,
                     "Extra lightmap brightening on top of the loader's overbright shift")
         ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
+    cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
+        ->check(CLI::Range(1, 32))
         ->capture_default_str();
     cmd->add_option("--out", opts->out_dir, "Directory for the PNGs ({eye}_{layer}.png)")
         ->required();

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstring>
 #include <map>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -143,6 +144,9 @@ struct Framebuffer {
     GLuint fbo = 0;
     GLuint color = 0;
     GLuint depth = 0;
+    // With multisampling: the single-sample target the samples are resolved into for read-back.
+    GLuint resolve_fbo = 0;
+    GLuint resolve_color = 0;
 };
 
 }  // namespace
@@ -162,7 +166,7 @@ struct GlRenderer::Impl {
     DrawList draw_list;
     // Layers of a plan alternate between a few sizes; one framebuffer per size avoids
     // reallocating them every frame.
-    std::map<std::pair<int, int>, Framebuffer> framebuffers;
+    std::map<std::tuple<int, int, int>, Framebuffer> framebuffers;
     GLuint query_time = 0;
     GLuint query_primitives = 0;
     GLuint query_clip_in = 0;
@@ -201,6 +205,8 @@ struct GlRenderer::Impl {
         glDeleteFramebuffers(1, &fb.fbo);
         glDeleteRenderbuffers(1, &fb.color);
         glDeleteRenderbuffers(1, &fb.depth);
+        glDeleteFramebuffers(1, &fb.resolve_fbo);
+        glDeleteRenderbuffers(1, &fb.resolve_color);
         fb = {};
     }
 
@@ -223,6 +229,14 @@ struct GlRenderer::Impl {
             if (ext != nullptr && std::strcmp(ext, "GL_ARB_pipeline_statistics_query") == 0)
                 info.pipeline_statistics = true;
         }
+        GLint max_samples = 1;
+        glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+        info.max_samples = max_samples;
+        if (options.msaa_samples < 1 || options.msaa_samples > max_samples)
+            return makeError(
+                fmt::format("render: {} samples per pixel asked for; the driver "
+                            "offers 1 to {}",
+                            options.msaa_samples, max_samples));
         GLint max_rb = 0;
         GLint max_vp[2] = {0, 0};
         glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
@@ -373,8 +387,8 @@ struct GlRenderer::Impl {
         return checkGl("scene upload");
     }
 
-    Expected<Framebuffer*> framebufferFor(int width, int height) {
-        const auto key = std::make_pair(width, height);
+    Expected<Framebuffer*> framebufferFor(int width, int height, int samples) {
+        const auto key = std::make_tuple(width, height, samples);
         auto it = framebuffers.find(key);
         if (it != framebuffers.end())
             return &it->second;
@@ -383,18 +397,34 @@ struct GlRenderer::Impl {
             framebuffers.erase(framebuffers.begin());
         }
         Framebuffer fb;
+        auto storage = [&](GLuint rb, GLenum format, int n) {
+            if (n > 1)
+                glNamedRenderbufferStorageMultisample(rb, n, format, width, height);
+            else
+                glNamedRenderbufferStorage(rb, format, width, height);
+        };
         glCreateRenderbuffers(1, &fb.color);
-        glNamedRenderbufferStorage(fb.color, GL_RGBA8, width, height);
+        storage(fb.color, GL_RGBA8, samples);
         glCreateRenderbuffers(1, &fb.depth);
-        glNamedRenderbufferStorage(fb.depth, GL_DEPTH_COMPONENT24, width, height);
+        storage(fb.depth, GL_DEPTH_COMPONENT24, samples);
         glCreateFramebuffers(1, &fb.fbo);
         glNamedFramebufferRenderbuffer(fb.fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, fb.color);
         glNamedFramebufferRenderbuffer(fb.fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, fb.depth);
-        const GLenum status = glCheckNamedFramebufferStatus(fb.fbo, GL_FRAMEBUFFER);
+        GLenum status = glCheckNamedFramebufferStatus(fb.fbo, GL_FRAMEBUFFER);
+        if (status == GL_FRAMEBUFFER_COMPLETE && samples > 1) {
+            glCreateRenderbuffers(1, &fb.resolve_color);
+            storage(fb.resolve_color, GL_RGBA8, 1);
+            glCreateFramebuffers(1, &fb.resolve_fbo);
+            glNamedFramebufferRenderbuffer(fb.resolve_fbo, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                           fb.resolve_color);
+            status = glCheckNamedFramebufferStatus(fb.resolve_fbo, GL_FRAMEBUFFER);
+        }
         if (status != GL_FRAMEBUFFER_COMPLETE) {
             releaseFramebuffer(fb);
-            return makeError(fmt::format("GL: {}x{} framebuffer incomplete (0x{:04x})", width,
-                                         height, static_cast<unsigned>(status)));
+            return makeError(
+                fmt::format("GL: {}x{} framebuffer with {} samples incomplete "
+                            "(0x{:04x})",
+                            width, height, samples, static_cast<unsigned>(status)));
         }
         return &framebuffers.emplace(key, fb).first->second;
     }
@@ -404,7 +434,7 @@ struct GlRenderer::Impl {
             return Error{s.error()};
         // Drawing needs a complete framebuffer even with rasterization discarded; the surfaceless
         // context has no default one.
-        auto fb = framebufferFor(1, 1);
+        auto fb = framebufferFor(1, 1, 1);
         if (!fb)
             return Error{fb.error()};
         glBindFramebuffer(GL_FRAMEBUFFER, (*fb)->fbo);
@@ -442,7 +472,7 @@ struct GlRenderer::Impl {
                                          view.width_px, view.height_px, info.max_framebuffer_px));
         if (Status s = egl->makeCurrent(); !s)
             return Error{s.error()};
-        auto fb = framebufferFor(view.width_px, view.height_px);
+        auto fb = framebufferFor(view.width_px, view.height_px, options.msaa_samples);
         if (!fb)
             return Error{fb.error()};
 
@@ -485,8 +515,16 @@ struct GlRenderer::Impl {
         }
         glEndQuery(GL_PRIMITIVES_GENERATED);
         glEndQuery(GL_TIME_ELAPSED);
+        GLuint read_fbo = (*fb)->fbo;
+        if ((*fb)->resolve_fbo != 0) {
+            glBlitNamedFramebuffer((*fb)->fbo, (*fb)->resolve_fbo, 0, 0, view.width_px,
+                                   view.height_px, 0, 0, view.width_px, view.height_px,
+                                   GL_COLOR_BUFFER_BIT, GL_NEAREST);
+            read_fbo = (*fb)->resolve_fbo;
+        }
         glFinish();
         stats.render_ms = msSince(t0);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fbo);
 
         const auto t1 = std::chrono::steady_clock::now();
         glPixelStorei(GL_PACK_ALIGNMENT, 1);

@@ -243,3 +243,54 @@ TEST(GlRenderer, ShadingIsTextureTimesLightmapTimesVertexColour) {
 
 }  // namespace
 }  // namespace qvr
+
+namespace qvr {
+namespace {
+
+TEST(GlRenderer, MultisamplingBlendsEdgesAndASecondContextCoexists) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    GlRendererOptions options;
+    options.msaa_samples = 4;
+    if (gl->info().max_samples < 4)
+        GTEST_SKIP() << "driver offers " << gl->info().max_samples << " samples";
+    auto msaa = GlRenderer::create(options);
+    ASSERT_TRUE(msaa) << msaa.error();
+    // A flat red square rotated 30° about the view axis: without multisampling every pixel is
+    // either red or the clear colour; with it the edge pixels fall in between.
+    Scene s;
+    const glm::quat r = glm::angleAxis(0.52f, glm::vec3(0, 0, 1));
+    test::addQuad(s, r * glm::vec3(-1, -1, -4), r * glm::vec3(1, -1, -4), r * glm::vec3(1, 1, -4),
+                  r * glm::vec3(-1, 1, -4), -1, -1, {255, 0, 0, 255});
+    const RenderView view = fullFrameView(test::smallProfile(), Pose{}, Eye::kLeft);
+    auto mixed = [](const ImageRgba8& img) {
+        int n = 0;
+        for (int y = 0; y < img.height(); ++y) {
+            for (int x = 0; x < img.width(); ++x) {
+                const int red = img.at(x, y, 0);
+                if (red != 255 && red != kClearRgba[0])
+                    ++n;
+            }
+        }
+        return n;
+    };
+    ImageRgba8 single, multi;
+    ASSERT_TRUE(gl->upload(s));
+    ASSERT_TRUE((*msaa)->upload(s));
+    ASSERT_TRUE(gl->render(view, single));
+    ASSERT_TRUE((*msaa)->render(view, multi));
+    EXPECT_EQ(mixed(single), 0);
+    EXPECT_GT(mixed(multi), 100);
+    EXPECT_EQ(multi.at(160, 180, 0), 255);
+    // The first renderer still works after the second one is gone.
+    msaa = Error{"released"};
+    ASSERT_TRUE(gl->render(view, single));
+    EXPECT_EQ(single.at(160, 180, 0), 255);
+
+    options.msaa_samples = 1000;
+    auto too_many = GlRenderer::create(options);
+    ASSERT_FALSE(too_many);
+    EXPECT_NE(too_many.error().find("samples"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace qvr

@@ -15,6 +15,9 @@ struct GlRendererOptions {
     // Multiplies the lightmap before shading; Quake III levels are authored for an overbright
     // factor of 2 (r_mapOverBrightBits 1 on a gamma-ramped display).
     float lightmap_gain = 1.0f;
+    // Samples per pixel (1 = no multisampling). 4 smooths geometry edges, which the periphery's
+    // video encoder would otherwise spend bits on; llvmpipe pays for it in fill time.
+    int msaa_samples = 1;
 };
 
 struct GlInfo {
@@ -23,7 +26,8 @@ struct GlInfo {
     std::string renderer;
     std::string version;
     bool pipeline_statistics = false;  // GL_ARB_pipeline_statistics_query
-    int max_framebuffer_px = 0;        // the larger of the renderbuffer and viewport limits
+    int max_framebuffer_px = 0;        // the smaller of the renderbuffer and viewport limits
+    int max_samples = 1;               // GL_MAX_SAMPLES
 };
 
 class GlRenderer final : public Renderer {
