@@ -522,6 +522,95 @@ TEST(NetTransport, SigkilledServerProcessSurfacesAsErrorAndTheClientReconnects) 
     EXPECT_EQ(receive(client, second->clients()[0], 3000, 4, 3s).streams, 4);
 }
 
+// The test plays the server by hand, so it can send the client exactly the datagrams and
+// control bytes it means: every malformed datagram is dropped and counted by reason, a valid
+// stream still completes and is acknowledged, and a broken control stream ends the session.
+TEST(NetTransport, ClientDropsAndCountsMalformedMedia) {
+    asio::io_context io;
+    asio::ip::tcp::acceptor acceptor(io, {asio::ip::make_address("127.0.0.1"), 0});
+    asio::ip::udp::socket media(io, {asio::ip::make_address("127.0.0.1"), 0});
+    Client client(clientOptions());
+    Status connected = makeError("not run");
+    std::thread connecting(
+        [&] { connected = client.connect("127.0.0.1", acceptor.local_endpoint().port()); });
+
+    asio::ip::tcp::socket peer(io);
+    acceptor.accept(peer);
+    const auto readMessage = [&peer]() -> ControlMessage {
+        std::array<uint8_t, kControlHeaderBytes> header{};
+        asio::read(peer, asio::buffer(header));
+        ControlHeader h;
+        EXPECT_EQ(decodeControlHeader(header, h), WireError::kNone);
+        std::vector<uint8_t> payload(h.payload_bytes);
+        asio::read(peer, asio::buffer(payload));
+        ControlMessage m;
+        EXPECT_EQ(decodeControlPayload(h.type, payload, m), WireError::kNone);
+        return m;
+    };
+    const auto hello = std::get<ClientHello>(readMessage());
+    const Nonce server_nonce = randomNonce();
+    const uint64_t session = 77;
+    asio::write(peer, asio::buffer(encodeControl(ServerChallenge{
+                          server_nonce, session,
+                          serverProof(testKey(), hello.client_nonce, server_nonce, session)})));
+    const auto auth = std::get<ClientAuth>(readMessage());
+    EXPECT_TRUE(macEqual(auth.client_proof, clientProof(testKey(), hello.client_nonce, server_nonce,
+                                                        session, hello.media_port)));
+    asio::write(peer, asio::buffer(encodeControl(Welcome{session, media.local_endpoint().port()})));
+    connecting.join();
+    ASSERT_TRUE(connected.ok()) << connected.error();
+
+    const asio::ip::udp::endpoint to(asio::ip::make_address("127.0.0.1"), hello.media_port);
+    uint32_t seq = 0;
+    const std::vector<uint8_t> bytes(1500, 0x42);
+    auto packets = packetizeStream(session, seq, 9, 0, true, bytes);
+    auto send = [&](std::vector<uint8_t> d) { media.send_to(asio::buffer(d), to); };
+    auto edited = [&](size_t at, uint8_t value) {
+        auto d = packets[0];
+        d[at] = value;
+        return d;
+    };
+    send({'n', 'o', 'p', 'e'});                              // truncated
+    send(edited(0, 'X'));                                    // bad magic
+    send(edited(2, kProtocolVersion + 1));                   // wrong version
+    send(edited(20, 9));                                     // bad stream id
+    send(std::vector<uint8_t>(kMaxDatagramBytes + 100, 0));  // oversized
+    uint32_t other_seq = 0;
+    send(packetizeStream(session + 1, other_seq, 9, 0, true, bytes)[0]);  // another session
+    for (const auto& p : packets) {
+        send(p);
+    }
+    auto s = client.nextStream(2000);
+    ASSERT_TRUE(s.ok() && s->has_value());
+    EXPECT_EQ((*s)->bytes, bytes);
+    EXPECT_TRUE((*s)->decodable);
+    const auto ack = std::get<MediaAck>(readMessage());
+    EXPECT_EQ(ack.frame_id, 9u);
+    EXPECT_TRUE(ack.complete);
+    EXPECT_EQ(ack.bytes_received, 1500u);
+    EXPECT_EQ(ack.packets_received, 2);
+    const DropCounters drops = client.stats().media_drops;
+    EXPECT_EQ(drops[WireError::kTruncated], 1u);
+    EXPECT_EQ(drops[WireError::kBadMagic], 1u);
+    EXPECT_EQ(drops[WireError::kWrongVersion], 1u);
+    EXPECT_EQ(drops[WireError::kBadField], 1u);
+    EXPECT_EQ(drops[WireError::kOversized], 1u);
+    EXPECT_EQ(drops[WireError::kWrongSession], 1u);
+
+    asio::write(peer, asio::buffer(encodeControl(ThroughputReport{123'000'000, 1})));
+    const auto deadline = std::chrono::steady_clock::now() + 2s;
+    while (client.throughputBps() == 0 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(2ms);
+    }
+    EXPECT_EQ(client.throughputBps(), 123e6);
+    // A control header that is not qvr: the client cannot re-frame the stream and hangs up.
+    asio::write(peer, asio::buffer(std::vector<uint8_t>{'H', 'T', 'T', 'P', '/', '1', '.', '1'}));
+    auto gone = client.nextStream(2000);
+    ASSERT_FALSE(gone.ok());
+    EXPECT_NE(gone.error().find("protocol error"), std::string::npos) << gone.error();
+    EXPECT_EQ(client.stats().control_drops[WireError::kBadMagic], 1u);
+}
+
 TEST(NetTransport, ConnectTimesOutOnASilentServer) {
     // A listener that accepts and never answers: the handshake deadline ends the wait.
     asio::io_context io;
