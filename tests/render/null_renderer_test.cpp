@@ -56,3 +56,32 @@ TEST(NullRenderer, EmptySceneAndEmptyViewAreNotErrors) {
 
 }  // namespace
 }  // namespace qvr
+
+namespace qvr {
+namespace {
+
+TEST(NullRenderer, RenderLayerGivesEachLayerItsOwnSizeAndSkipsEmptyOnes) {
+    auto r = makeNullRenderer();
+    ASSERT_TRUE(r->upload(test::texturedRoom()));
+    const HmdProfile profile = test::smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({-5.0, 3.0}, 12.0);
+    ImageRgba8 img;
+    for (Eye eye : {Eye::kLeft, Eye::kRight}) {
+        for (LayerKind kind : {LayerKind::kFovea, LayerKind::kMiddle, LayerKind::kOuter}) {
+            const LayerRect& l = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
+            ASSERT_TRUE(renderLayer(*r, profile, plan, Pose{}, eye, kind, img));
+            EXPECT_EQ(img.width(), l.width_px) << layerName(kind);
+            EXPECT_EQ(img.height(), l.height_px) << layerName(kind);
+        }
+    }
+    // A fovea that covers the whole field leaves no middle or outer layer to render.
+    const LayerPlan all_local = LayerPlanner(profile).plan({0.0, 0.0}, 120.0);
+    ASSERT_TRUE(all_local.eyes[0].middle.empty());
+    auto stats = renderLayer(*r, profile, all_local, Pose{}, Eye::kLeft, LayerKind::kMiddle, img);
+    ASSERT_TRUE(stats);
+    EXPECT_TRUE(img.empty());
+    EXPECT_EQ(stats->primitives_generated, 0u);
+}
+
+}  // namespace
+}  // namespace qvr
