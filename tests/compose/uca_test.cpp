@@ -231,6 +231,86 @@ TEST(ComposeUca, KnownYawAndPitchMoveAMarkerByThePredictedPixels) {
                 0.05);
 }
 
+// An all-fovea frame of one 4×4 white marker centred on the rendered point (x, y).
+LayerFrame markerFrame(const HmdProfile& profile, int x, int y) {
+    LayerFrame frame;
+    frame.plan = LayerPlanner(profile).plan({0.0, 0.0}, 180.0);
+    for (auto& e : frame.eyes) {
+        e.fovea.resize(profile.width_px, profile.height_px);
+        for (int j = y - 2; j < y + 2; ++j) {
+            for (int i = x - 2; i < x + 2; ++i) {
+                for (int c = 0; c < 3; ++c)
+                    e.fovea.at(i, j, c) = 255;
+            }
+        }
+    }
+    return frame;
+}
+
+// Centroid along x of channel c's bright pixels.
+double channelCentroidX(const ImageRgba8& img, int c) {
+    double sx = 0, sw = 0;
+    for (int y = 0; y < img.height(); ++y) {
+        for (int x = 0; x < img.width(); ++x) {
+            const double v = img.at(x, y, c);
+            if (v < 8)
+                continue;
+            sx += v * (x + 0.5);
+            sw += v;
+        }
+    }
+    return sw > 0 ? sx / sw : -1.0;
+}
+
+TEST(ComposeUca, LensDistortionPlacesAMarkerWhereThePolynomialSays) {
+    HmdProfile profile = noLens(smallProfile(640, 720));
+    profile.lens.k1 = 0.22;
+    profile.lens.k2 = 0.24;
+    const double cx = 0.5 * profile.width_px;
+    const double fx = profile.focalXPx();
+    const int marker_x = static_cast<int>(std::lround(cx + 0.5 * fx));
+    const double tangent = (marker_x - cx) / fx;  // the marker's centre, rendered side
+    // The display shows at tangent radius t what the render holds at t·(1 + k1·t² + k2·t⁴):
+    // solve for t by Newton's method, independently of the code under test.
+    double t = tangent;
+    for (int i = 0; i < 50; ++i) {
+        const double f = t * (1 + 0.22 * t * t + 0.24 * t * t * t * t) - tangent;
+        const double df = 1 + 3 * 0.22 * t * t + 5 * 0.24 * t * t * t * t;
+        t -= f / df;
+    }
+    Compositor c(profile);
+    std::array<ImageRgba8, 2> out;
+    ASSERT_TRUE(c.compose(markerFrame(profile, marker_x, profile.height_px / 2), Pose{}, out).ok());
+    // The marker shrinks under the barrel map, so its centroid sits within a few hundredths of
+    // a pixel of the mapped centre.
+    EXPECT_NEAR(channelCentroidX(out[0], 1), cx + fx * t, 0.15);
+    EXPECT_LT(cx + fx * t, marker_x - 5.0) << "barrel pre-distortion pulls content inwards";
+}
+
+TEST(ComposeUca, ChromaticAberrationShiftsRedAndBlueRadially) {
+    HmdProfile profile = noLens(smallProfile(640, 720));
+    profile.lens.chroma_red_scale = 1.02;
+    profile.lens.chroma_blue_scale = 0.98;
+    const double cx = 0.5 * profile.width_px;
+    const double fx = profile.focalXPx();
+    const int marker_x = static_cast<int>(std::lround(cx + 0.6 * fx));
+    const double tangent = (marker_x - cx) / fx;
+    Compositor c(profile);
+    std::array<ImageRgba8, 2> out;
+    ASSERT_TRUE(c.compose(markerFrame(profile, marker_x, profile.height_px / 2), Pose{}, out).ok());
+    // Channel k samples tangent radius t·scale_k, so it shows the marker at tangent/scale_k.
+    EXPECT_NEAR(channelCentroidX(out[0], 0), cx + fx * tangent / 1.02, 0.15);
+    EXPECT_NEAR(channelCentroidX(out[0], 1), cx + fx * tangent, 0.15);
+    EXPECT_NEAR(channelCentroidX(out[0], 2), cx + fx * tangent / 0.98, 0.15);
+    // Without chromatic aberration the channels coincide.
+    ComposeOptions o;
+    o.chromatic_aberration = false;
+    Compositor plain(profile, o);
+    ASSERT_TRUE(
+        plain.compose(markerFrame(profile, marker_x, profile.height_px / 2), Pose{}, out).ok());
+    EXPECT_NEAR(channelCentroidX(out[0], 0), channelCentroidX(out[0], 1), 1e-9);
+}
+
 // Layers of a horizontal ramp with a brightness offset per layer, as a codec or a different
 // renderer would leave: a seam unless the blend band spreads it.
 LayerFrame rampFrame(const LayerPlan& plan, int offset_per_layer) {
