@@ -26,7 +26,7 @@ constexpr double kRadPerDeg = 0.017453292519943295;
 
 struct Token {
     std::string_view text;
-    int line;
+    int line = 0;  // initialised: GCC -O3 (Release) otherwise warns maybe-uninitialized
 };
 
 // Splits the hierarchy section into tokens (braces are tokens even when glued to a word).

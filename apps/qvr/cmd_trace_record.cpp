@@ -1,0 +1,154 @@
+// `qvr trace record`: renders a level along a head-motion and gaze trace and writes the measured
+// workload trace (paper §5; docs/RECORDING.md). Interruptible: Ctrl-C finishes the current frame
+// and keeps every whole line written so far.
+#include <unistd.h>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "qvr/render/gl_renderer.h"
+#include "qvr/trace/recorder.h"
+
+namespace qvr::cli {
+
+bool addTraceCommand(int order, RegisterFn fn);
+
+namespace {
+
+constexpr const char* kCmd = "qvr trace record";
+
+// Set by SIGINT/SIGTERM; the recorder checks it between frames.
+std::atomic<bool> g_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+extern "C" void onStopSignal(int) {
+    g_stop.store(true);
+}
+
+struct RecordCliOptions {
+    RecordOptions record;
+    std::string profile = "default";
+    std::string out;
+    bool quiet = false;
+};
+
+Registered registerTraceRecord(CLI::App& parent) {
+    auto o = std::make_shared<RecordCliOptions>();
+    CLI::App* cmd = parent.add_subcommand(
+        "record",
+        "Render a level along motion and gaze traces and write the measured workload "
+        "trace (docs/RECORDING.md)");
+    cmd->add_option("--scene", o->record.scene,
+                    "openarena:MAP, nexuiz:MAP, builtin:room[?objects=N] or a file")
+        ->required();
+    cmd->add_option("--motion", o->record.motion,
+                    "Head motion: pose CSV, BVH file, or 'default' (CMU 01_01 from "
+                    "assimp-testmodels)")
+        ->capture_default_str();
+    auto* gaze = cmd->add_option("--gaze", o->record.gaze_csv, "Gaze CSV (t_ms,x_deg,y_deg)");
+    auto* seed = cmd->add_option("--gaze-seed", o->record.gaze_seed, "Seed of the gaze model")
+                     ->capture_default_str();
+    gaze->excludes(seed);
+    seed->excludes(gaze);
+    cmd->add_option("--profile", o->profile, "HMD profile: default, low or a TOML file")
+        ->capture_default_str();
+    cmd->add_option("--frames", o->record.frames, "Frames to record at the display rate")
+        ->check(CLI::Range(1, 1'000'000))
+        ->capture_default_str();
+    cmd->add_option("--spawn", o->record.spawn, "Spawn point to start from")
+        ->check(CLI::Range(0, 1'000'000))
+        ->capture_default_str();
+    cmd->add_option("--name", o->record.name, "Trace name (default: the scene name)");
+    cmd->add_option("--raster-scale", o->record.raster_scale,
+                    "CPU z-buffer (overdraw, depth, objects) at 1/N resolution")
+        ->check(CLI::Range(1, 16))
+        ->capture_default_str();
+    cmd->add_option("--foreground", o->record.foreground_objects,
+                    "Nearest visible objects that form the static design's foreground")
+        ->check(CLI::Range(0, 1000))
+        ->capture_default_str();
+    cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")->required();
+    cmd->add_flag("--quiet", o->quiet, "No progress line");
+    Action action = [o]() -> int {
+        auto profile = hmdProfileByName(o->profile);
+        if (!profile) {
+            std::fprintf(stderr, "%s: --profile: %s\n", kCmd, profile.error().c_str());
+            return 2;
+        }
+        o->record.profile = *profile;
+        auto inputs = prepareRecording(o->record);
+        if (!inputs) {
+            std::fprintf(stderr, "%s: %s\n", kCmd, inputs.error().c_str());
+            return 2;
+        }
+        auto renderer = GlRenderer::create();
+        if (!renderer) {
+            std::fprintf(stderr, "%s: renderer: %s\n", kCmd, renderer.error().c_str());
+            return 1;
+        }
+        std::ofstream out(o->out, std::ios::binary | std::ios::trunc);
+        if (!out) {
+            std::fprintf(stderr, "%s: cannot write '%s'\n", kCmd, o->out.c_str());
+            return 1;
+        }
+        const bool tty = isatty(STDERR_FILENO) != 0;
+        fmt::print(stderr,
+                   "{}: {} ({} triangles, {} batches, {} spawn points), {}x{} at {} Hz, "
+                   "{} frames, {}\n",
+                   kCmd, inputs->scene.name, inputs->scene.triangleCount(),
+                   inputs->scene.batches.size(), inputs->scene.spawns.size(),
+                   o->record.profile.width_px, o->record.profile.height_px,
+                   o->record.profile.refresh_hz, o->record.frames, (*renderer)->info().renderer);
+        auto progress = [o, tty](const RecordProgress& p) {
+            if (o->quiet)
+                return;
+            const double per_frame = p.elapsed_s / static_cast<double>(p.frame);
+            const double eta = per_frame * static_cast<double>(p.frames - p.frame);
+            // A terminal gets one rewritten line; a log gets a line every 10 frames.
+            if (tty) {
+                fmt::print(stderr, "\r  frame {}/{}  {:.2f} s/frame  ETA {:.0f} s   ", p.frame,
+                           p.frames, per_frame, eta);
+            } else if (p.frame % 10 == 0 || p.frame == p.frames) {
+                fmt::print(stderr, "  frame {}/{}  {:.2f} s/frame  ETA {:.0f} s\n", p.frame,
+                           p.frames, per_frame, eta);
+            }
+        };
+        g_stop.store(false);
+        std::signal(SIGINT, onStopSignal);
+        std::signal(SIGTERM, onStopSignal);
+        auto result = recordWorkload(o->record, *inputs, **renderer, out, &g_stop, progress);
+        std::signal(SIGINT, SIG_DFL);
+        std::signal(SIGTERM, SIG_DFL);
+        out.close();
+        if (tty && !o->quiet)
+            fmt::print(stderr, "\n");
+        if (!result) {
+            std::fprintf(stderr, "%s: %s (the lines written before stay valid)\n", kCmd,
+                         result.error().c_str());
+            return 1;
+        }
+        if (result->stopped) {
+            std::fprintf(stderr, "%s: interrupted: kept %lld of %d frames in %s\n", kCmd,
+                         static_cast<long long>(result->frames_written), o->record.frames,
+                         o->out.c_str());
+            return 130;
+        }
+        fmt::print("wrote {}: {} frames of {} in {:.1f} s ({:.2f} s/frame)\n", o->out,
+                   result->frames_written, result->header.name, result->elapsed_s,
+                   result->elapsed_s / static_cast<double>(result->frames_written));
+        return 0;
+    };
+    return {cmd, action};
+}
+
+[[maybe_unused]] const bool kRecordRegistered = addTraceCommand(30, &registerTraceRecord);
+
+}  // namespace
+
+}  // namespace qvr::cli

@@ -1,0 +1,388 @@
+// The workload recorder: each frame renders both eyes' full frames with the real renderer,
+// encodes them at every layer scale as persistent x264 streams, counts triangles per ring with
+// the scene's BVH and shaded pixels per ring with a CPU z-buffer, and writes one flushed line.
+// Choices and their costs are in docs/RECORDING.md.
+#include "qvr/trace/recorder.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "qvr/foveation/eye_geometry.h"
+#include "qvr/render/camera.h"
+#include "qvr/render/renderer.h"
+#include "qvr/scene/triangle_bvh.h"
+#include "qvr/trace/depth_raster.h"
+#include "qvr/trace/head_motion.h"
+#include "qvr/workload/trace_io.h"
+
+namespace qvr {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+bool endsWithNoCase(const std::string& s, const std::string& suffix) {
+    if (s.size() < suffix.size())
+        return false;
+    return std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(),
+                      [](char a, char b) { return std::tolower(a) == std::tolower(b); });
+}
+
+// Numbers are rounded before writing so a 300-frame trace stays a few hundred kilobytes: the
+// measurements are not more precise than this anyway (x264 sizes vary by more run to run).
+double roundTo(double v, double step) {
+    return std::round(v / step) * step;
+}
+double roundSignificant(double v, int digits) {
+    if (v == 0.0 || !std::isfinite(v))
+        return v;
+    const double mag =
+        std::pow(10.0, digits - 1 - static_cast<int>(std::floor(std::log10(std::fabs(v)))));
+    return std::round(v * mag) / mag;
+}
+
+bool isPowerOfTwo(double s) {
+    if (s < 1.0 || s > 1024.0 || s != std::floor(s))
+        return false;
+    const auto i = static_cast<unsigned>(s);
+    return (i & (i - 1)) == 0;
+}
+
+Status checkOptions(const RecordOptions& o) {
+    if (o.frames < 1 || o.frames > 1'000'000)
+        return makeError(fmt::format("--frames must be in 1..1000000, got {}", o.frames));
+    if (o.spawn < 0)
+        return makeError(fmt::format("--spawn must be >= 0, got {}", o.spawn));
+    if (o.scales.empty() || o.scales.front() != 1.0)
+        return makeError(
+            "the scales must start at 1 (the static design's background is the "
+            "scale-1 stream)");
+    for (size_t i = 0; i < o.scales.size(); ++i) {
+        if (!isPowerOfTwo(o.scales[i]) || (i > 0 && o.scales[i] <= o.scales[i - 1]))
+            return makeError(fmt::format(
+                "scales must be increasing powers of two up to 1024 (each is a box-halving of "
+                "the one before), got {}",
+                o.scales[i]));
+    }
+    if (o.raster_scale < 1 || o.raster_scale > 16)
+        return makeError(fmt::format("raster scale must be in 1..16, got {}", o.raster_scale));
+    if (!(o.ring_deg > 0.0) || o.rings < 1 || o.rings > kMaxRings || o.ring_deg * o.rings < 45.0 ||
+        o.ring_deg * o.rings > 180.0)
+        return makeError("rings must cover 45..180 degrees (docs/WORKLOAD_FORMAT.md)");
+    if (o.foreground_objects < 0)
+        return makeError("foreground objects must be >= 0");
+    return {};
+}
+
+Expected<PoseTrace> loadMotion(const RecordOptions& o, std::string& source) {
+    const double rate_hz = o.profile.refresh_hz;
+    if (o.motion == "default" || endsWithNoCase(o.motion, ".bvh")) {
+        const std::string path = o.motion == "default" ? defaultBvhPath() : o.motion;
+        auto bvh = loadBvhFile(path);
+        if (!bvh)
+            return makeError(fmt::format(
+                "motion: {}{}", bvh.error(),
+                o.motion == "default" ? " (install the Debian package assimp-testmodels)" : ""));
+        HeadMotionOptions h;
+        h.rate_hz = rate_hz;
+        h.frames = o.frames;
+        auto trace = headTraceFromBvh(*bvh, h);
+        if (!trace)
+            return makeError(fmt::format("motion: {}: {}", path, trace.error()));
+        source = path;
+        return trace;
+    }
+    auto csv = loadPoseCsv(o.motion);
+    if (!csv)
+        return makeError(fmt::format("motion: {}", csv.error()));
+    auto trace = resamplePoses(*csv, rate_hz, o.frames);
+    if (!trace)
+        return makeError(fmt::format("motion: {}: {}", o.motion, trace.error()));
+    source = o.motion;
+    return trace;
+}
+
+}  // namespace
+
+Expected<RecordInputs> prepareRecording(const RecordOptions& options) {
+    if (Status s = checkOptions(options); !s)
+        return makeError(s.error());
+    RecordInputs in;
+    auto motion = loadMotion(options, in.motion_source);
+    if (!motion)
+        return makeError(motion.error());
+    if (static_cast<int>(motion->samples.size()) < options.frames)
+        return makeError(fmt::format("motion: {} holds {} frames at {} Hz, {} asked for",
+                                     options.motion, motion->samples.size(),
+                                     options.profile.refresh_hz, options.frames));
+    if (options.gaze_csv.empty()) {
+        const double duration_ms = options.frames * 1000.0 / options.profile.refresh_hz;
+        const GazeModelConfig config;
+        const int samples =
+            static_cast<int>(std::ceil(duration_ms * config.sample_rate_hz / 1000.0)) + 2;
+        auto gaze = generateGaze(config, options.gaze_seed, samples);
+        if (!gaze)
+            return makeError(fmt::format("gaze: {}", gaze.error()));
+        in.gaze = std::move(*gaze);
+        in.gaze_source = fmt::format("model seed {}", options.gaze_seed);
+    } else {
+        auto gaze = loadGazeCsv(options.gaze_csv);
+        if (!gaze)
+            return makeError(fmt::format("gaze: {}", gaze.error()));
+        in.gaze = std::move(*gaze);
+        in.gaze_source = options.gaze_csv;
+    }
+    auto scene = loadScene(options.scene, options.scene_options, &in.report);
+    if (!scene)
+        return makeError(fmt::format("scene: {}", scene.error()));
+    in.scene = std::move(*scene);
+    if (options.spawn >= static_cast<int>(in.scene.spawns.size()))
+        return makeError(fmt::format("--spawn {}: {} has {} spawn point(s)", options.spawn,
+                                     in.scene.name, in.scene.spawns.size()));
+    // The trace's first eye position goes to the spawn point's eye, its heading to the spawn's.
+    const SpawnPoint& spawn = in.scene.spawns[static_cast<size_t>(options.spawn)];
+    const float first_y = motion->samples.front().pose.position_m.y;
+    motion->samples.resize(static_cast<size_t>(options.frames));
+    in.poses = placePoses(
+        *motion, glm::vec3(spawn.position_m.x, spawn.position_m.y - first_y, spawn.position_m.z),
+        spawn.yaw_deg);
+    return in;
+}
+
+Expected<RecordResult> recordWorkload(const RecordOptions& options, const RecordInputs& inputs,
+                                      Renderer& renderer, std::ostream& out,
+                                      const std::atomic<bool>* stop,
+                                      const std::function<void(const RecordProgress&)>& progress) {
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    if (Status s = checkOptions(options); !s)
+        return makeError(s.error());
+    if (static_cast<int>(inputs.poses.samples.size()) < options.frames)
+        return makeError("fewer poses than frames");
+    const HmdProfile& profile = options.profile;
+    const Scene& scene = inputs.scene;
+    if (Status s = renderer.upload(scene); !s)
+        return makeError(fmt::format("upload of {}: {}", scene.name, s.error()));
+    const TriangleBvh bvh(scene);
+    const DepthRasterizer rasterizer(scene, options.object_cell_m);
+    const EyeGeometry geometry(profile);
+    std::vector<bool> flat(static_cast<size_t>(rasterizer.objectCount()));
+    for (int id = 0; id < rasterizer.objectCount(); ++id) {
+        const Aabb& b = rasterizer.objectBounds(id);
+        const glm::vec3 size = b.max - b.min;
+        flat[static_cast<size_t>(id)] =
+            std::min({size.x, size.y, size.z}) < static_cast<float>(options.flat_object_m);
+    }
+
+    CodecConfig codec = options.codec;
+    codec.frame_rate_hz = profile.refresh_hz;
+    const size_t n_scales = options.scales.size();
+    // Persistent streams, so P-frames predict from the previous frame as they would on the wire.
+    std::array<std::vector<std::unique_ptr<VideoEncoder>>, 2> colour_enc;
+    std::array<std::array<std::unique_ptr<VideoEncoder>, 2>, 2> depth_enc;
+    for (int eye = 0; eye < 2; ++eye) {
+        for (size_t s = 0; s < n_scales; ++s) {
+            auto e = makeVideoEncoder(codec);
+            if (!e)
+                return makeError(fmt::format("encoder: {}", e.error()));
+            colour_enc[static_cast<size_t>(eye)].push_back(std::move(*e));
+        }
+        for (int p = 0; p < 2; ++p) {
+            auto e = makeVideoEncoder(codec);
+            if (!e)
+                return makeError(fmt::format("encoder: {}", e.error()));
+            depth_enc[static_cast<size_t>(eye)][static_cast<size_t>(p)] = std::move(*e);
+        }
+    }
+
+    // Each raster pixel's view direction and how many full-resolution pixels it stands for.
+    const int r = options.raster_scale;
+    const int rw = (profile.width_px + r - 1) / r;
+    const int rh = (profile.height_px + r - 1) / r;
+    std::vector<glm::dvec3> directions(static_cast<size_t>(rw) * static_cast<size_t>(rh));
+    std::vector<float> weights(directions.size());
+    for (int y = 0; y < rh; ++y) {
+        for (int x = 0; x < rw; ++x) {
+            const size_t p = static_cast<size_t>(y) * rw + x;
+            const int cw = std::min(r, profile.width_px - x * r);
+            const int ch = std::min(r, profile.height_px - y * r);
+            directions[p] = geometry.directionAt(x * r + 0.5 * cw, y * r + 0.5 * ch);
+            weights[p] = static_cast<float>(cw * ch);
+        }
+    }
+
+    RecordResult result;
+    WorkloadHeader& h = result.header;
+    h.name = options.name.empty() ? scene.name : options.name;
+    h.source = fmt::format(
+        "recorded {} spawn {} by {}; motion {}; gaze {}; tri: BVH frustum counts per ring, both "
+        "eyes; pix: fragments passing an early depth test in draw order, both faces (CPU z-buffer "
+        "at 1/{} resolution); bpp: x264 {} crf {} keyint {}, one stream per eye and scale, the "
+        "full frame box-halved from the scale-1 render, 24-byte frame headers included; static: "
+        "nearest {} visible non-flat objects (batch x {} m cells) by bounds distance, bg = the "
+        "scale-1 frame, depth = 16 bits as two 8-bit planes (high, folded low) at 1/{} resolution",
+        scene.name, options.spawn, renderer.name(), inputs.motion_source, inputs.gaze_source, r,
+        codec.preset, codec.crf, codec.keyint_frames, options.foreground_objects,
+        options.object_cell_m, r);
+    h.profile = profile;
+    h.ring_deg = options.ring_deg;
+    h.rings = options.rings;
+    h.scales = options.scales;
+    h.batches = static_cast<int>(scene.batches.size());
+
+    WorkloadTraceWriter writer(out);
+    writer.writeHeader(h);
+    if (!out)
+        return makeError("cannot write the trace header");
+
+    const double frame_ms = 1000.0 / profile.refresh_hz;
+    const double max_scale = options.scales.back();
+    ImageRgba8 full, halved, depth_high, depth_low;
+    std::array<DepthRaster, 2> rasters;
+    std::vector<int> ring_of(directions.size());
+    for (int n = 0; n < options.frames; ++n) {
+        if (stop != nullptr && stop->load()) {
+            result.stopped = true;
+            break;
+        }
+        const auto frame_start = Clock::now();
+        WorkloadFrame f;
+        f.index = n;
+        f.time_ms = roundTo(n * frame_ms, 1e-3);
+        const Pose head = inputs.poses.samples[static_cast<size_t>(n)].pose;
+        f.gaze = gazeAt(inputs.gaze, n * frame_ms);
+        f.gaze.x_deg = roundTo(f.gaze.x_deg, 1e-3);
+        f.gaze.y_deg = roundTo(f.gaze.y_deg, 1e-3);
+        const glm::dvec3 gaze_dir = geometry.gazeDirection(f.gaze);
+        f.triangles_per_ring.assign(static_cast<size_t>(options.rings), 0.0);
+        f.pixels_per_ring.assign(static_cast<size_t>(options.rings), 0.0);
+        std::vector<double> bytes(n_scales, 0.0), pixels(n_scales, 0.0);
+        double depth_bytes = 0.0;
+
+        for (size_t p = 0; p < directions.size(); ++p) {
+            const double e_deg =
+                std::acos(std::clamp(glm::dot(directions[p], gaze_dir), -1.0, 1.0)) * 180.0 / kPi;
+            ring_of[p] = std::min(options.rings - 1, static_cast<int>(e_deg / options.ring_deg));
+        }
+        for (int e = 0; e < 2; ++e) {
+            const Eye eye = e == 0 ? Eye::kLeft : Eye::kRight;
+            const auto rings = bvh.trianglesPerRing(fullFrameEyeView(profile, head, eye), gaze_dir,
+                                                    options.ring_deg, options.rings);
+            for (size_t k = 0; k < rings.size(); ++k)
+                f.triangles_per_ring[k] += static_cast<double>(rings[k]);
+
+            const RenderView view = fullFrameView(profile, head, eye);
+            auto stats = renderer.render(view, full);
+            if (!stats)
+                return makeError(fmt::format("frame {}: render: {}", n, stats.error()));
+            // Scale 1, 2, 4, …: each a box-halving of the one before (what a layer rendered at
+            // that scale shows, up to filtering: docs/RECORDING.md).
+            const ImageRgba8* current = &full;
+            size_t next = 0;
+            for (double s = 1.0; s <= max_scale && next < n_scales; s *= 2.0) {
+                if (s > 1.0) {
+                    halveImage(*current, halved);
+                    std::swap(full, halved);
+                    current = &full;
+                }
+                if (s != options.scales[next])
+                    continue;
+                auto encoded = colour_enc[static_cast<size_t>(e)][next]->encode(*current);
+                if (!encoded)
+                    return makeError(
+                        fmt::format("frame {}: encode at scale {}: {}", n, s, encoded.error()));
+                bytes[next] += static_cast<double>(encoded->bytes.size());
+                pixels[next] += static_cast<double>(current->width()) * current->height();
+                ++next;
+            }
+
+            DepthRaster& raster = rasters[static_cast<size_t>(e)];
+            rasterizer.rasterize(view.view, view.projection, profile.width_px, profile.height_px, r,
+                                 raster);
+            for (size_t p = 0; p < directions.size(); ++p) {
+                if (raster.shaded[p] != 0)
+                    f.pixels_per_ring[static_cast<size_t>(ring_of[p])] +=
+                        static_cast<double>(raster.shaded[p]) * weights[p];
+            }
+            depthPlanes(raster, depth_high, depth_low);
+            for (int plane = 0; plane < 2; ++plane) {
+                auto encoded =
+                    depth_enc[static_cast<size_t>(e)][static_cast<size_t>(plane)]->encode(
+                        plane == 0 ? depth_high : depth_low);
+                if (!encoded)
+                    return makeError(fmt::format("frame {}: depth encode: {}", n, encoded.error()));
+                depth_bytes += static_cast<double>(encoded->bytes.size());
+            }
+        }
+        for (double& v : f.pixels_per_ring)
+            v = std::round(v);
+        for (size_t s = 0; s < n_scales; ++s)
+            f.bits_per_pixel.push_back(roundSignificant(bytes[s] * 8.0 / pixels[s], 4));
+
+        // §6.1's interactive objects: the visible objects nearest the head by bounds distance.
+        // Flat pieces (floor, wall and ceiling cells) are architecture, not objects a player
+        // interacts with; without this rule the floor under the viewer would always win.
+        std::vector<int> visible;
+        for (int id = 0; id < rasterizer.objectCount(); ++id) {
+            if (rasters[0].object_pixels[static_cast<size_t>(id)] +
+                        rasters[1].object_pixels[static_cast<size_t>(id)] >
+                    0 &&
+                !flat[static_cast<size_t>(id)])
+                visible.push_back(id);
+        }
+        const size_t k = std::min(visible.size(), static_cast<size_t>(options.foreground_objects));
+        std::partial_sort(visible.begin(), visible.begin() + static_cast<std::ptrdiff_t>(k),
+                          visible.end(), [&](int a, int b) {
+                              return distanceToBox(head.position_m, rasterizer.objectBounds(a)) <
+                                     distanceToBox(head.position_m, rasterizer.objectBounds(b));
+                          });
+        double fg_triangles = 0.0, fg_pixels = 0.0;
+        for (size_t i = 0; i < k; ++i) {
+            for (const DepthRaster& raster : rasters) {
+                fg_triangles += raster.object_triangles[static_cast<size_t>(visible[i])];
+                fg_pixels += raster.object_pixels[static_cast<size_t>(visible[i])];
+            }
+        }
+        const double frame_pixels = 2.0 * profile.width_px * profile.height_px;
+        f.static_split.fg_triangles = fg_triangles;
+        f.static_split.fg_screen_fraction =
+            roundSignificant(std::min(1.0, fg_pixels * r * r / frame_pixels), 4);
+        f.static_split.bg_bytes = bytes[0];
+        f.static_split.depth_bytes = depth_bytes;
+
+        f.head.orientation = head.orientation;
+        for (int c = 0; c < 4; ++c)
+            f.head.orientation[c] = static_cast<float>(roundTo(head.orientation[c], 1e-5));
+        for (int c = 0; c < 3; ++c)
+            f.head.position_m[c] = static_cast<float>(roundTo(head.position_m[c], 1e-4));
+
+        // The line must pass the reader's checks before it is written.
+        WorkloadTrace one;
+        one.header = h;
+        one.frames.push_back(f);
+        if (Status s = validateTrace(one); !s)
+            return makeError(fmt::format("frame {}: {}", n, s.error()));
+        writer.writeFrame(f);
+        if (!out)
+            return makeError(fmt::format("frame {}: write failed", n));
+        ++result.frames_written;
+        if (progress) {
+            RecordProgress p;
+            p.frame = result.frames_written;
+            p.frames = options.frames;
+            p.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+            p.last_frame_s = std::chrono::duration<double>(Clock::now() - frame_start).count();
+            progress(p);
+        }
+    }
+    result.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+    return result;
+}
+
+}  // namespace qvr
