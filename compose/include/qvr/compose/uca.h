@@ -77,6 +77,8 @@ inline constexpr int kTilePx = 32;
 // Checks that a frame's plan fits the profile and its images fit the plan.
 Status validateFrame(const HmdProfile& profile, const LayerFrame& frame);
 
+// One compositor per display loop: calls must not overlap (it keeps the newest frame and per-frame
+// scratch); the tiles of one call run in parallel inside it.
 class Compositor {
 public:
     explicit Compositor(const HmdProfile& profile, ComposeOptions options = {});
@@ -106,7 +108,8 @@ public:
                                            std::array<ImageRgba8, 2>& out,
                                            std::array<ImageRgba8, 2>* eye_buffers = nullptr);
 
-    // The tile classes of the last compose() for one eye, row-major over the tile grid.
+    // The tile classes of the last call for one eye (for composeTwoPass: its warp pass),
+    // row-major over the tile grid.
     const std::vector<TileKind>& lastTileKinds(int eye) const { return m_tile_kinds[eye]; }
     int tileColumns() const;
     int tileRows() const;
