@@ -132,12 +132,17 @@ TEST(EncodeMotion, StaysBelow1024AndDecodesToSameFieldsWhenMotionIsRandom) {
 TEST(DecodeMotion, InvertsBitLayoutWhenGivenEveryCode) {
     for (int code = 0; code < kMotionCodes; ++code) {
         const MotionFields f = decodeMotion(static_cast<uint16_t>(code));
-        const bool fields[] = {f.yaw, f.pitch,  f.roll,       f.x,      f.y,
-                               f.z,   f.gaze_h, f.gaze_right, f.gaze_v, f.gaze_up};
-        int rebuilt = 0;
-        for (int i = 0; i < kMotionBits; ++i)
-            rebuilt |= (fields[i] ? 1 : 0) << i;
-        EXPECT_EQ(rebuilt, code);
+        auto has = [code](int i) { return ((code >> i) & 1) != 0; };
+        EXPECT_EQ(f.yaw, has(0)) << code;
+        EXPECT_EQ(f.pitch, has(1)) << code;
+        EXPECT_EQ(f.roll, has(2)) << code;
+        EXPECT_EQ(f.x, has(3)) << code;
+        EXPECT_EQ(f.y, has(4)) << code;
+        EXPECT_EQ(f.z, has(5)) << code;
+        EXPECT_EQ(f.gaze_h, has(6)) << code;
+        EXPECT_EQ(f.gaze_right, has(7)) << code;
+        EXPECT_EQ(f.gaze_v, has(8)) << code;
+        EXPECT_EQ(f.gaze_up, has(9)) << code;
     }
     EXPECT_EQ(kMotionBits, 10);
     EXPECT_EQ(kMotionCodes, 1024);
