@@ -337,20 +337,12 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
             r.energy.liwc_mj = hw.liwc.power_w * period_ms;
 
         if (policy) {
-            FrameMeasurement m;
-            m.index = frame.index;
-            m.e1_deg = plan.e1_deg;
+            // The controller's own builder fills what the plan and cost say; the times and the
+            // goodput are the simulated pipeline's, contention and queueing included.
+            FrameMeasurement m =
+                measureFrame(frame.index, plan, fcost, r.bytes > 0.0 ? r.goodput_bps : 0.0);
             m.t_local_ms = r.t_local_ms;
             m.t_remote_ms = r.t_remote_ms;
-            m.triangles_local = fcost.triangles_local;
-            m.pixels_local = fcost.pixels_local;
-            m.middle_bytes = fcost.bytes.middle;
-            m.outer_bytes = fcost.bytes.outer;
-            m.middle_pixels = 2.0 * static_cast<double>(plan.middle_pixels);
-            m.outer_pixels = 2.0 * static_cast<double>(plan.outer_pixels);
-            m.s1 = plan.s1;
-            m.s2 = plan.s2;
-            m.throughput_bps = r.bytes > 0.0 ? r.goodput_bps : 0.0;
             policy->observe(m);
         }
         result.frames.push_back(r);
