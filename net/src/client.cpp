@@ -29,6 +29,9 @@ void add(AssemblerStats& a, const AssemblerStats& b) {
     a.streams_completed += b.streams_completed;
     a.streams_lost += b.streams_lost;
     a.streams_undecodable += b.streams_undecodable;
+    a.nacks += b.nacks;
+    a.packets_nacked += b.packets_nacked;
+    a.packets_recovered += b.packets_recovered;
 }
 
 const char* byeText(ByeReason r) {
@@ -47,11 +50,17 @@ const char* byeText(ByeReason r) {
     return "said bye";
 }
 
+AssemblerLimits limitsOf(const ClientOptions& o) {
+    AssemblerLimits limits = o.assembler;
+    limits.retransmit = o.retransmit;
+    return limits;
+}
+
 }  // namespace
 
 struct Connection {
     explicit Connection(const ClientOptions& o)
-        : writer(o.max_control_queue), expire_timer(io), assembler(o.assembler) {
+        : writer(o.max_control_queue), expire_timer(io), assembler(limitsOf(o)) {
         last_key_request_ns.fill(std::numeric_limits<int64_t>::min() / 2);
     }
     asio::io_context io;
@@ -328,7 +337,8 @@ void Client::Impl::readMedia(Connection& c) {
 }
 
 void Client::Impl::armExpiry(Connection& c) {
-    c.expire_timer.expires_after(std::chrono::milliseconds(20));
+    // Often enough that a lost tail (AssemblerLimits::tail_nack_ns) is asked for promptly.
+    c.expire_timer.expires_after(std::chrono::milliseconds(5));
     c.expire_timer.async_wait([this, &c](const asio::error_code& ec) {
         if (ec || c.closed) {
             return;
@@ -363,6 +373,9 @@ void Client::Impl::handleAssembler(Connection& c, int64_t now_ns) {
     }
     for (const MediaAck& a : acks) {
         sendControl(c, a);
+    }
+    for (const Nack& n : c.assembler.takeNacks()) {
+        sendControl(c, n);
     }
     // Rate-limit per stream: a request is in flight for key_frame_retry_ms.
     uint8_t mask = 0;

@@ -43,6 +43,8 @@ size_t payloadBytesOf(ControlType type) {
             return 8 + 4;
         case ControlType::kBye:
             return 1;
+        case ControlType::kNack:
+            return 1 + 4 + 8;
     }
     return 0;
 }
@@ -132,6 +134,11 @@ struct Encoder {
         w.u32(m.samples);
     }
     void operator()(const Bye& m) { w.u8(static_cast<uint8_t>(m.reason)); }
+    void operator()(const Nack& m) {
+        w.u8(m.stream_id);
+        w.u32(m.first_seq);
+        w.u64(m.missing_mask);
+    }
 };
 
 ControlType typeOf(const ControlMessage& m) {
@@ -411,6 +418,17 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
                 return WireError::kBadField;
             }
             out = Bye{static_cast<ByeReason>(reason)};
+            break;
+        }
+        case ControlType::kNack: {
+            Nack m;
+            m.stream_id = r.u8();
+            m.first_seq = r.u32();
+            m.missing_mask = r.u64();
+            if (m.stream_id >= kMaxStreams || m.missing_mask == 0) {
+                return WireError::kBadField;
+            }
+            out = m;
             break;
         }
     }

@@ -4,6 +4,7 @@
 
 #include <asio.hpp>
 #include <atomic>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -210,6 +211,8 @@ struct Session : std::enable_shared_from_this<Session> {
                 return send(ThroughputReport{static_cast<uint64_t>(estimator.throughputBps()),
                                              estimator.samples()});
             }
+        } else if (const auto* nack = std::get_if<Nack>(&m)) {
+            retransmit(*nack);
         } else if (const auto* key = std::get_if<KeyFrameRequest>(&m)) {
             count([](ServerStats& st) { ++st.key_frame_requests; });
             server.handler.onKeyFrameRequest(session_id, *key);
@@ -284,10 +287,47 @@ struct Session : std::enable_shared_from_this<Session> {
         auto packets =
             packetizeStream(session_id, seq[stream_id], frame_id, stream_id, key_frame, bytes);
         estimator.onSend(frame_id, static_cast<int64_t>(bytes.size()), now_ns);
+        auto& kept = history[stream_id];
         for (auto& p : packets) {
+            if (server.options.retransmit_history_packets > 0) {
+                kept.push_back({seq[stream_id] - static_cast<uint32_t>(packets.size()) +
+                                    static_cast<uint32_t>(&p - packets.data()),
+                                p});
+                if (static_cast<int>(kept.size()) > server.options.retransmit_history_packets) {
+                    kept.pop_front();
+                }
+            }
             link.send(std::move(p), now_ns);  // the link counts its own drops
         }
         count([&](ServerStats& st) { ++st.streams_sent; });
+        flush();
+    }
+
+    // Resends what the client asked for from the history, through the link like any packet.
+    void retransmit(const Nack& nack) {
+        const auto& kept = history[nack.stream_id];
+        const int64_t now_ns = SteadyClock::instance().nowNs();
+        uint64_t resent = 0, missing = 0;
+        for (int i = 0; i < 64; ++i) {
+            if (!((nack.missing_mask >> i) & 1)) {
+                continue;
+            }
+            // History packets have consecutive sequence numbers (one counter per stream).
+            const uint32_t want = nack.first_seq + static_cast<uint32_t>(i);
+            const int64_t offset =
+                kept.empty() ? -1 : static_cast<int32_t>(want - kept.front().seq);
+            if (offset < 0 || offset >= static_cast<int64_t>(kept.size())) {
+                ++missing;
+                continue;
+            }
+            link.send(kept[static_cast<size_t>(offset)].bytes, now_ns);
+            ++resent;
+        }
+        count([&](ServerStats& st) {
+            ++st.nacks;
+            st.packets_retransmitted += resent;
+            st.packets_not_in_history += missing;
+        });
         flush();
     }
 
@@ -340,6 +380,11 @@ struct Session : std::enable_shared_from_this<Session> {
     LinkStats link_stats;  // a copy for other threads, under server.mutex
     ThroughputEstimator estimator;
     std::array<uint32_t, kMaxStreams> seq{};
+    struct Sent {
+        uint32_t seq;
+        std::vector<uint8_t> bytes;
+    };
+    std::array<std::deque<Sent>, kMaxStreams> history;
     std::vector<std::vector<uint8_t>> out;
     std::atomic<int64_t> queued_bytes{0};
     std::atomic<double> throughput_bps{0.0};

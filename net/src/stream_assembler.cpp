@@ -44,6 +44,11 @@ void StreamAssembler::declareLost(uint8_t stream_id, std::map<uint32_t, Partial>
     m_buffered_bytes -= static_cast<int64_t>(p.bytes.size());
     s.awaiting_key = true;
     m_loss_mask |= static_cast<uint8_t>(1u << stream_id);
+    // Nothing more to ask for in a frame given up.
+    const uint32_t first_seq = p.last_seq - (p.packet_count - 1u);
+    std::erase_if(s.missing, [&](const Missing& m) {
+        return seqAfter(m.seq, first_seq) >= 0 && seqAfter(m.seq, p.last_seq) <= 0;
+    });
     finish(stream_id, it->first);
     s.partials.erase(it);
 }
@@ -63,20 +68,45 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
         if (d >= 0) {
             if (d > 0) {
                 m_stats.seq_gap_packets += static_cast<uint64_t>(d);
-                s.awaiting_key = true;
-                m_loss_mask |= static_cast<uint8_t>(1u << h.stream_id);
+                if (m_limits.retransmit) {
+                    // Ask for the gap instead of giving up on it; a gap larger than what is
+                    // tracked is left to the loss timeout.
+                    for (uint32_t k = 0; k < d && static_cast<int>(s.missing.size()) <
+                                                      m_limits.max_missing_per_stream;
+                         ++k) {
+                        const uint32_t want = s.next_seq + k;
+                        // A stalled tail may have been asked for already.
+                        if (std::none_of(s.missing.begin(), s.missing.end(),
+                                         [&](const Missing& m) { return m.seq == want; })) {
+                            s.missing.push_back({want, now_ns, 1});
+                            s.nack_now.push_back(want);
+                        }
+                    }
+                } else {
+                    s.awaiting_key = true;
+                    m_loss_mask |= static_cast<uint8_t>(1u << h.stream_id);
+                }
             }
             s.next_seq = h.seq + 1;
         }
     }
+    if (m_limits.retransmit && !s.missing.empty()) {
+        // An answer to a NACK: a gap packet (behind next_seq) or a lost tail (at or past it).
+        const auto before = s.missing.size();
+        std::erase_if(s.missing, [&](const Missing& m) { return m.seq == h.seq; });
+        m_stats.packets_recovered += before - s.missing.size();
+    }
 
-    // Frames whose last packet is well behind the newest sequence number will not complete.
-    for (auto it = s.partials.begin(); it != s.partials.end();) {
-        const auto next = std::next(it);
-        if (seqAfter(h.seq, it->second.last_seq) > m_limits.reorder_window_packets) {
-            declareLost(h.stream_id, it);
+    // Frames whose last packet is well behind the newest sequence number will not complete
+    // (without retransmission: with it, the late packets may still come).
+    if (!m_limits.retransmit) {
+        for (auto it = s.partials.begin(); it != s.partials.end();) {
+            const auto next = std::next(it);
+            if (seqAfter(h.seq, it->second.last_seq) > m_limits.reorder_window_packets) {
+                declareLost(h.stream_id, it);
+            }
+            it = next;
         }
-        it = next;
     }
 
     if (isFinished(s, h.frame_id)) {
@@ -153,16 +183,80 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
 
 void StreamAssembler::expire(int64_t now_ns) {
     for (uint8_t id = 0; id < kMaxStreams; ++id) {
-        auto& partials = m_streams[id].partials;
+        Stream& s = m_streams[id];
+        auto& partials = s.partials;
         for (auto it = partials.begin(); it != partials.end();) {
             const auto next = std::next(it);
-            if (now_ns - std::max(it->second.first_rx_ns, it->second.last_rx_ns) >
-                m_limits.frame_timeout_ns) {
+            const bool silent = now_ns - std::max(it->second.first_rx_ns, it->second.last_rx_ns) >
+                                m_limits.frame_timeout_ns;
+            const bool too_old = m_limits.retransmit && now_ns - it->second.first_rx_ns >
+                                                            m_limits.retransmit_loss_timeout_ns;
+            if (silent || too_old) {
                 declareLost(id, it);
             }
             it = next;
         }
+        if (!m_limits.retransmit) {
+            continue;
+        }
+        // A stalled partial frame: its tail was lost, and nothing after it shows the gap.
+        for (const auto& [frame_id, p] : partials) {
+            if (now_ns - std::max(p.first_rx_ns, p.last_rx_ns) < m_limits.tail_nack_ns) {
+                continue;
+            }
+            const uint32_t first_seq = p.last_seq - (p.packet_count - 1u);
+            for (uint32_t i = 0; i < p.packet_count; ++i) {
+                const uint32_t want = first_seq + i;
+                if (p.have[i] ||
+                    static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream ||
+                    std::any_of(s.missing.begin(), s.missing.end(),
+                                [&](const Missing& m) { return m.seq == want; })) {
+                    continue;
+                }
+                s.missing.push_back({want, now_ns, 1});
+                s.nack_now.push_back(want);
+            }
+        }
+        // Ask again for what a retransmission did not bring; give up after the last try.
+        for (Missing& m : s.missing) {
+            if (now_ns - m.last_nack_ns >= m_limits.nack_retry_ns &&
+                m.tries < m_limits.max_nack_tries) {
+                ++m.tries;
+                m.last_nack_ns = now_ns;
+                s.nack_now.push_back(m.seq);
+            }
+        }
+        std::erase_if(s.missing, [&](const Missing& m) {
+            return m.tries >= m_limits.max_nack_tries &&
+                   now_ns - m.last_nack_ns >= m_limits.nack_retry_ns;
+        });
     }
+}
+
+std::vector<Nack> StreamAssembler::takeNacks() {
+    std::vector<Nack> out;
+    for (uint8_t id = 0; id < kMaxStreams; ++id) {
+        auto& seqs = m_streams[id].nack_now;
+        if (seqs.empty()) {
+            continue;
+        }
+        // Sorted in serial order relative to the first, then packed 64 to a message.
+        const uint32_t base = seqs.front();
+        std::sort(seqs.begin(), seqs.end(), [base](uint32_t a, uint32_t b) {
+            return static_cast<uint32_t>(a - base) < static_cast<uint32_t>(b - base);
+        });
+        for (uint32_t seq : seqs) {
+            if (out.empty() || out.back().stream_id != id ||
+                static_cast<uint32_t>(seq - out.back().first_seq) >= 64) {
+                out.push_back({id, seq, 0});
+            }
+            out.back().missing_mask |= uint64_t{1} << (seq - out.back().first_seq);
+        }
+        m_stats.packets_nacked += seqs.size();
+        seqs.clear();
+    }
+    m_stats.nacks += out.size();
+    return out;
 }
 
 std::vector<CompletedStream> StreamAssembler::takeCompleted() {

@@ -48,7 +48,8 @@ std::vector<ControlMessage> everyMessage() {
             MediaAck{9, 3, true, 17, 20000, 100, 900},
             KeyFrameRequest{0b0101, 12, KeyFrameReason::kPacketLoss},
             ThroughputReport{187'000'000, 30},
-            Bye{ByeReason::kAuthFailed}};
+            Bye{ByeReason::kAuthFailed},
+            Nack{2, 0xFFFFFFF0u, 0x8000000000000005ull}};
 }
 
 TEST(NetProtocol, EveryControlMessageRoundTrips) {
@@ -162,6 +163,8 @@ TEST(NetProtocol, OutOfRangeFieldsAreRejected) {
     EXPECT_EQ(decodeControl(encodeControl(KeyFrameRequest{0x10, 1, KeyFrameReason::kStart}), out),
               WireError::kBadField);
     EXPECT_EQ(decodeControl(encodeControl(Welcome{0, 1}), out), WireError::kBadField);
+    EXPECT_EQ(decodeControl(encodeControl(Nack{4, 1, 1}), out), WireError::kBadField);
+    EXPECT_EQ(decodeControl(encodeControl(Nack{0, 1, 0}), out), WireError::kBadField);
     EXPECT_EQ(decodeControl(encodeControl(ClientHello{{}, 0}), out), WireError::kBadField);
     auto bye = encodeControl(Bye{});
     bye.back() = 99;

@@ -153,6 +153,67 @@ TEST(NetStreamAssembler, MemoryStaysWithinBudget) {
     EXPECT_GE(a.stats().streams_lost, 7u);
 }
 
+TEST(NetStreamAssembler, RetransmitModeNacksGapsAndRecovers) {
+    AssemblerLimits limits;
+    limits.retransmit = true;
+    limits.nack_retry_ns = 10'000'000;
+    limits.max_nack_tries = 2;
+    limits.retransmit_loss_timeout_ns = 100'000'000;
+    StreamAssembler a(limits);
+    uint32_t seq = 500;
+    const auto bytes = frameBytes(6 * kMediaChunkBytes, 7);
+    const auto f = packetizeStream(1, seq, 1, 2, true, bytes);  // seqs 500..505
+    feed(a, f[0], 0);
+    feed(a, f[3], 1);  // 501, 502 missing
+    auto nacks = a.takeNacks();
+    ASSERT_EQ(nacks.size(), 1u);
+    EXPECT_EQ(nacks[0].stream_id, 2);
+    EXPECT_EQ(nacks[0].first_seq, 501u);
+    EXPECT_EQ(nacks[0].missing_mask, 0b11u);
+    EXPECT_FALSE(a.awaitingKeyFrame(2) && a.takeLossMask() != 0);  // not a loss yet
+    feed(a, f[4], 2);
+    feed(a, f[5], 3);
+    feed(a, f[1], 4);  // the retransmission of 501
+    // 502 is still missing after the retry interval: asked again, once.
+    a.expire(20'000'000);
+    nacks = a.takeNacks();
+    ASSERT_EQ(nacks.size(), 1u);
+    EXPECT_EQ(nacks[0].first_seq, 502u);
+    EXPECT_EQ(nacks[0].missing_mask, 1u);
+    a.expire(40'000'000);
+    EXPECT_TRUE(a.takeNacks().empty());  // out of tries
+    feed(a, f[2], 45'000'000);           // it made it after all
+    const auto done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);
+    EXPECT_EQ(done[0].bytes, bytes);
+    EXPECT_TRUE(done[0].decodable);
+    EXPECT_EQ(a.stats().packets_recovered, 1u);  // 502 was already given up in the list
+    EXPECT_EQ(a.stats().packets_nacked, 3u);
+    EXPECT_TRUE(a.takeLost().empty());
+}
+
+TEST(NetStreamAssembler, RetransmitModeDeclaresLossByTime) {
+    AssemblerLimits limits;
+    limits.retransmit = true;
+    limits.retransmit_loss_timeout_ns = 100'000'000;
+    StreamAssembler a(limits);
+    uint32_t seq = 0;
+    const auto f1 = packetizeStream(1, seq, 1, 0, true, frameBytes(3 * kMediaChunkBytes, 1));
+    feed(a, f1[0], 0);
+    // Many later packets do not make frame 1 lost: its retransmission may still come.
+    for (uint32_t frame = 2; frame < 20; ++frame) {
+        for (const auto& p : packetizeStream(1, seq, frame, 0, false, frameBytes(5000, frame))) {
+            feed(a, p, 1'000'000);
+        }
+    }
+    EXPECT_TRUE(a.takeLost().empty());
+    a.expire(150'000'000);
+    const auto lost = a.takeLost();
+    ASSERT_EQ(lost.size(), 1u);
+    EXPECT_EQ(lost[0].frame_id, 1u);
+    EXPECT_TRUE(a.awaitingKeyFrame(0));
+}
+
 TEST(NetThroughputEstimator, BytesOverFirstSendToLastAck) {
     ThroughputEstimator est(0.5);
     // Frame 1: two streams of 1 MB sent at t = 0; acks at 40 ms and 80 ms → 2 MB / 80 ms.

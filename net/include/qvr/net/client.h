@@ -20,6 +20,9 @@ struct ClientOptions {
     PresharedKey key;
     int connect_timeout_ms = 2000;  // TCP connect + handshake
     AssemblerLimits assembler;
+    // NACK gaps so the server resends the missing packets (one frame's loss then costs a round
+    // trip, not a key frame); assembler.retransmit follows this.
+    bool retransmit = true;
     int key_frame_retry_ms = 100;    // at most one key-frame request per stream in this time
     size_t max_ready_streams = 256;  // completed streams the caller has not taken yet
     size_t max_control_queue = 256;

@@ -73,6 +73,7 @@ enum class ControlType : uint8_t {
     kKeyFrameRequest = 7,
     kThroughputReport = 8,
     kBye = 9,
+    kNack = 10,
 };
 
 struct ControlHeader {
@@ -161,8 +162,17 @@ struct Bye {
     ByeReason reason = ByeReason::kNormal;
 };
 
+// Selective retransmission: the packets of one stream the client saw missing, as sequence
+// numbers first_seq + i for each set bit i. By sequence number, so a frame whose packets were
+// all lost can be asked for too.
+struct Nack {
+    uint8_t stream_id = 0;
+    uint32_t first_seq = 0;
+    uint64_t missing_mask = 0;  // ≠ 0
+};
+
 using ControlMessage = std::variant<ClientHello, ServerChallenge, ClientAuth, Welcome, FrameRequest,
-                                    MediaAck, KeyFrameRequest, ThroughputReport, Bye>;
+                                    MediaAck, KeyFrameRequest, ThroughputReport, Bye, Nack>;
 
 // Header + payload, ready to write.
 std::vector<uint8_t> encodeControl(const ControlMessage& message);

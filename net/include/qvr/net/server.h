@@ -28,6 +28,8 @@ struct ServerOptions {
     int64_t max_media_queue_bytes = 8 << 20;  // accepted by sendStream, not yet in the link
     LinkConfig link;                          // each client gets its own emulator with this
     double throughput_alpha = 0.25;
+    // Sent datagrams kept per client and stream for NACKed retransmission (~1.2 MB a stream).
+    int retransmit_history_packets = 1024;
 };
 
 // Called on the server's network thread: keep them short (hand work to the render thread).
@@ -55,6 +57,9 @@ struct ServerStats {
     uint64_t streams_rejected = 0;  // per-client media queue full or client gone
     uint64_t packets_sent = 0;
     uint64_t packets_send_failed = 0;  // the socket buffer was full
+    uint64_t nacks = 0;
+    uint64_t packets_retransmitted = 0;
+    uint64_t packets_not_in_history = 0;  // asked for too late (or never sent)
 };
 
 class Server {

@@ -19,6 +19,18 @@ struct AssemblerLimits {
     int64_t max_buffered_bytes = 64 << 20;   // all partial frames of all streams
     uint32_t reorder_window_packets = 32;    // a frame is lost once seq passed its end by this
     int64_t frame_timeout_ns = 250'000'000;  // or once it saw no packet for this long
+    // Selective retransmission: gaps are NACKed (again after nack_retry_ns, at most
+    // max_nack_tries times) instead of being losses at once; a frame is then lost only when
+    // retransmit_loss_timeout_ns passed since its first packet (the reorder-window rule is off,
+    // since retransmitted packets arrive far behind the newest).
+    bool retransmit = false;
+    int64_t nack_retry_ns = 30'000'000;
+    int max_nack_tries = 2;
+    int64_t retransmit_loss_timeout_ns = 100'000'000;
+    // A partial frame that got nothing for this long has lost its tail (no later packet on the
+    // stream reveals a gap): its missing packets are NACKed.
+    int64_t tail_nack_ns = 5'000'000;
+    int max_missing_per_stream = 512;  // tracked gap packets; more are left to loss
 };
 
 struct CompletedStream {
@@ -52,6 +64,9 @@ struct AssemblerStats {
     uint64_t streams_completed = 0;
     uint64_t streams_lost = 0;
     uint64_t streams_undecodable = 0;  // completed while waiting for a key frame
+    uint64_t nacks = 0;                // NACK messages produced
+    uint64_t packets_nacked = 0;       // sequence numbers asked for (tries counted)
+    uint64_t packets_recovered = 0;    // gap packets that arrived after all
 };
 
 class StreamAssembler {
@@ -67,6 +82,8 @@ public:
     std::vector<LostStream> takeLost();
     // Streams on which a loss was newly detected since the last call (bit s = stream s).
     uint8_t takeLossMask();
+    // Retransmission requests due (retransmit mode), grouped by 64 sequence numbers.
+    std::vector<Nack> takeNacks();
     bool awaitingKeyFrame(uint8_t stream_id) const { return m_streams[stream_id].awaiting_key; }
     const AssemblerStats& stats() const { return m_stats; }
     int64_t bufferedBytes() const { return m_buffered_bytes; }
@@ -84,7 +101,14 @@ private:
         std::vector<uint8_t> bytes;
         std::vector<bool> have;
     };
+    struct Missing {
+        uint32_t seq;
+        int64_t last_nack_ns;
+        int tries;
+    };
     struct Stream {
+        std::deque<Missing> missing;     // retransmit mode: gap packets not yet arrived
+        std::vector<uint32_t> nack_now;  // sequence numbers to ask for in the next takeNacks
         bool has_seq = false;
         uint32_t next_seq = 0;
         bool awaiting_key = true;  // the first decodable frame is a key frame
