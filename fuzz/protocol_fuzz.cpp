@@ -27,10 +27,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         QVR_CHECK(header.payload_bytes <= kMaxControlPayloadBytes);
         const auto payload = bytes.subspan(kControlHeaderBytes);
         ControlMessage m;
-        (void)decodeControlPayload(header.type,
-                                   payload.first(std::min<size_t>(payload.size(),
-                                                                  header.payload_bytes)),
-                                   m);
+        (void)decodeControlPayload(
+            header.type, payload.first(std::min<size_t>(payload.size(), header.payload_bytes)), m);
     }
 
     MediaPacketView view;
@@ -43,6 +41,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // reassembler with a small budget; the clock advances 1 ms per datagram.
     AssemblerLimits limits;
     limits.max_buffered_bytes = 256 << 10;
+    limits.retransmit = size > 0 && (data[0] & 1);  // both loss-handling modes
     StreamAssembler assembler(limits);
     size_t pos = 0;
     int64_t now_ns = 0;
@@ -60,6 +59,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             QVR_CHECK(s.stream_id < kMaxStreams && !s.bytes.empty());
         }
         (void)assembler.takeLost();
+        for (const Nack& n : assembler.takeNacks()) {
+            QVR_CHECK(n.stream_id < kMaxStreams && n.missing_mask != 0);
+        }
     }
     return 0;
 }
