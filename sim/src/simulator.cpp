@@ -68,7 +68,6 @@ int steadyStateStart(int frames) {
 }
 
 Expected<std::unique_ptr<FoveaPolicy>> makeDesignPolicy(Design design, const WorkloadHeader& header,
-                                                        const CostModel& truth,
                                                         double link_nominal_bps) {
     const DesignTraits& t = traitsOf(design);
     if (t.policy.empty())
@@ -83,7 +82,6 @@ Expected<std::unique_ptr<FoveaPolicy>> makeDesignPolicy(Design design, const Wor
         cfg.throughput_bps_initial = link_nominal_bps;
         return std::unique_ptr<FoveaPolicy>(std::make_unique<LiwcPolicy>(header, cfg));
     }
-    (void)truth;
     return makeError("design '" + std::string(t.name) + "' names an unknown policy");
 }
 
@@ -93,7 +91,7 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
     const WorkloadHeader& header = trace.header;
     const CostModel truth(header, hw.gpu.render, link.meanGoodputBps());
     const LayerPlanner& planner = truth.planner();
-    auto policy_or = makeDesignPolicy(config.design, header, truth, link.nominalBps());
+    auto policy_or = makeDesignPolicy(config.design, header, link.nominalBps());
     QVR_CHECK_MSG(policy_or.ok(), "built-in design without a policy");
     std::unique_ptr<FoveaPolicy> policy = std::move(*policy_or);
 

@@ -107,7 +107,6 @@ int steadyStateStart(int frames);
 
 // The policy a design uses, built by name; nullptr for designs without a fovea.
 Expected<std::unique_ptr<FoveaPolicy>> makeDesignPolicy(Design design, const WorkloadHeader& header,
-                                                        const CostModel& truth,
                                                         double link_nominal_bps);
 
 // Runs one design over a trace on a link. The trace must outlive the call.
