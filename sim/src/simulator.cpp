@@ -111,8 +111,9 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
     double cpu_free = 0.0, link_free = 0.0, server_free = 0.0, decoder_free = 0.0;
     double uca_free = 0.0;
     double previous_inputs_delay_ms = 0.0;
-    // Static design: the background of the next frame, requested one frame ahead.
-    struct Prefetch {
+    // One remote fetch; for the static design `prefetch` holds the next frame's background,
+    // requested one frame ahead.
+    struct RemoteFetch {
         bool valid = false;
         double pose_ms = 0.0;  // when the pose the server renders for was sampled
         double request_ms = 0.0, ready_ms = 0.0, t_remote_ms = 0.0, net_ms = 0.0;
@@ -122,7 +123,7 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
     // One streamed remote fetch: render, encode, transmit and decode overlap (§2.3, [31, 34]).
     auto stream = [&](double pose_ms, double request_ms, double bytes, double server_ms,
                       double encode_ms, double decode_ms) {
-        Prefetch p;
+        RemoteFetch p;
         p.valid = true;
         p.pose_ms = pose_ms;
         p.request_ms = request_ms;
@@ -194,7 +195,7 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
         double render_work_ms = 0.0;
         LayerPlan plan;
         FrameCost fcost;
-        Prefetch remote;
+        RemoteFetch remote;
         switch (traits.split) {
             case Split::LocalOnly:
                 render_work_ms = truth.localOnlyMs(frame);
