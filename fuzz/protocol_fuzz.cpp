@@ -59,8 +59,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             QVR_CHECK(s.stream_id < kMaxStreams && !s.bytes.empty());
         }
         (void)assembler.takeLost();
-        for (const Nack& n : assembler.takeNacks()) {
-            QVR_CHECK(n.stream_id < kMaxStreams && n.missing_mask != 0);
+        for (const Nack& nack : assembler.takeNacks()) {
+            QVR_CHECK(nack.stream_id < kMaxStreams && nack.missing_mask != 0);
         }
     }
     return 0;
