@@ -45,8 +45,10 @@ constexpr const char* kInstallHint =
 }  // namespace
 
 Expected<std::unique_ptr<EglContext>> EglContext::create() {
-    std::lock_guard<std::mutex> lock(g_display_mutex);
+    // Declared before the lock so that on an error return the lock is released first and the
+    // half-built context's destructor can take it.
     std::unique_ptr<EglContext> ctx(new EglContext());
+    std::lock_guard<std::mutex> lock(g_display_mutex);
     EGLDisplay display = EGL_NO_DISPLAY;
     const char* client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (hasExtension(client_extensions, "EGL_MESA_platform_surfaceless")) {

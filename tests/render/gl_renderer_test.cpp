@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -290,6 +291,27 @@ TEST(GlRenderer, MultisamplingBlendsEdgesAndASecondContextCoexists) {
     auto too_many = GlRenderer::create(options);
     ASSERT_FALSE(too_many);
     EXPECT_NE(too_many.error().find("samples"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace qvr
+
+namespace qvr {
+namespace {
+
+// A machine without an EGL driver must get a message, not a crash or a hang. GLVND reads
+// __EGL_VENDOR_LIBRARY_FILENAMES once per process, so the child of a thread-safe death test
+// (a fresh process running only this test) sets it before its first EGL call.
+TEST(GlRendererDeathTest, NoEglDriverIsAClearErrorNotACrashOrHang) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    EXPECT_EXIT(
+        {
+            setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/egl_vendor.json", 1);
+            auto r = GlRenderer::create();
+            std::fprintf(stderr, "%s\n", r ? "created" : r.error().c_str());
+            std::exit(r ? 0 : 3);
+        },
+        ::testing::ExitedWithCode(3), "EGL: .*libegl-mesa0");
 }
 
 }  // namespace
