@@ -3,6 +3,7 @@
 // and through the paper's link profiles. Numbers and command: docs/NETWORK.md.
 #include <benchmark/benchmark.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <thread>
@@ -68,11 +69,13 @@ BENCHMARK(BM_LinkEmulatorPerPacket);
 // client that waits for each frame: bytes/s is the goodput a frame sees on loopback.
 class Echo : public ServerHandler {
 public:
-    Server* server = nullptr;
+    // Set after Server::start returns; read on its network thread.
+    std::atomic<Server*> server{nullptr};
     size_t stream_bytes = 0;
     void onFrameRequest(ClientId id, const FrameRequest& r) override {
         for (uint8_t s = 0; s < kMaxStreams; ++s) {
-            server->sendStream(id, r.frame_id, s, true, std::vector<uint8_t>(stream_bytes, s));
+            server.load()->sendStream(id, r.frame_id, s, true,
+                                      std::vector<uint8_t>(stream_bytes, s));
         }
     }
 };

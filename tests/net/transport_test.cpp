@@ -45,7 +45,8 @@ std::vector<uint8_t> streamBytes(ClientId client, uint32_t frame, uint8_t stream
 class EchoServer : public ServerHandler {
 public:
     explicit EchoServer(size_t stream_bytes) : m_stream_bytes(stream_bytes) {}
-    Server* server = nullptr;
+    // Set after Server::start returns; read on its network thread.
+    std::atomic<Server*> server{nullptr};
 
     void onClientConnected(ClientId id) override {
         std::lock_guard lock(m_mutex);
@@ -67,8 +68,8 @@ public:
         for (uint8_t s = 0; s < kMaxStreams; ++s) {
             const bool key = (key_mask >> s) & 1;
             key_frames_sent += key ? 1 : 0;
-            auto st = server->sendStream(id, request.frame_id, s, key,
-                                         streamBytes(id, request.frame_id, s, m_stream_bytes));
+            auto st = server.load()->sendStream(
+                id, request.frame_id, s, key, streamBytes(id, request.frame_id, s, m_stream_bytes));
             send_errors += st.ok() ? 0 : 1;
         }
     }
