@@ -80,7 +80,7 @@ public:
     }
 };
 
-void loopbackTransfer(benchmark::State& state, const char* link_spec) {
+void loopbackTransfer(benchmark::State& state, const char* link_spec, bool retransmit = true) {
     Echo echo;
     echo.stream_bytes = static_cast<size_t>(state.range(0));
     ServerOptions so;
@@ -94,6 +94,7 @@ void loopbackTransfer(benchmark::State& state, const char* link_spec) {
     echo.server = server->get();
     ClientOptions co;
     co.key = so.key;
+    co.retransmit = retransmit;
     Client client(co);
     if (!client.connect("127.0.0.1", (*server)->port()).ok()) {
         state.SkipWithError("connect failed");
@@ -116,10 +117,14 @@ void loopbackTransfer(benchmark::State& state, const char* link_spec) {
     state.SetBytesProcessed(complete * kMaxStreams * state.range(0));
     state.counters["frames_incomplete"] = static_cast<double>(incomplete);
     state.counters["ack_estimate_Mbps"] = client.throughputBps() / 1e6;
+    state.counters["packets_nacked"] = static_cast<double>(client.stats().assembler.packets_nacked);
 }
 
 void BM_LoopbackFrames_Unshaped(benchmark::State& state) {
     loopbackTransfer(state, "none");
+}
+void BM_LoopbackFrames_UnshapedNoRetransmit(benchmark::State& state) {
+    loopbackTransfer(state, "none", false);
 }
 void BM_LoopbackFrames_Wifi(benchmark::State& state) {
     loopbackTransfer(state, "wifi");
@@ -128,6 +133,7 @@ void BM_LoopbackFrames_5g(benchmark::State& state) {
     loopbackTransfer(state, "5g");
 }
 BENCHMARK(BM_LoopbackFrames_Unshaped)->Arg(25'000)->Arg(250'000)->UseRealTime();
+BENCHMARK(BM_LoopbackFrames_UnshapedNoRetransmit)->Arg(250'000)->UseRealTime();
 BENCHMARK(BM_LoopbackFrames_Wifi)->Arg(25'000)->Arg(250'000)->UseRealTime();
 BENCHMARK(BM_LoopbackFrames_5g)->Arg(250'000)->UseRealTime();
 
