@@ -50,7 +50,9 @@ public:
     Client(const Client&) = delete;
     Client& operator=(const Client&) = delete;
 
-    // Blocks until the handshake finished, failed or timed out. Drops any earlier connection.
+    // Blocks until the handshake finished, failed or timed out (connect_timeout_ms; a host
+    // name is resolved before the clock starts, so prefer an address). Drops any earlier
+    // connection; after an error, calling it again is the reconnect.
     Status connect(const std::string& host, uint16_t port);
     void disconnect();
     bool connected() const;

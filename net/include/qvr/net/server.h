@@ -32,7 +32,8 @@ struct ServerOptions {
     int retransmit_history_packets = 1024;
 };
 
-// Called on the server's network thread: keep them short (hand work to the render thread).
+// Called on the server's network thread: keep them short (hand work to the render thread),
+// and never call Server::stop() from one (it joins that thread). sendStream() is fine.
 class ServerHandler {
 public:
     virtual ~ServerHandler() = default;
