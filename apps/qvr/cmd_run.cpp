@@ -1,0 +1,564 @@
+// `qvr run`: a render server and a headset client on loopback, each pinned to its own core, run
+// every design of the runtime over the same frames through net's link emulator (paper Fig. 4,
+// §6.1 measured for real), then write summary.json, per-frame telemetry, report.html with
+// gnuplot figures, the video the headset displayed for `qvr`, and `qvr sim`'s prediction for the
+// workload recorded during the run.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "qvr/codec/frame_header.h"
+#include "qvr/codec/video_codec.h"
+#include "qvr/net/link_emulator.h"
+#include "qvr/runtime/affinity.h"
+#include "qvr/runtime/headset_client.h"
+#include "qvr/runtime/render_server.h"
+#include "qvr/runtime/session.h"
+#include "qvr/scene/scene_loader.h"
+#include "qvr/sim/network.h"
+#include "qvr/sim/simulator.h"
+#include "qvr/workload/trace_io.h"
+
+namespace qvr::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace qvr::runtime;
+
+struct RunOptions {
+    std::string scene = "builtin:room";
+    std::string motion = "default";
+    std::string gaze = "model";
+    std::string net = "wifi";
+    std::string profile = "run";
+    std::string designs = "local,remote,ffr,sw,qvr";
+    std::string out = "qvr-run";
+    std::string codec = "x264";
+    int frames = 240;
+    uint64_t seed = 1;
+    double remote_timeout_ms = 100.0;
+    bool video = true;
+    int video_max_frames = 900;
+    std::string command_line;
+};
+
+// Keeps what the headset scanned out, both eyes side by side at half resolution, in memory;
+// encoded after the run so the video costs the measured run nothing.
+class ScanoutRecorder final : public DisplaySink {
+public:
+    explicit ScanoutRecorder(int max_frames) : m_max_frames(max_frames) {}
+    void onScanout(const FrameTelemetry&, const LayerPlan&,
+                   const std::array<ImageRgba8, 2>& eyes) override {
+        if (static_cast<int>(m_frames.size()) >= m_max_frames || eyes[0].empty())
+            return;
+        const int w = eyes[0].width() / 2, h = eyes[0].height() / 2;
+        ImageRgba8 img(2 * w, h);
+        for (int e = 0; e < 2; ++e)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    for (int c = 0; c < 4; ++c) {
+                        const int sum =
+                            eyes[e].at(2 * x, 2 * y, c) + eyes[e].at(2 * x + 1, 2 * y, c) +
+                            eyes[e].at(2 * x, 2 * y + 1, c) + eyes[e].at(2 * x + 1, 2 * y + 1, c);
+                        img.at(e * w + x, y, c) = static_cast<uint8_t>((sum + 2) / 4);
+                    }
+        m_frames.push_back(std::move(img));
+    }
+    // An H.264 Annex B elementary stream (plays in ffplay/mpv/VLC).
+    Status writeH264(const std::string& path) const {
+        CodecConfig cfg;
+        cfg.crf = 20;
+        cfg.keyint_frames = 90;
+        auto enc = makeVideoEncoder(cfg);
+        if (!enc)
+            return makeError(enc.error());
+        std::ofstream out(path, std::ios::binary);
+        if (!out)
+            return makeError("cannot write " + path);
+        for (const ImageRgba8& f : m_frames) {
+            auto e = (*enc)->encode(f);
+            if (!e)
+                return makeError("video: " + e.error());
+            auto parsed = parseFrame(e->bytes);
+            if (!parsed)
+                return makeError("video: " + parsed.error());
+            out.write(reinterpret_cast<const char*>(parsed->payload.data()),
+                      static_cast<std::streamsize>(parsed->payload.size()));
+        }
+        return out ? Status{} : Status(makeError("error writing " + path));
+    }
+    size_t frames() const { return m_frames.size(); }
+
+private:
+    int m_max_frames;
+    std::vector<ImageRgba8> m_frames;
+};
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s)
+        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+bool runGnuplot(const fs::path& dir, const std::string& name, const std::string& body) {
+    for (const char* term : {"pngcairo", "png"}) {
+        std::ofstream(dir / (name + ".gp")) << fmt::format(
+            "set terminal {} size 1000,420 noenhanced\nset output '{}.png'\n"
+            "set datafile separator ','\nset key outside right\nset grid\n{}",
+            term, name, body);
+        const std::string cmd = "cd " + shellQuote(dir.string()) + " && gnuplot " +
+                                shellQuote(name + ".gp") + " >/dev/null 2>&1";
+        if (std::system(cmd.c_str()) == 0)
+            return true;
+    }
+    return false;
+}
+
+std::string htmlEscape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '<')
+            out += "&lt;";
+        else if (c == '>')
+            out += "&gt;";
+        else if (c == '&')
+            out += "&amp;";
+        else
+            out += c;
+    }
+    return out;
+}
+
+std::string machineDescription() {
+    std::string model;
+    std::ifstream cpu("/proc/cpuinfo");
+    for (std::string line; std::getline(cpu, line);)
+        if (line.rfind("model name", 0) == 0) {
+            model = line.substr(line.find(':') + 2);
+            break;
+        }
+    return fmt::format("{} × {}", onlineCores(), model.empty() ? "unknown CPU" : model);
+}
+
+std::string utcNow() {
+    const std::time_t t = std::time(nullptr);
+    char buf[64];
+    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
+    return buf;
+}
+
+nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
+    return {{"fps_mean", s.fps_mean},
+            {"mtp_ms_mean", s.mtp_ms_mean},
+            {"mtp_ms_p99", s.mtp_ms_p99},
+            {"bytes_per_frame_mean", s.bytes_per_frame_mean},
+            {"e1_deg_mean", s.e1_deg_mean},
+            {"frames_displayed", s.frames_displayed},
+            {"frames_reused", s.frames_reused},
+            {"frames", s.frames},
+            {"frames_fallback_local", s.frames_fallback_local},
+            {"t_local_ms_mean", s.t_local_ms_mean},
+            {"t_remote_ms_mean", s.t_remote_ms_mean},
+            {"uca_ms_mean", s.uca_ms_mean},
+            {"wall_s", s.wall_s},
+            {"streams_decoded", st.streams_decoded},
+            {"streams_lost", st.streams_lost},
+            {"decode_failures", st.decode_failures},
+            {"late_frames", st.late_frames},
+            {"key_frame_requests", st.key_frame_requests + st.net.key_frame_requests_sent},
+            {"client_core", st.core}};
+}
+
+int runRun(const RunOptions& o) {
+    auto designs = parseDesignList(o.designs);
+    if (!designs) {
+        std::fprintf(stderr, "qvr run: --designs: %s\n", designs.error().c_str());
+        return 2;
+    }
+    if (o.frames < 2 || o.frames > 100000) {
+        std::fprintf(stderr, "qvr run: --frames must be within 2..100000, got %d\n", o.frames);
+        return 2;
+    }
+    auto link = net::parseLinkSpec(o.net);
+    if (!link) {
+        std::fprintf(stderr, "qvr run: --net: %s\n", link.error().c_str());
+        return 2;
+    }
+    auto profile = runtimeProfileByName(o.profile);
+    if (!profile) {
+        std::fprintf(stderr, "qvr run: --profile: %s\n", profile.error().c_str());
+        return 2;
+    }
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (ec) {
+        std::fprintf(stderr, "qvr run: cannot create '%s': %s\n", o.out.c_str(),
+                     ec.message().c_str());
+        return 1;
+    }
+    const fs::path out(o.out);
+    const auto t_start = std::chrono::steady_clock::now();
+    auto scene_loaded = loadScene(o.scene);
+    if (!scene_loaded) {
+        std::fprintf(stderr, "qvr run: %s\n", scene_loaded.error().c_str());
+        return 2;
+    }
+    auto scene = std::make_shared<const Scene>(std::move(*scene_loaded));
+    auto bvh = std::make_shared<const TriangleBvh>(*scene);
+    auto traces = makeTraces(o.motion, o.gaze, *scene, profile->refresh_hz, o.frames, o.seed);
+    if (!traces) {
+        std::fprintf(stderr, "qvr run: %s\n", traces.error().c_str());
+        return 2;
+    }
+
+    // Two cores: the headset on core 0, the server's render thread on the last core.
+    const int cores = onlineCores();
+    const int client_core = 0;
+    const int server_core = cores > 1 ? cores - 1 : -1;
+    const net::PresharedKey key = net::PresharedKey::random();
+    RenderServerConfig sc;
+    sc.net.key = key;
+    sc.net.link = *link;
+    sc.profile = *profile;
+    sc.codec.backend = o.codec;
+    sc.core = server_core;
+    auto server = RenderServer::start(sc, scene);
+    if (!server) {
+        std::fprintf(stderr, "qvr run: %s\n", server.error().c_str());
+        return 1;
+    }
+    fmt::print("qvr run: {} ({} triangles), {}x{} per eye at {} Hz, net {}, {} frames per design\n",
+               scene->name, scene->triangleCount(), profile->width_px, profile->height_px,
+               profile->refresh_hz, o.net, o.frames);
+    fmt::print("  server on 127.0.0.1:{} pinned to core {}, headset pinned to core {} ({} cores)\n",
+               (*server)->port(), server_core, client_core, cores);
+
+    struct DesignRun {
+        RuntimeDesign design;
+        HeadsetResult result;
+    };
+    std::vector<DesignRun> runs;
+    ScanoutRecorder recorder(o.video_max_frames);
+    const fs::path workload_path = out / "workload.jsonl";
+    bool recorded_workload = false;
+    std::ofstream all_csv(out / "telemetry.csv");
+    all_csv << telemetryCsvHeader();
+    for (RuntimeDesign d : *designs) {
+        HeadsetConfig hc;
+        hc.design = d;
+        hc.profile = *profile;
+        hc.codec.backend = o.codec;
+        hc.port = (*server)->port();
+        hc.key = key;
+        hc.frames = o.frames;
+        hc.core = client_core;
+        hc.remote_timeout_ms = o.remote_timeout_ms;
+        std::ofstream workload_out;
+        std::unique_ptr<WorkloadTraceWriter> writer;
+        if (d == RuntimeDesign::kQvr) {
+            if (o.video)
+                hc.display = &recorder;
+            workload_out.open(workload_path);
+            if (workload_out) {
+                writer = std::make_unique<WorkloadTraceWriter>(workload_out);
+                hc.workload = writer.get();
+                recorded_workload = true;
+            }
+        }
+        Expected<HeadsetResult> result = makeError("not run");
+        std::thread headset([&] { result = runHeadset(hc, scene, bvh, *traces); });
+        headset.join();
+        if (!result) {
+            std::fprintf(stderr, "qvr run: %s: %s\n", designName(d), result.error().c_str());
+            return 1;
+        }
+        const DesignSummary& s = result->summary;
+        fmt::print(
+            "  {:6} fps {:6.1f}  mtp {:6.1f} ms (p99 {:6.1f})  {:8.0f} B/frame  e1 {:5.1f} deg  "
+            "displayed {} reused {}\n",
+            s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
+            s.e1_deg_mean, s.frames_displayed, s.frames_reused);
+        std::fflush(stdout);
+        for (const FrameTelemetry& t : result->frames)
+            all_csv << telemetryCsvRow(designName(d), t);
+        if (auto st =
+                writeTelemetryCsv((out / fmt::format("frames_{}.csv", designName(d))).string(),
+                                  designName(d), result->frames);
+            !st)
+            std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
+        runs.push_back({d, std::move(*result)});
+        // Let the server finish the last session before the next one starts.
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    }
+    const RenderServerStats server_stats = (*server)->stats();
+    (*server)->stop();
+    const double run_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+
+    // What the simulator predicts for the recorded workload.
+    nlohmann::json sim_json = nlohmann::json::object();
+    std::string sim_note;
+    if (recorded_workload) {
+        auto trace = loadWorkloadTrace(workload_path.string());
+        const std::string net_name = o.net.substr(0, o.net.find(','));
+        auto spec = networkSpecByName(net_name);
+        if (!spec) {
+            sim_note =
+                fmt::format("--net '{}' has no simulator profile; predicted on wifi", net_name);
+            spec = networkSpecByName("wifi");
+        }
+        if (trace && spec && !trace->frames.empty()) {
+            for (Design sd : {Design::Qvr, Design::Local, Design::Remote}) {
+                auto sim_link = makeLink(*spec, o.seed);
+                if (!sim_link)
+                    break;
+                SimConfig cfg;
+                cfg.bench = "qvr-run";
+                cfg.design = sd;
+                cfg.frames = static_cast<int>(trace->frames.size());
+                const RunResult r = simulate(*trace, cfg, **sim_link);
+                sim_json[std::string(traitsOf(sd).name)] = {
+                    {"fps_mean", r.summary.fps_mean},
+                    {"mtp_ms_mean", r.summary.mtp_ms_mean},
+                    {"bytes_per_frame_mean", r.summary.bytes_per_frame_mean},
+                    {"e1_deg_mean", r.summary.e1_deg_mean}};
+            }
+        } else if (!trace) {
+            sim_note = "workload trace unreadable: " + trace.error();
+        }
+    }
+
+    // summary.json
+    nlohmann::json j;
+    j["command"] = o.command_line;
+    j["date"] = utcNow();
+    j["machine"] = machineDescription();
+    j["scene"] = scene->name;
+    j["profile"] = {{"name", profile->name},
+                    {"width_px", profile->width_px},
+                    {"height_px", profile->height_px},
+                    {"refresh_hz", profile->refresh_hz}};
+    j["net"] = o.net;
+    j["frames_per_design"] = o.frames;
+    j["pinning"] = {{"client_core", client_core},
+                    {"server_core", server_core},
+                    {"cores", cores},
+                    {"how",
+                     "pthread_setaffinity_np on the headset thread and the server's render "
+                     "thread; threads they create (llvmpipe, x264) inherit the mask"}};
+    j["run_seconds"] = run_s;
+    nlohmann::json dj = nlohmann::json::object();
+    const DesignSummary* local = nullptr;
+    const DesignSummary* remote = nullptr;
+    const DesignSummary* qvr = nullptr;
+    for (const DesignRun& r : runs) {
+        dj[designName(r.design)] = summaryJson(r.result.summary, r.result.stats);
+        if (r.design == RuntimeDesign::kLocal)
+            local = &r.result.summary;
+        if (r.design == RuntimeDesign::kRemote)
+            remote = &r.result.summary;
+        if (r.design == RuntimeDesign::kQvr)
+            qvr = &r.result.summary;
+    }
+    j["designs"] = dj;
+    nlohmann::json ratios = nlohmann::json::object();
+    if (qvr && local && local->fps_mean > 0)
+        ratios["qvr_fps_over_local"] = qvr->fps_mean / local->fps_mean;
+    if (qvr && remote && remote->bytes_per_frame_mean > 0)
+        ratios["qvr_bytes_saved_vs_remote"] =
+            1.0 - qvr->bytes_per_frame_mean / remote->bytes_per_frame_mean;
+    ratios["paper_qvr_fps_over_local"] = 3.4;
+    ratios["paper_qvr_bytes_saved_vs_remote"] = 0.85;
+    if (sim_json.contains("qvr") && sim_json.contains("local") &&
+        sim_json["local"]["fps_mean"].get<double>() > 0)
+        ratios["sim_qvr_fps_over_local"] =
+            sim_json["qvr"]["fps_mean"].get<double>() / sim_json["local"]["fps_mean"].get<double>();
+    if (sim_json.contains("qvr") && sim_json.contains("remote") &&
+        sim_json["remote"]["bytes_per_frame_mean"].get<double>() > 0)
+        ratios["sim_qvr_bytes_saved_vs_remote"] =
+            1.0 - sim_json["qvr"]["bytes_per_frame_mean"].get<double>() /
+                      sim_json["remote"]["bytes_per_frame_mean"].get<double>();
+    j["ratios"] = ratios;
+    j["sim_prediction"] = sim_json;
+    if (!sim_note.empty())
+        j["sim_note"] = sim_note;
+    j["server"] = {{"frames_rendered", server_stats.frames_rendered},
+                   {"requests", server_stats.requests},
+                   {"requests_dropped", server_stats.requests_dropped},
+                   {"streams_sent", server_stats.streams_sent},
+                   {"stream_send_failures", server_stats.stream_send_failures},
+                   {"render_ms_per_layer",
+                    server_stats.layers_rendered
+                        ? server_stats.render_ms_total / double(server_stats.layers_rendered)
+                        : 0.0},
+                   {"encode_ms_per_layer",
+                    server_stats.layers_rendered
+                        ? server_stats.encode_ms_total / double(server_stats.layers_rendered)
+                        : 0.0},
+                   {"auth_failures", server_stats.net.auth_failures},
+                   {"control_drops", server_stats.net.control_drops.total()}};
+    std::ofstream(out / "summary.json") << j.dump(2) << "\n";
+
+    // Video of what the headset displayed for qvr.
+    std::string video_note = "not recorded";
+    if (o.video && recorder.frames() > 0) {
+        const fs::path video = out / "qvr_display.h264";
+        if (auto st = recorder.writeH264(video.string()); st)
+            video_note = fmt::format(
+                "qvr_display.h264: {} frames, both eyes side by side at half "
+                "resolution, H.264 Annex B at 90 fps (ffplay -f h264)",
+                recorder.frames());
+        else
+            video_note = "video failed: " + st.error();
+    }
+
+    // Figures.
+    const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
+    std::vector<std::string> figures;
+    if (have_gnuplot) {
+        std::string e1_plot = "set xlabel 'frame'\nset ylabel 'e1 (deg)'\nplot ";
+        std::string mtp_plot = "set xlabel 'frame'\nset ylabel 'motion-to-photon (ms)'\nplot ";
+        std::string bytes_plot =
+            "set xlabel 'frame'\nset ylabel 'KB per frame'\nset logscale y\nplot ";
+        std::string ft_plot = "set xlabel 'frame'\nset ylabel 'scan-out interval (ms)'\nplot ";
+        bool first = true;
+        for (const DesignRun& r : runs) {
+            const std::string f = fmt::format("frames_{}.csv", designName(r.design));
+            const std::string sep = first ? "" : ", ";
+            // Columns (1-based, telemetryCsvHeader): 2 frame, 3 e1, 21 display_ns, 22 bytes, 31
+            // mtp.
+            e1_plot += fmt::format("{}'{}' every ::1 using 2:3 with lines title '{}'", sep, f,
+                                   designName(r.design));
+            mtp_plot += fmt::format("{}'{}' every ::1 using 2:31 with lines title '{}'", sep, f,
+                                    designName(r.design));
+            bytes_plot +=
+                fmt::format("{}'{}' every ::1 using 2:($22/1000+0.001) with lines title '{}'", sep,
+                            f, designName(r.design));
+            ft_plot += fmt::format(
+                "{}'{}' every ::1 using 2:(d=($21-prev)/1e6, prev=$21, d) with lines title '{}'",
+                sep, f, designName(r.design));
+            first = false;
+        }
+        ft_plot = "prev=0\nset yrange [0:150]\n" + ft_plot;
+        if (runGnuplot(out, "e1", e1_plot + "\n"))
+            figures.push_back("e1");
+        if (runGnuplot(out, "mtp", mtp_plot + "\n"))
+            figures.push_back("mtp");
+        if (runGnuplot(out, "bytes", bytes_plot + "\n"))
+            figures.push_back("bytes");
+        if (runGnuplot(out, "scanout", ft_plot + "\n"))
+            figures.push_back("scanout");
+    }
+
+    // report.html
+    std::string html = "<!doctype html><meta charset='utf-8'><title>qvr run</title>\n";
+    html +=
+        "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
+        "table{border-collapse:collapse}td,th{border:1px solid #999;padding:3px 8px;"
+        "text-align:right}</style>\n";
+    html += "<h1>qvr run</h1>\n<p>" + htmlEscape(o.command_line) + "<br>" + htmlEscape(utcNow()) +
+            ", " + htmlEscape(machineDescription()) + "</p>\n";
+    html += fmt::format(
+        "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
+        "the "
+        "server's egress), {} frames per design. Headset pinned to core {}, server render thread "
+        "to core {}. Motion-to-photon is pose sample → UCA output complete on the headset's "
+        "steady clock.</p>\n",
+        htmlEscape(scene->name), profile->width_px, profile->height_px, profile->refresh_hz,
+        htmlEscape(o.net), o.frames, client_core, server_core);
+    html +=
+        "<table><tr><th>design</th><th>FPS</th><th>MTP mean ms</th><th>MTP p99 ms</th>"
+        "<th>KB/frame</th><th>e1 mean °</th><th>T_local ms</th><th>T_remote ms</th>"
+        "<th>UCA ms</th><th>displayed</th><th>reused</th></tr>\n";
+    for (const DesignRun& r : runs) {
+        const DesignSummary& s = r.result.summary;
+        html += fmt::format(
+            "<tr><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>"
+            "<td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{}</td><td>{}</td></"
+            "tr>\n",
+            s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean / 1e3,
+            s.e1_deg_mean, s.t_local_ms_mean, s.t_remote_ms_mean, s.uca_ms_mean, s.frames_displayed,
+            s.frames_reused);
+    }
+    html += "</table>\n<h2>Against the paper and the simulator</h2>\n<pre>" +
+            htmlEscape(j["ratios"].dump(2)) + "\n" + htmlEscape(sim_json.dump(2)) + "</pre>\n";
+    if (!sim_note.empty())
+        html += "<p>" + htmlEscape(sim_note) + "</p>\n";
+    html +=
+        "<p>The simulator replays <code>workload.jsonl</code> (recorded during the qvr run) on "
+        "its modelled mobile GPU and link (docs/MODEL.md), not on llvmpipe: the gap to the "
+        "measured FPS is the gap between that model and this machine.</p>\n";
+    for (const std::string& f : figures)
+        html += "<h3>" + f + "</h3><img src='" + f + ".png' width='1000'>\n";
+    if (!have_gnuplot)
+        html += "<p>gnuplot not found: CSV written, no figures.</p>\n";
+    html += "<p>Video: " + htmlEscape(video_note) + "</p>\n";
+    std::ofstream(out / "report.html") << html;
+
+    fmt::print("  ratios: {}\n", ratios.dump());
+    if (!sim_json.empty())
+        fmt::print("  sim prediction: {}\n", sim_json.dump());
+    fmt::print(
+        "  {}\n  wrote {}/summary.json, telemetry.csv, frames_*.csv, report.html in {:.0f} s\n",
+        video_note, o.out, run_s);
+    return 0;
+}
+
+}  // namespace
+
+static Registered registerRun(CLI::App& app) {
+    auto o = std::make_shared<RunOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "run", "Server + headset on loopback (each on its own core): every design, measured");
+    cmd->add_option("--scene", o->scene, "Scene (builtin:room, openarena:MAP, a file)")
+        ->capture_default_str();
+    cmd->add_option("--motion", o->motion,
+                    "Head motion: default (CMU BVH), a .bvh, a pose CSV, still")
+        ->capture_default_str();
+    cmd->add_option("--gaze", o->gaze, "Gaze: model (seeded), center, or a gaze CSV")
+        ->capture_default_str();
+    cmd->add_option("--net", o->net,
+                    "Link spec for net's emulator (wifi, lte, 5g, rate:MBPS, trace:...)")
+        ->capture_default_str();
+    cmd->add_option("--frames", o->frames, "Frames per design")->capture_default_str();
+    cmd->add_option("--designs", o->designs, "Comma-separated: local,remote,ffr,sw,qvr")
+        ->capture_default_str();
+    cmd->add_option(
+           "--profile", o->profile,
+           "Display profile: run (480x540), small (320x360), default (1920x2160), low, TOML")
+        ->capture_default_str();
+    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
+    cmd->add_option("--codec", o->codec, "Codec backend: x264 or raw")->capture_default_str();
+    cmd->add_option("--seed", o->seed, "Gaze model and simulator seed")->capture_default_str();
+    cmd->add_option("--remote-timeout-ms", o->remote_timeout_ms,
+                    "Remote layers later than this after the local render are late (frame reuse)")
+        ->check(CLI::Range(1.0, 10000.0))
+        ->capture_default_str();
+    cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
+    return {cmd, [o] {
+                o->command_line = fmt::format(
+                    "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
+                    "--profile {} --codec {} --seed {}",
+                    o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile,
+                    o->codec, o->seed);
+                return runRun(*o);
+            }};
+}
+
+QVR_REGISTER_COMMAND(90, registerRun);
+
+}  // namespace qvr::cli

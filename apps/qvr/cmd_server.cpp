@@ -1,0 +1,126 @@
+// `qvr server`: the render server (paper §3.2, Fig. 7) on its own: renders and streams the middle
+// and outer layers each headset requests, after a pre-shared-key handshake; loopback by default.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "qvr/net/link_emulator.h"
+#include "qvr/runtime/render_server.h"
+#include "qvr/runtime/session.h"
+#include "qvr/scene/scene_loader.h"
+
+namespace qvr::cli {
+
+namespace {
+
+using namespace qvr::runtime;
+
+std::atomic<bool> g_server_stop{false};
+
+void onServerSignal(int) {
+    g_server_stop = true;
+}
+
+struct ServerCmdOptions {
+    std::string bind = "127.0.0.1";
+    uint16_t port = 7400;
+    std::string key;
+    std::string key_file;
+    std::string scene = "builtin:room";
+    std::string profile = "run";
+    std::string net = "none";
+    std::string codec = "x264";
+    int core = -1;
+    double duration_s = 0.0;
+};
+
+int runServer(const ServerCmdOptions& o) {
+    auto key = keyFromOptions(o.key, o.key_file);
+    if (!key) {
+        std::fprintf(stderr, "qvr server: %s\n", key.error().c_str());
+        return 2;
+    }
+    auto profile = runtimeProfileByName(o.profile);
+    if (!profile) {
+        std::fprintf(stderr, "qvr server: --profile: %s\n", profile.error().c_str());
+        return 2;
+    }
+    auto link = net::parseLinkSpec(o.net);
+    if (!link) {
+        std::fprintf(stderr, "qvr server: --net: %s\n", link.error().c_str());
+        return 2;
+    }
+    auto scene = loadScene(o.scene);
+    if (!scene) {
+        std::fprintf(stderr, "qvr server: %s\n", scene.error().c_str());
+        return 2;
+    }
+    RenderServerConfig cfg;
+    cfg.net.bind_address = o.bind;
+    cfg.net.port = o.port;
+    cfg.net.key = *key;
+    cfg.net.link = *link;
+    cfg.profile = *profile;
+    cfg.codec.backend = o.codec;
+    cfg.core = o.core;
+    auto server = RenderServer::start(cfg, std::make_shared<const Scene>(std::move(*scene)));
+    if (!server) {
+        std::fprintf(stderr, "qvr server: %s\n", server.error().c_str());
+        return 1;
+    }
+    fmt::print("qvr server: listening on {}:{} ({}x{} per eye, link {}); Ctrl-C stops\n", o.bind,
+               (*server)->port(), profile->width_px, profile->height_px, o.net);
+    std::fflush(stdout);
+    std::signal(SIGINT, onServerSignal);
+    std::signal(SIGTERM, onServerSignal);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!g_server_stop) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (o.duration_s > 0 &&
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >
+                o.duration_s)
+            break;
+    }
+    const RenderServerStats s = (*server)->stats();
+    (*server)->stop();
+    fmt::print(
+        "qvr server: {} requests ({} dropped, {} invalid), {} frames, {} streams sent, {} auth "
+        "failures, {} malformed control messages\n",
+        s.requests, s.requests_dropped, s.requests_invalid, s.frames_rendered, s.streams_sent,
+        s.net.auth_failures, s.net.control_drops.total());
+    return 0;
+}
+
+}  // namespace
+
+static Registered registerServer(CLI::App& app) {
+    auto o = std::make_shared<ServerCmdOptions>();
+    CLI::App* cmd = app.add_subcommand("server", "The render server: streams periphery layers");
+    cmd->add_option("--bind", o->bind, "Address to listen on (loopback unless changed)")
+        ->capture_default_str();
+    cmd->add_option("--port", o->port, "TCP port (0: any)")->capture_default_str();
+    cmd->add_option("--key", o->key, "Pre-shared key: 64 hex digits, or pass:TEXT");
+    cmd->add_option("--key-file", o->key_file, "File holding the pre-shared key");
+    cmd->add_option("--scene", o->scene, "Scene")->capture_default_str();
+    cmd->add_option("--profile", o->profile, "Display profile (must match the headset's)")
+        ->capture_default_str();
+    cmd->add_option("--net", o->net, "Link emulator spec on the media egress")
+        ->capture_default_str();
+    cmd->add_option("--codec", o->codec, "x264 or raw")->capture_default_str();
+    cmd->add_option("--core", o->core, "Pin the render thread to this core (-1: no)")
+        ->capture_default_str();
+    cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")
+        ->capture_default_str();
+    return {cmd, [o] { return runServer(*o); }};
+}
+
+QVR_REGISTER_COMMAND(90, registerServer);
+
+}  // namespace qvr::cli

@@ -1,0 +1,102 @@
+// The headset (paper Fig. 4, §3–4): per frame it samples head pose and gaze from traces, asks the
+// fovea policy for e1 before rendering (LIWC reads the frame's fovea-cone triangles and the
+// throughput measured from acknowledgements), requests the periphery from the render server,
+// renders the fovea locally, decodes the periphery streams as they arrive, and composes with
+// UCA for the newest pose, paced to the display's vsync. Late or lost remote layers make it
+// re-warp the newest layers it has (frame reuse); a server that is gone makes it render
+// everything locally and reconnect when it returns.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "qvr/codec/video_codec.h"
+#include "qvr/core/expected.h"
+#include "qvr/core/image.h"
+#include "qvr/foveation/layer_plan.h"
+#include "qvr/net/auth.h"
+#include "qvr/net/client.h"
+#include "qvr/runtime/pacing.h"
+#include "qvr/runtime/render_server.h"
+#include "qvr/runtime/runtime_design.h"
+#include "qvr/runtime/telemetry.h"
+#include "qvr/scene/scene.h"
+#include "qvr/scene/triangle_bvh.h"
+#include "qvr/trace/gaze_model.h"
+#include "qvr/trace/pose_trace.h"
+#include "qvr/workload/trace_io.h"
+
+namespace qvr::runtime {
+
+// The display seam: receives what the headset scanned out (both eyes, after UCA).
+class DisplaySink {
+public:
+    virtual ~DisplaySink() = default;
+    virtual void onScanout(const FrameTelemetry& frame, const LayerPlan& shown_plan,
+                           const std::array<ImageRgba8, 2>& eyes) = 0;
+};
+
+struct HeadsetTraces {
+    PoseTrace motion;  // sampled at the frame's content time, k / refresh_hz
+    GazeTrace gaze;
+};
+
+struct HeadsetConfig {
+    RuntimeDesign design = RuntimeDesign::kQvr;
+    HmdProfile profile;
+    CodecConfig codec;  // the decoders' backend must match the server's encoders
+    RendererFactory renderer = glRendererFactory();
+    std::string host = "127.0.0.1";
+    uint16_t port = 0;
+    net::PresharedKey key;
+    int frames = 300;
+    int core = -1;  // pin the headset thread (and the threads it creates) to this core
+    // A frame's remote layers that have not all been decoded this long after the request are
+    // late: the display re-warps the newest layers it has instead (§4.2 frame reuse).
+    double remote_timeout_ms = 100.0;
+    int connect_timeout_ms = 500;
+    int reconnect_interval_ms = 250;
+    double ffr_e1_deg = 5.0;
+    PacingClock* clock = nullptr;  // steady clock when null
+    DisplaySink* display = nullptr;
+    WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set
+    std::function<void(int64_t frame)> before_frame;  // test hook, called at each frame start
+};
+
+struct HeadsetStats {
+    uint64_t streams_received = 0;
+    uint64_t streams_decoded = 0;
+    uint64_t streams_lost = 0;
+    uint64_t decode_failures = 0;
+    uint64_t streams_discarded = 0;  // decoded for the reference chain, frame already shown
+    uint64_t key_frame_requests = 0;
+    uint64_t late_frames = 0;
+    uint64_t connects = 0;
+    uint64_t connect_failures = 0;
+    uint64_t disconnects = 0;
+    uint64_t compose_failures = 0;
+    uint64_t render_failures = 0;
+    int core = -1;  // where the loop ran at the end
+    net::ClientStats net;
+};
+
+struct HeadsetResult {
+    std::vector<FrameTelemetry> frames;
+    HeadsetStats stats;
+    DesignSummary summary;
+};
+
+// Runs config.frames frames on the calling thread. Errors only for set-up (renderer, empty
+// traces); per-frame failures are counted and the loop continues.
+Expected<HeadsetResult> runHeadset(const HeadsetConfig& config, std::shared_ptr<const Scene> scene,
+                                   std::shared_ptr<const TriangleBvh> bvh,
+                                   const HeadsetTraces& traces);
+
+// The plan of whole-frame streaming: one full-resolution "middle" layer per eye, nothing local.
+LayerPlan wholeFramePlan(const LayerPlanner& planner, const Gaze& gaze);
+
+}  // namespace qvr::runtime

@@ -1,0 +1,73 @@
+// The render server (paper §3.2, Fig. 7): for each frame request of each headset, renders the
+// middle and outer layers of both eyes for the request's pose, gaze and layer plan, encodes each
+// as its own video stream and hands each to the transport the moment it is encoded. Serves
+// several headsets from one render thread; each has a bounded request queue and its own encoders.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "qvr/codec/video_codec.h"
+#include "qvr/core/expected.h"
+#include "qvr/foveation/hmd_profile.h"
+#include "qvr/net/server.h"
+#include "qvr/render/renderer.h"
+#include "qvr/scene/scene.h"
+
+namespace qvr::runtime {
+
+// Renderers are made on the thread that uses them (an OpenGL context is current on one thread).
+using RendererFactory = std::function<Expected<std::unique_ptr<Renderer>>()>;
+RendererFactory glRendererFactory();
+RendererFactory nullRendererFactory();
+
+struct RenderServerConfig {
+    net::ServerOptions net;
+    HmdProfile profile;  // must be the headsets' profile: requests larger than it are refused
+    CodecConfig codec;
+    RendererFactory renderer = glRendererFactory();
+    int core = -1;  // pin the render thread to this core (-1: no pinning)
+    // Requests waiting per headset; a newer request pushes the oldest out (it would be late).
+    size_t max_pending_requests = 2;
+};
+
+struct RenderServerStats {
+    uint64_t requests = 0;
+    uint64_t requests_dropped = 0;  // pushed out of a full queue
+    uint64_t requests_invalid = 0;  // a plan that does not fit the profile
+    uint64_t frames_rendered = 0;
+    uint64_t layers_rendered = 0;
+    uint64_t streams_sent = 0;
+    uint64_t stream_send_failures = 0;  // the transport's queue was full or the client gone
+    uint64_t render_failures = 0;
+    uint64_t encode_failures = 0;
+    uint64_t key_frame_requests = 0;
+    double render_ms_total = 0.0;
+    double encode_ms_total = 0.0;
+    net::ServerStats net;
+};
+
+class RenderServer {
+public:
+    // Starts the render thread (renderer made and scene uploaded there) and then the transport.
+    static Expected<std::unique_ptr<RenderServer>> start(RenderServerConfig config,
+                                                         std::shared_ptr<const Scene> scene);
+    ~RenderServer();
+    RenderServer(const RenderServer&) = delete;
+    RenderServer& operator=(const RenderServer&) = delete;
+
+    // Closes every connection and joins the threads. Idempotent.
+    void stop();
+    uint16_t port() const;
+    RenderServerStats stats() const;
+    size_t clients() const;
+
+    struct Impl;
+
+private:
+    explicit RenderServer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace qvr::runtime

@@ -1,0 +1,72 @@
+// Per-frame telemetry of the headset, every stage on one clock (issue 6, paper Fig. 4): pose
+// sample, decision, local render, request, each stream received and decoded, UCA, scan-out.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "qvr/core/expected.h"
+
+namespace qvr::runtime {
+
+inline constexpr int kStreams = 4;  // eye × {middle, outer}, net's stream ids
+
+// Times are ns on the client's steady clock, relative to the run's start; -1 = did not happen.
+struct FrameTelemetry {
+    int64_t frame = 0;
+    double e1_deg = 0.0;
+    double e2_deg = 0.0;
+    int64_t pose_ns = -1;
+    int64_t decision_ns = -1;
+    int64_t local_start_ns = -1;
+    int64_t local_end_ns = -1;
+    int64_t request_ns = -1;
+    std::array<int64_t, kStreams> stream_rx_ns{-1, -1, -1, -1};       // last packet arrived
+    std::array<int64_t, kStreams> stream_decoded_ns{-1, -1, -1, -1};  // decode finished
+    int64_t remote_done_ns = -1;  // every stream this frame expected decoded
+    int64_t uca_start_ns = -1;
+    int64_t uca_end_ns = -1;
+    int64_t display_ns = -1;  // the vsync slot it was scanned out at
+    int64_t bytes = 0;        // media payload received for this frame's streams
+    bool remote_requested = false;
+    bool reused = false;       // the display re-warped older layers (remote layers late/lost)
+    int64_t shown_frame = -1;  // the frame whose layers were displayed
+    bool connected = false;
+    bool fallback_local = false;  // the server was gone: everything rendered locally
+    double t_local_ms = 0.0;
+    double t_remote_ms = 0.0;
+    double uca_ms = 0.0;
+    double mtp_ms = 0.0;  // pose sample → UCA output complete
+    double throughput_bps = 0.0;
+    double fovea_triangles = 0.0;  // both eyes, in the e1 cone (LIWC's input)
+    double warp_deg = 0.0;
+};
+
+struct DesignSummary {
+    std::string design;
+    int frames = 0;
+    int frames_displayed = 0;
+    int frames_reused = 0;
+    double fps_mean = 0.0;  // displayed frames per second of scan-out time
+    double mtp_ms_mean = 0.0;
+    double mtp_ms_p99 = 0.0;
+    double bytes_per_frame_mean = 0.0;
+    double e1_deg_mean = 0.0;
+    double t_local_ms_mean = 0.0;
+    double t_remote_ms_mean = 0.0;  // over frames that requested remote layers
+    double uca_ms_mean = 0.0;
+    double frames_fallback_local = 0;
+    double wall_s = 0.0;
+};
+
+DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& frames);
+// Nearest-rank percentile (p in (0, 100]) of a non-empty sample; 0 when empty.
+double percentile(std::vector<double> values, double p);
+std::string telemetryCsvHeader();
+std::string telemetryCsvRow(const std::string& design, const FrameTelemetry& t);
+Status writeTelemetryCsv(const std::string& path, const std::string& design,
+                         const std::vector<FrameTelemetry>& frames);
+
+}  // namespace qvr::runtime

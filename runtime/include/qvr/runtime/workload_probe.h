@@ -1,0 +1,44 @@
+// The frame description LIWC reads before rendering (paper §4.1's "hardware intermediate data"):
+// triangles per eccentricity ring from the scene's BVH for both eyes' frusta, the full-resolution
+// pixels per ring, and the periphery's bits per pixel as measured on the streams so far. The same
+// frames are written as a workload trace so `qvr sim` can replay a run.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "qvr/core/pose.h"
+#include "qvr/foveation/layer_plan.h"
+#include "qvr/scene/triangle_bvh.h"
+#include "qvr/workload/workload.h"
+
+namespace qvr::runtime {
+
+class WorkloadProbe {
+public:
+    // ring_deg · rings must lie in [45, 180] (the trace format's rule).
+    WorkloadProbe(const HmdProfile& profile, std::shared_ptr<const TriangleBvh> bvh,
+                  double ring_deg = 1.0, int rings = 120);
+
+    const WorkloadHeader& header() const { return m_header; }
+    void setName(const std::string& name, const std::string& source);
+
+    WorkloadFrame frame(int64_t index, double time_ms, const Pose& head, const Gaze& gaze) const;
+
+    // Folds one frame's measured periphery sizes (both eyes, bytes and layer pixels at s1/s2)
+    // into the bits-per-pixel power law b·s^γ the next frames report.
+    void observeBits(double middle_bytes, double middle_pixels, double s1, double outer_bytes,
+                     double outer_pixels, double s2);
+
+private:
+    std::vector<double> pixelsPerRing(const Gaze& gaze) const;
+
+    HmdProfile m_profile;
+    EyeGeometry m_geometry;
+    std::shared_ptr<const TriangleBvh> m_bvh;
+    WorkloadHeader m_header;
+    double m_log_bits_at_1 = 0.0;  // log(bits per pixel at scale 1)
+    double m_bits_exponent = 0.7;
+};
+
+}  // namespace qvr::runtime

@@ -1,0 +1,544 @@
+// The headset's frame loop (paper Fig. 4): decide e1 → request periphery → render fovea →
+// decode streams as they arrive → UCA with the newest pose → scan-out at the next vsync.
+#include "qvr/runtime/headset_client.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <optional>
+
+#include <fmt/format.h>
+
+#include "qvr/compose/uca.h"
+#include "qvr/controller/liwc.h"
+#include "qvr/controller/policy.h"
+#include "qvr/render/camera.h"
+#include "qvr/runtime/affinity.h"
+#include "qvr/runtime/workload_probe.h"
+
+namespace qvr::runtime {
+
+LayerPlan wholeFramePlan(const LayerPlanner& planner, const Gaze& gaze) {
+    // Start from the all-local plan for its bookkeeping, then move the full frame to the
+    // middle slot at scale 1: the server renders and streams it, the headset only warps it.
+    LayerPlan p = planner.plan(gaze, 180.0);
+    const PixelRect full = planner.geometry().fullRect();
+    p.e1_deg = 0.0;
+    p.e2_deg = p.cover_deg;
+    p.s1 = 1.0;
+    p.s2 = 1.0;
+    for (EyeLayers& e : p.eyes) {
+        e.fovea = LayerRect{};
+        e.outer = LayerRect{};
+        e.middle = LayerRect{full, 1.0, full.width(), full.height()};
+    }
+    p.fovea_pixels = 0;
+    p.middle_pixels = full.area();
+    p.outer_pixels = 0;
+    p.fovea_fraction = 0.0;
+    return p;
+}
+
+namespace {
+
+// One frame waiting for its remote layers.
+struct PendingFrame {
+    int64_t frame = 0;
+    size_t telemetry = 0;  // index into the result's frames
+    std::shared_ptr<LayerFrame> layers;
+    uint8_t expected = 0;  // stream mask
+    uint8_t decoded = 0;
+    uint8_t failed = 0;
+    int64_t request_ns = 0;
+    std::array<double, net::kMaxStreams> bytes{};
+    bool complete() const { return expected != 0 && (decoded & expected) == expected; }
+    bool broken() const { return (failed & expected) != 0; }
+};
+
+uint8_t expectedStreams(const LayerPlan& plan) {
+    uint8_t mask = 0;
+    for (int eye = 0; eye < 2; ++eye) {
+        if (!plan.eyes[static_cast<size_t>(eye)].middle.empty())
+            mask |= static_cast<uint8_t>(1u << net::streamId(eye, net::Layer::kMiddle));
+        if (!plan.eyes[static_cast<size_t>(eye)].outer.empty())
+            mask |= static_cast<uint8_t>(1u << net::streamId(eye, net::Layer::kOuter));
+    }
+    return mask;
+}
+
+ImageRgba8& layerSlot(LayerFrame& f, uint8_t stream_id) {
+    EyeLayerImages& e = f.eyes[stream_id / 2];
+    return (stream_id % 2) == 0 ? e.middle : e.outer;
+}
+
+const LayerRect& layerRectOf(const LayerPlan& plan, uint8_t stream_id) {
+    const EyeLayers& e = plan.eyes[stream_id / 2];
+    return (stream_id % 2) == 0 ? e.middle : e.outer;
+}
+
+class Headset {
+public:
+    Headset(const HeadsetConfig& config, std::shared_ptr<const Scene> scene,
+            std::shared_ptr<const TriangleBvh> bvh, const HeadsetTraces& traces)
+        : m_config(config),
+          m_clock(config.clock ? *config.clock : SteadyPacingClock::instance()),
+          m_pacer(m_clock, config.profile.refresh_hz),
+          m_scene(std::move(scene)),
+          m_traces(traces),
+          m_planner(config.profile),
+          m_probe(config.profile, std::move(bvh)),
+          m_compositor(config.profile, composeOptions()) {}
+
+    static ComposeOptions composeOptions() {
+        ComposeOptions o;
+        o.threads = 1;  // the headset has one core
+        return o;
+    }
+
+    Status setUp() {
+        if (m_traces.motion.samples.empty())
+            return makeError("headset: the head-motion trace is empty");
+        if (m_traces.gaze.samples.empty())
+            return makeError("headset: the gaze trace is empty");
+        auto r = m_config.renderer();
+        if (!r)
+            return makeError("headset: " + r.error());
+        m_renderer = std::move(*r);
+        if (auto st = m_renderer->upload(*m_scene); !st)
+            return makeError("headset: " + st.error());
+        switch (m_config.design) {
+            case RuntimeDesign::kQvr:
+                m_policy = std::make_unique<LiwcPolicy>(m_probe.header());
+                break;
+            case RuntimeDesign::kSw:
+                m_policy = makeSoftwareReactivePolicy(m_probe.header());
+                break;
+            case RuntimeDesign::kFfr:
+                m_policy = std::make_unique<FixedPolicy>(m_config.ffr_e1_deg);
+                break;
+            default:
+                break;
+        }
+        if (m_config.workload)
+            m_config.workload->writeHeader(m_probe.header());
+        if (usesServer(m_config.design)) {
+            net::ClientOptions o;
+            o.key = m_config.key;
+            o.connect_timeout_ms = m_config.connect_timeout_ms;
+            m_client = std::make_unique<net::Client>(o);
+        }
+        return {};
+    }
+
+    HeadsetResult run() {
+        HeadsetResult result;
+        result.frames.reserve(static_cast<size_t>(std::max(m_config.frames, 0)));
+        m_origin_ns = m_clock.nowNs();
+        m_pacer.reset();
+        if (m_client)
+            tryConnect(true);
+        for (int64_t i = 0; i < m_config.frames; ++i) {
+            if (m_config.before_frame)
+                m_config.before_frame(i);
+            runFrame(i, result);
+        }
+        // Streams still in flight belong to frames already shown: drain them so the server's
+        // acks complete, then leave.
+        if (m_client) {
+            pumpNetwork(result, 0);
+            m_stats.net = m_client->stats();
+            m_client->disconnect();
+        }
+        m_stats.core = currentCore();
+        result.stats = m_stats;
+        result.summary = summarizeRun(designName(m_config.design), result.frames);
+        return result;
+    }
+
+private:
+    int64_t rel(int64_t t_ns) const { return t_ns - m_origin_ns; }
+    double frameTimeMs(int64_t i) const { return 1000.0 * double(i) / m_config.profile.refresh_hz; }
+
+    void tryConnect(bool force) {
+        const int64_t now_ns = m_clock.nowNs();
+        if (!force &&
+            now_ns - m_last_connect_try_ns < int64_t(m_config.reconnect_interval_ms) * 1'000'000)
+            return;
+        m_last_connect_try_ns = now_ns;
+        if (auto st = m_client->connect(m_config.host, m_config.port); st) {
+            ++m_stats.connects;
+            // A new session: new encoders on the server, so new decoders here.
+            for (auto& d : m_decoders)
+                d.reset();
+            m_pending.clear();
+        } else {
+            ++m_stats.connect_failures;
+        }
+    }
+
+    VideoDecoder* decoder(uint8_t stream_id) {
+        auto& d = m_decoders[stream_id];
+        if (!d) {
+            auto made = makeVideoDecoder(m_config.codec);
+            if (!made)
+                return nullptr;
+            d = std::move(*made);
+        }
+        return d.get();
+    }
+
+    PendingFrame* pendingFor(int64_t frame) {
+        for (PendingFrame& p : m_pending)
+            if (p.frame == frame)
+                return &p;
+        return nullptr;
+    }
+
+    void onStream(net::CompletedStream& cs, HeadsetResult& result) {
+        ++m_stats.streams_received;
+        if (cs.stream_id >= net::kMaxStreams)
+            return;
+        PendingFrame* p = pendingFor(cs.frame_id);
+        if (p) {
+            FrameTelemetry& t = result.frames[p->telemetry];
+            t.stream_rx_ns[cs.stream_id] = rel(cs.last_rx_ns);
+            t.bytes += static_cast<int64_t>(cs.bytes.size());
+            p->bytes[cs.stream_id] += static_cast<double>(cs.bytes.size());
+        }
+        // Every frame goes through its stream's decoder, shown or not: later frames refer to it.
+        VideoDecoder* dec = decoder(cs.stream_id);
+        if (!dec) {
+            ++m_stats.decode_failures;
+            return;
+        }
+        auto image = dec->decode(cs.bytes);
+        if (!image) {
+            ++m_stats.decode_failures;
+            if (p)
+                p->failed |= static_cast<uint8_t>(1u << cs.stream_id);
+            if (dec->needsKeyframe() && m_client->connected()) {
+                const int64_t now_ns = m_clock.nowNs();
+                if (now_ns - m_last_key_request_ns[cs.stream_id] > 100'000'000) {
+                    m_last_key_request_ns[cs.stream_id] = now_ns;
+                    if (m_client->requestKeyFrame(static_cast<uint8_t>(1u << cs.stream_id),
+                                                  cs.frame_id, net::KeyFrameReason::kDecoderError))
+                        ++m_stats.key_frame_requests;
+                }
+            }
+            return;
+        }
+        ++m_stats.streams_decoded;
+        if (!p) {
+            ++m_stats.streams_discarded;
+            return;
+        }
+        const LayerRect& r = layerRectOf(p->layers->plan, cs.stream_id);
+        if (image->width() != r.width_px || image->height() != r.height_px) {
+            ++m_stats.decode_failures;
+            p->failed |= static_cast<uint8_t>(1u << cs.stream_id);
+            return;
+        }
+        layerSlot(*p->layers, cs.stream_id) = std::move(*image);
+        p->decoded |= static_cast<uint8_t>(1u << cs.stream_id);
+        FrameTelemetry& t = result.frames[p->telemetry];
+        t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
+        if (p->complete())
+            t.remote_done_ns = rel(m_clock.nowNs());
+    }
+
+    // Takes what the transport has, waiting up to wait_ms for the first stream.
+    void pumpNetwork(HeadsetResult& result, int wait_ms) {
+        if (!m_client)
+            return;
+        int timeout_ms = wait_ms;
+        for (;;) {
+            auto next = m_client->nextStream(timeout_ms);
+            if (!next) {
+                if (m_was_connected) {
+                    ++m_stats.disconnects;
+                    m_was_connected = false;
+                }
+                break;
+            }
+            if (!next->has_value())
+                break;
+            onStream(**next, result);
+            timeout_ms = 0;
+        }
+        for (const net::LostStream& l : m_client->takeLost()) {
+            ++m_stats.streams_lost;
+            if (PendingFrame* p = pendingFor(l.frame_id)) {
+                p->failed |= static_cast<uint8_t>(1u << l.stream_id);
+                result.frames[p->telemetry].bytes += l.bytes_received;
+                p->bytes[l.stream_id] += l.bytes_received;
+            }
+        }
+    }
+
+    void runFrame(int64_t i, HeadsetResult& result) {
+        result.frames.emplace_back();
+        const size_t ti = result.frames.size() - 1;
+        FrameTelemetry& t0 = result.frames[ti];
+        t0.frame = i;
+
+        // 1. Pose and gaze sample: the start of motion-to-photon.
+        const int64_t pose_ns = m_clock.nowNs();
+        t0.pose_ns = rel(pose_ns);
+        const double content_ms = frameTimeMs(i);
+        const Pose head = poseAt(m_traces.motion, content_ms);
+        const Gaze gaze = gazeAt(m_traces.gaze, content_ms);
+
+        // Keep the transport drained and the session alive.
+        if (m_client) {
+            pumpNetwork(result, 0);
+            if (!m_client->connected())
+                tryConnect(false);
+            m_was_connected = m_client->connected();
+        }
+        const bool connected = m_client && m_client->connected();
+        result.frames[ti].connected = connected;
+
+        // 2. Decision: e1 before rendering.
+        const bool needs_workload = m_config.design == RuntimeDesign::kQvr || m_config.workload;
+        std::optional<WorkloadFrame> wf;
+        if (needs_workload)
+            wf = m_probe.frame(i, content_ms, head, gaze);
+        LayerPlan plan;
+        bool decided = false;
+        bool fallback = false;
+        switch (m_config.design) {
+            case RuntimeDesign::kLocal:
+                plan = m_planner.plan(gaze, 180.0);
+                break;
+            case RuntimeDesign::kRemote:
+                if (connected) {
+                    plan = wholeFramePlan(m_planner, gaze);
+                } else {
+                    plan = m_planner.plan(gaze, 180.0);
+                    fallback = true;
+                }
+                break;
+            default:
+                if (connected) {
+                    // Policies other than LIWC read only the pose and gaze (policy.h).
+                    WorkloadFrame light;
+                    if (!wf) {
+                        light.index = i;
+                        light.time_ms = content_ms;
+                        light.head = head;
+                        light.gaze = gaze;
+                    }
+                    const Decision d = m_policy->decide(wf ? *wf : light);
+                    plan = m_planner.plan(gaze, d.e1_deg);
+                    decided = true;
+                } else {
+                    plan = m_planner.plan(gaze, 180.0);
+                    fallback = true;
+                }
+                break;
+        }
+        if (m_config.workload && wf)
+            m_config.workload->writeFrame(*wf);
+        FrameTelemetry* t = &result.frames[ti];
+        t->decision_ns = rel(m_clock.nowNs());
+        t->fallback_local = fallback;
+        t->e1_deg = m_config.design == RuntimeDesign::kRemote && !fallback ? 0.0
+                    : m_config.design == RuntimeDesign::kLocal || fallback ? plan.cover_deg
+                                                                           : plan.e1_deg;
+        t->e2_deg = plan.e2_deg;
+        if (wf)
+            t->fovea_triangles =
+                sumWithinDeg(wf->triangles_per_ring, m_probe.header().ring_deg, plan.e1_deg);
+
+        auto layers = std::make_shared<LayerFrame>();
+        layers->frame_index = static_cast<uint64_t>(i);
+        layers->plan = plan;
+        layers->render_pose = head;
+
+        // 3. Request the periphery first, so the server works while the fovea renders.
+        const uint8_t expected = connected ? expectedStreams(plan) : 0;
+        if (expected != 0) {
+            const net::FrameRequest req = net::makeFrameRequest(
+                static_cast<uint32_t>(i), static_cast<uint64_t>(pose_ns), head, plan);
+            if (m_client->sendFrameRequest(req)) {
+                PendingFrame p;
+                p.frame = i;
+                p.telemetry = ti;
+                p.layers = layers;
+                p.expected = expected;
+                p.request_ns = m_clock.nowNs();
+                t->request_ns = rel(p.request_ns);
+                t->remote_requested = true;
+                m_pending.push_back(p);
+                while (m_pending.size() > kMaxPendingFrames)
+                    m_pending.pop_front();
+            }
+        }
+
+        // 4. The fovea (or the whole frame) locally.
+        const int64_t local_start_ns = m_clock.nowNs();
+        t->local_start_ns = rel(local_start_ns);
+        for (int eye = 0; eye < 2; ++eye) {
+            if (plan.eyes[static_cast<size_t>(eye)].fovea.empty())
+                continue;
+            auto rs = renderLayer(*m_renderer, m_config.profile, plan, head, static_cast<Eye>(eye),
+                                  LayerKind::kFovea, layers->eyes[static_cast<size_t>(eye)].fovea);
+            if (!rs)
+                ++m_stats.render_failures;
+        }
+        const int64_t local_end_ns = m_clock.nowNs();
+        t = &result.frames[ti];
+        t->local_end_ns = rel(local_end_ns);
+        t->t_local_ms = double(local_end_ns - local_start_ns) * 1e-6;
+
+        // 5. Wait for this frame's remote layers, decoding each as it arrives.
+        bool have_current = expected == 0;
+        if (expected != 0) {
+            const int64_t deadline_ns = std::max(local_end_ns, pose_ns) +
+                                        static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
+            for (;;) {
+                PendingFrame* p = pendingFor(i);
+                if (!p || p->complete() || p->broken())
+                    break;
+                const int64_t now_ns = m_clock.nowNs();
+                if (now_ns >= deadline_ns || !m_client->connected())
+                    break;
+                const int wait_ms =
+                    static_cast<int>(std::clamp<int64_t>((deadline_ns - now_ns) / 1'000'000, 1, 5));
+                pumpNetwork(result, wait_ms);
+            }
+            PendingFrame* p = pendingFor(i);
+            t = &result.frames[ti];
+            have_current = p && p->complete();
+            const int64_t end_ns = have_current ? m_origin_ns + t->remote_done_ns : m_clock.nowNs();
+            t->t_remote_ms = double(end_ns - (m_origin_ns + t->request_ns)) * 1e-6;
+            if (!have_current)
+                ++m_stats.late_frames;
+        }
+
+        // 6. UCA with the newest pose, then scan-out at the next vsync.
+        const int64_t uca_start_ns = m_clock.nowNs();
+        const Pose display_pose =
+            poseAt(m_traces.motion, content_ms + double(uca_start_ns - pose_ns) * 1e-6);
+        std::shared_ptr<const LayerFrame> arrived;
+        bool reused = false;
+        if (have_current) {
+            arrived = layers;
+        } else {
+            // A frame older than this one whose layers completed after its own display: newer
+            // than what the compositor holds, so show it (still a reuse of older layers).
+            for (auto it = m_pending.rbegin(); it != m_pending.rend(); ++it) {
+                if (it->frame < i && it->complete() &&
+                    static_cast<int64_t>(it->layers->frame_index) > m_last_shown) {
+                    arrived = it->layers;
+                    break;
+                }
+            }
+            reused = true;
+        }
+        auto report = m_compositor.present(arrived, display_pose, m_display);
+        if (!report) {
+            ++m_stats.compose_failures;
+            // Nothing to re-warp yet (the very first frame was late): show the local part.
+            reused = true;
+        }
+        const int64_t uca_end_ns = m_clock.nowNs();
+        t = &result.frames[ti];
+        t->uca_start_ns = rel(uca_start_ns);
+        t->uca_end_ns = rel(uca_end_ns);
+        t->uca_ms = double(uca_end_ns - uca_start_ns) * 1e-6;
+        t->mtp_ms = double(uca_end_ns - pose_ns) * 1e-6;
+        t->reused = reused || (report && report->reused);
+        if (report) {
+            t->shown_frame = static_cast<int64_t>(report->frame_index);
+            t->warp_deg = report->warp_deg;
+            m_last_shown = t->shown_frame;
+        }
+        t->throughput_bps = m_client ? m_client->throughputBps() : 0.0;
+        const int64_t display_ns = m_pacer.waitForScanout(uca_end_ns);
+        t = &result.frames[ti];
+        t->display_ns = rel(display_ns);
+        if (m_config.display && report) {
+            const LayerFrame* shown = m_compositor.newestFrame();
+            m_config.display->onScanout(*t, shown ? shown->plan : plan, m_display);
+        }
+
+        // 7. The policy learns what the frame measured.
+        if (decided) {
+            PendingFrame* p = pendingFor(i);
+            FrameMeasurement m;
+            m.index = i;
+            m.e1_deg = plan.e1_deg;
+            m.t_local_ms = t->t_local_ms;
+            m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
+            if (wf) {
+                m.triangles_local =
+                    sumWithinDeg(wf->triangles_per_ring, m_probe.header().ring_deg, plan.e1_deg);
+                m.pixels_local =
+                    sumWithinDeg(wf->pixels_per_ring, m_probe.header().ring_deg, plan.e1_deg);
+            }
+            if (p) {
+                m.middle_bytes = p->bytes[0] + p->bytes[2];
+                m.outer_bytes = p->bytes[1] + p->bytes[3];
+            }
+            m.middle_pixels = 2.0 * double(plan.middle_pixels);
+            m.outer_pixels = 2.0 * double(plan.outer_pixels);
+            m.s1 = plan.s1;
+            m.s2 = plan.s2;
+            m.throughput_bps = t->throughput_bps;
+            m_policy->observe(m);
+            if (p && have_current)
+                m_probe.observeBits(m.middle_bytes, m.middle_pixels, plan.s1, m.outer_bytes,
+                                    m.outer_pixels, plan.s2);
+        }
+        // Frames already shown keep their slot only until their streams are decoded.
+        while (!m_pending.empty() &&
+               (m_pending.front().frame <= m_last_shown && m_pending.front().frame < i))
+            m_pending.pop_front();
+    }
+
+    static constexpr size_t kMaxPendingFrames = 8;
+
+    const HeadsetConfig& m_config;
+    PacingClock& m_clock;
+    VsyncPacer m_pacer;
+    std::shared_ptr<const Scene> m_scene;
+    const HeadsetTraces& m_traces;
+    LayerPlanner m_planner;
+    WorkloadProbe m_probe;
+    Compositor m_compositor;
+    std::unique_ptr<Renderer> m_renderer;
+    std::unique_ptr<FoveaPolicy> m_policy;
+    std::unique_ptr<net::Client> m_client;
+    std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;
+    std::array<int64_t, net::kMaxStreams> m_last_key_request_ns{};
+    std::deque<PendingFrame> m_pending;
+    std::array<ImageRgba8, 2> m_display;
+    HeadsetStats m_stats;
+    int64_t m_origin_ns = 0;
+    int64_t m_last_connect_try_ns = 0;
+    int64_t m_last_shown = -1;
+    bool m_was_connected = false;
+};
+
+}  // namespace
+
+Expected<HeadsetResult> runHeadset(const HeadsetConfig& config, std::shared_ptr<const Scene> scene,
+                                   std::shared_ptr<const TriangleBvh> bvh,
+                                   const HeadsetTraces& traces) {
+    if (!scene || !bvh)
+        return makeError("headset: no scene");
+    if (config.frames < 0)
+        return makeError("headset: negative frame count");
+    if (config.core >= 0) {
+        if (auto st = pinCurrentThread(config.core); !st)
+            std::fprintf(stderr, "qvr client: %s (running unpinned)\n", st.error().c_str());
+    }
+    auto headset = std::make_unique<Headset>(config, std::move(scene), std::move(bvh), traces);
+    if (auto st = headset->setUp(); !st)
+        return makeError(st.error());
+    return headset->run();
+}
+
+}  // namespace qvr::runtime

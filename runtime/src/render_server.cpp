@@ -1,0 +1,293 @@
+// The render server: a bounded request queue per headset, one render thread that renders,
+// encodes and sends each periphery layer as soon as it is ready (paper Fig. 7's parallel streams).
+#include "qvr/runtime/render_server.h"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "qvr/render/gl_renderer.h"
+#include "qvr/runtime/affinity.h"
+
+namespace qvr::runtime {
+
+RendererFactory glRendererFactory() {
+    return []() -> Expected<std::unique_ptr<Renderer>> {
+        auto r = GlRenderer::create();
+        if (!r)
+            return makeError(r.error());
+        return std::unique_ptr<Renderer>(std::move(*r));
+    };
+}
+
+RendererFactory nullRendererFactory() {
+    return []() -> Expected<std::unique_ptr<Renderer>> { return makeNullRenderer(); };
+}
+
+namespace {
+
+struct ClientState {
+    std::deque<net::FrameRequest> pending;  // guarded by Impl::mutex
+    std::atomic<uint8_t> key_frame_mask{0};
+    // Touched by the render thread only.
+    std::array<std::unique_ptr<VideoEncoder>, net::kMaxStreams> encoders;
+};
+
+bool layerFits(const HmdProfile& profile, const LayerRect& l) {
+    if (l.empty())
+        return true;
+    return l.rect.x0 >= 0 && l.rect.y0 >= 0 && l.rect.x1 <= profile.width_px &&
+           l.rect.y1 <= profile.height_px && l.width_px <= profile.width_px &&
+           l.height_px <= profile.height_px;
+}
+
+bool planFits(const HmdProfile& profile, const LayerPlan& plan) {
+    for (const EyeLayers& e : plan.eyes)
+        if (!layerFits(profile, e.middle) || !layerFits(profile, e.outer))
+            return false;
+    return true;
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+struct RenderServer::Impl final : net::ServerHandler {
+    RenderServerConfig config;
+    std::shared_ptr<const Scene> scene;
+    std::unique_ptr<net::Server> server;
+    std::thread render_thread;
+
+    mutable std::mutex mutex;
+    std::condition_variable cv;
+    std::map<net::ClientId, std::shared_ptr<ClientState>> clients;
+    net::ClientId last_served = 0;
+    bool stopping = false;
+    RenderServerStats stats;
+
+    // Start-up handshake with the render thread.
+    bool ready = false;
+    std::string start_error;
+
+    void onClientConnected(net::ClientId id) override {
+        std::lock_guard lock(mutex);
+        clients[id] = std::make_shared<ClientState>();
+    }
+    void onClientGone(net::ClientId id) override {
+        std::lock_guard lock(mutex);
+        clients.erase(id);
+    }
+    void onFrameRequest(net::ClientId id, const net::FrameRequest& request) override {
+        {
+            std::lock_guard lock(mutex);
+            ++stats.requests;
+            auto it = clients.find(id);
+            if (it == clients.end())
+                return;
+            auto& q = it->second->pending;
+            q.push_back(request);
+            while (q.size() > std::max<size_t>(config.max_pending_requests, 1)) {
+                q.pop_front();
+                ++stats.requests_dropped;
+            }
+        }
+        cv.notify_one();
+    }
+    void onKeyFrameRequest(net::ClientId id, const net::KeyFrameRequest& request) override {
+        std::lock_guard lock(mutex);
+        ++stats.key_frame_requests;
+        auto it = clients.find(id);
+        if (it != clients.end())
+            it->second->key_frame_mask.fetch_or(request.stream_mask);
+    }
+
+    // The next request, round robin over headsets; false when stopping.
+    bool next(net::ClientId& id, std::shared_ptr<ClientState>& state, net::FrameRequest& req) {
+        std::unique_lock lock(mutex);
+        for (;;) {
+            if (stopping)
+                return false;
+            auto pick = clients.upper_bound(last_served);
+            for (size_t n = 0; n < clients.size(); ++n) {
+                if (pick == clients.end())
+                    pick = clients.begin();
+                if (!pick->second->pending.empty()) {
+                    id = pick->first;
+                    state = pick->second;
+                    req = state->pending.front();
+                    state->pending.pop_front();
+                    last_served = id;
+                    return true;
+                }
+                ++pick;
+            }
+            cv.wait(lock);
+        }
+    }
+
+    void renderLoop() {
+        if (config.core >= 0) {
+            if (auto st = pinCurrentThread(config.core); !st)
+                std::fprintf(stderr, "qvr server: %s (running unpinned)\n", st.error().c_str());
+        }
+        auto renderer = config.renderer();
+        Status upload =
+            renderer ? (*renderer)->upload(*scene) : Status(makeError(renderer.error()));
+        {
+            std::lock_guard lock(mutex);
+            if (!upload)
+                start_error = upload.error();
+            ready = true;
+        }
+        cv.notify_all();
+        if (!upload)
+            return;
+        Renderer& r = **renderer;
+        ImageRgba8 image;
+        net::ClientId id = 0;
+        std::shared_ptr<ClientState> state;
+        net::FrameRequest req;
+        while (next(id, state, req)) {
+            const LayerPlan plan = net::layerPlanOf(req);
+            if (!planFits(config.profile, plan)) {
+                std::lock_guard lock(mutex);
+                ++stats.requests_invalid;
+                continue;
+            }
+            const uint8_t key_mask = state->key_frame_mask.exchange(0);
+            RenderServerStats delta;
+            for (int eye = 0; eye < 2; ++eye) {
+                for (net::Layer layer : {net::Layer::kMiddle, net::Layer::kOuter}) {
+                    const LayerKind kind =
+                        layer == net::Layer::kMiddle ? LayerKind::kMiddle : LayerKind::kOuter;
+                    if (layerOf(plan.eyes[static_cast<size_t>(eye)], kind).empty())
+                        continue;
+                    const uint8_t sid = net::streamId(eye, layer);
+                    const auto t0 = std::chrono::steady_clock::now();
+                    auto rs = renderLayer(r, config.profile, plan, req.pose, static_cast<Eye>(eye),
+                                          kind, image);
+                    delta.render_ms_total += msSince(t0);
+                    if (!rs) {
+                        ++delta.render_failures;
+                        continue;
+                    }
+                    ++delta.layers_rendered;
+                    auto& enc = state->encoders[sid];
+                    if (!enc) {
+                        auto made = makeVideoEncoder(config.codec);
+                        if (!made) {
+                            ++delta.encode_failures;
+                            continue;
+                        }
+                        enc = std::move(*made);
+                    }
+                    if (key_mask & (1u << sid))
+                        enc->requestKeyframe();
+                    auto encoded = enc->encode(image);
+                    if (!encoded) {
+                        ++delta.encode_failures;
+                        continue;
+                    }
+                    delta.encode_ms_total += encoded->encode_ms;
+                    const bool key = encoded->is_keyframe;
+                    if (server->sendStream(id, req.frame_id, sid, key, std::move(encoded->bytes)))
+                        ++delta.streams_sent;
+                    else
+                        ++delta.stream_send_failures;
+                }
+            }
+            std::lock_guard lock(mutex);
+            ++stats.frames_rendered;
+            stats.layers_rendered += delta.layers_rendered;
+            stats.streams_sent += delta.streams_sent;
+            stats.stream_send_failures += delta.stream_send_failures;
+            stats.render_failures += delta.render_failures;
+            stats.encode_failures += delta.encode_failures;
+            stats.render_ms_total += delta.render_ms_total;
+            stats.encode_ms_total += delta.encode_ms_total;
+        }
+    }
+};
+
+Expected<std::unique_ptr<RenderServer>> RenderServer::start(RenderServerConfig config,
+                                                            std::shared_ptr<const Scene> scene) {
+    if (!scene)
+        return makeError("render server: no scene");
+    if (auto st = validateCodecConfig(config.codec); !st)
+        return makeError("render server: " + st.error());
+    auto impl = std::make_unique<Impl>();
+    impl->config = std::move(config);
+    impl->scene = std::move(scene);
+    Impl* p = impl.get();
+    impl->render_thread = std::thread([p] { p->renderLoop(); });
+    {
+        std::unique_lock lock(p->mutex);
+        p->cv.wait(lock, [p] { return p->ready; });
+    }
+    if (!p->start_error.empty()) {
+        p->render_thread.join();
+        return makeError("render server: " + p->start_error);
+    }
+    auto server = net::Server::start(p->config.net, *p);
+    if (!server) {
+        {
+            std::lock_guard lock(p->mutex);
+            p->stopping = true;
+        }
+        p->cv.notify_all();
+        p->render_thread.join();
+        return makeError("render server: " + server.error());
+    }
+    p->server = std::move(*server);
+    return std::unique_ptr<RenderServer>(new RenderServer(std::move(impl)));
+}
+
+RenderServer::RenderServer(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+
+RenderServer::~RenderServer() {
+    stop();
+}
+
+void RenderServer::stop() {
+    if (!m_impl)
+        return;
+    {
+        std::lock_guard lock(m_impl->mutex);
+        m_impl->stopping = true;
+    }
+    m_impl->cv.notify_all();
+    if (m_impl->render_thread.joinable())
+        m_impl->render_thread.join();
+    if (m_impl->server)
+        m_impl->server->stop();
+}
+
+uint16_t RenderServer::port() const {
+    return m_impl->server ? m_impl->server->port() : 0;
+}
+
+RenderServerStats RenderServer::stats() const {
+    RenderServerStats s;
+    {
+        std::lock_guard lock(m_impl->mutex);
+        s = m_impl->stats;
+    }
+    if (m_impl->server)
+        s.net = m_impl->server->stats();
+    return s;
+}
+
+size_t RenderServer::clients() const {
+    std::lock_guard lock(m_impl->mutex);
+    return m_impl->clients.size();
+}
+
+}  // namespace qvr::runtime

@@ -1,0 +1,94 @@
+// LIWC's per-frame input measured from the scene (paper §4.1): BVH ring counts and pixel rings.
+#include "qvr/runtime/workload_probe.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "qvr/render/camera.h"
+
+namespace qvr::runtime {
+
+namespace {
+// Pixel rings are counted on a grid of this many samples per side at most; each sample stands
+// for the pixels around it, so a frame costs ~16k direction tests whatever the resolution.
+constexpr int kMaxPixelSamplesPerSide = 128;
+}  // namespace
+
+WorkloadProbe::WorkloadProbe(const HmdProfile& profile, std::shared_ptr<const TriangleBvh> bvh,
+                             double ring_deg, int rings)
+    : m_profile(profile), m_geometry(profile), m_bvh(std::move(bvh)) {
+    m_header.name = "qvr-run";
+    m_header.source = "recorded by qvr run";
+    m_header.profile = profile;
+    m_header.ring_deg = ring_deg;
+    m_header.rings = rings;
+    m_header.scales = {1, 2, 4, 8, 16, 32};
+}
+
+void WorkloadProbe::setName(const std::string& name, const std::string& source) {
+    m_header.name = name;
+    m_header.source = source;
+}
+
+std::vector<double> WorkloadProbe::pixelsPerRing(const Gaze& gaze) const {
+    std::vector<double> rings(static_cast<size_t>(m_header.rings), 0.0);
+    const int w = m_geometry.width(), h = m_geometry.height();
+    const int step_x = std::max(1, (w + kMaxPixelSamplesPerSide - 1) / kMaxPixelSamplesPerSide);
+    const int step_y = std::max(1, (h + kMaxPixelSamplesPerSide - 1) / kMaxPixelSamplesPerSide);
+    for (int y0 = 0; y0 < h; y0 += step_y) {
+        const int bh = std::min(step_y, h - y0);
+        for (int x0 = 0; x0 < w; x0 += step_x) {
+            const int bw = std::min(step_x, w - x0);
+            const double e = m_geometry.eccentricityDeg(gaze, x0 + 0.5 * bw, y0 + 0.5 * bh);
+            const int k =
+                std::clamp(static_cast<int>(e / m_header.ring_deg), 0, m_header.rings - 1);
+            rings[static_cast<size_t>(k)] += 2.0 * bw * bh;  // both eyes share the gaze
+        }
+    }
+    return rings;
+}
+
+WorkloadFrame WorkloadProbe::frame(int64_t index, double time_ms, const Pose& head,
+                                   const Gaze& gaze) const {
+    WorkloadFrame f;
+    f.index = index;
+    f.time_ms = time_ms;
+    f.head = head;
+    f.gaze = gaze;
+    f.triangles_per_ring.assign(static_cast<size_t>(m_header.rings), 0.0);
+    const glm::dvec3 gaze_eye = m_geometry.gazeDirection(gaze);
+    for (Eye eye : {Eye::kLeft, Eye::kRight}) {
+        const EyeView view = fullFrameEyeView(m_profile, head, eye);
+        const std::vector<uint64_t> per_ring =
+            m_bvh->trianglesPerRing(view, gaze_eye, m_header.ring_deg, m_header.rings);
+        for (size_t k = 0; k < per_ring.size() && k < f.triangles_per_ring.size(); ++k)
+            f.triangles_per_ring[k] += static_cast<double>(per_ring[k]);
+    }
+    f.pixels_per_ring = pixelsPerRing(gaze);
+    f.bits_per_pixel.reserve(m_header.scales.size());
+    for (double s : m_header.scales)
+        f.bits_per_pixel.push_back(std::exp(m_log_bits_at_1) * std::pow(s, m_bits_exponent));
+    return f;
+}
+
+void WorkloadProbe::observeBits(double middle_bytes, double middle_pixels, double s1,
+                                double outer_bytes, double outer_pixels, double s2) {
+    constexpr double kWeight = 0.5;
+    const bool have_middle = middle_bytes > 0 && middle_pixels > 0;
+    const bool have_outer = outer_bytes > 0 && outer_pixels > 0;
+    if (have_middle && have_outer && s2 > s1 * 1.05) {
+        const double bm = 8.0 * middle_bytes / middle_pixels;
+        const double bo = 8.0 * outer_bytes / outer_pixels;
+        const double gamma = std::clamp(std::log(bo / bm) / std::log(s2 / s1), -1.0, 3.0);
+        m_bits_exponent = (1 - kWeight) * m_bits_exponent + kWeight * gamma;
+    }
+    if (have_middle || have_outer) {
+        const double bytes = have_middle ? middle_bytes : outer_bytes;
+        const double pixels = have_middle ? middle_pixels : outer_pixels;
+        const double s = have_middle ? s1 : s2;
+        const double log_b1 = std::log(8.0 * bytes / pixels) - m_bits_exponent * std::log(s);
+        m_log_bits_at_1 = (1 - kWeight) * m_log_bits_at_1 + kWeight * log_b1;
+    }
+}
+
+}  // namespace qvr::runtime
