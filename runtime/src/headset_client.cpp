@@ -303,7 +303,9 @@ private:
         const bool needs_workload = m_config.design == RuntimeDesign::kQvr || m_config.workload;
         std::optional<WorkloadFrame> wf;
         if (needs_workload)
-            wf = m_probe.frame(i, content_ms, head, gaze);
+            // LIWC's candidates reach 5° past the last e1: rings beyond are lumped into the last
+            // counted one (also in the recorded trace: its totals are exact, its far rings not).
+            wf = m_probe.frame(i, content_ms, head, gaze, m_last_e1_deg + 6.0);
         LayerPlan plan;
         bool decided = false;
         bool fallback = false;
@@ -330,6 +332,7 @@ private:
                         light.gaze = gaze;
                     }
                     const Decision d = m_policy->decide(wf ? *wf : light);
+                    m_last_e1_deg = d.e1_deg;
                     plan = m_planner.plan(gaze, d.e1_deg);
                     decided = true;
                 } else {
@@ -519,6 +522,7 @@ private:
     int64_t m_origin_ns = 0;
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
+    double m_last_e1_deg = 5.0;
     bool m_was_connected = false;
 };
 

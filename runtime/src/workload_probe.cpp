@@ -49,7 +49,7 @@ std::vector<double> WorkloadProbe::pixelsPerRing(const Gaze& gaze) const {
 }
 
 WorkloadFrame WorkloadProbe::frame(int64_t index, double time_ms, const Pose& head,
-                                   const Gaze& gaze) const {
+                                   const Gaze& gaze, double count_to_deg) const {
     WorkloadFrame f;
     f.index = index;
     f.time_ms = time_ms;
@@ -57,10 +57,12 @@ WorkloadFrame WorkloadProbe::frame(int64_t index, double time_ms, const Pose& he
     f.gaze = gaze;
     f.triangles_per_ring.assign(static_cast<size_t>(m_header.rings), 0.0);
     const glm::dvec3 gaze_eye = m_geometry.gazeDirection(gaze);
+    const int rings = std::clamp(static_cast<int>(std::ceil(count_to_deg / m_header.ring_deg)) + 1,
+                                 1, m_header.rings);
     for (Eye eye : {Eye::kLeft, Eye::kRight}) {
         const EyeView view = fullFrameEyeView(m_profile, head, eye);
         const std::vector<uint64_t> per_ring =
-            m_bvh->trianglesPerRing(view, gaze_eye, m_header.ring_deg, m_header.rings);
+            m_bvh->trianglesPerRing(view, gaze_eye, m_header.ring_deg, rings);
         for (size_t k = 0; k < per_ring.size() && k < f.triangles_per_ring.size(); ++k)
             f.triangles_per_ring[k] += static_cast<double>(per_ring[k]);
     }

@@ -57,7 +57,7 @@ struct HeadsetConfig {
     int core = -1;  // pin the headset thread (and the threads it creates) to this core
     // A frame's remote layers that have not all been decoded this long after the request are
     // late: the display re-warps the newest layers it has instead (§4.2 frame reuse).
-    double remote_timeout_ms = 100.0;
+    double remote_timeout_ms = 250.0;
     int connect_timeout_ms = 500;
     int reconnect_interval_ms = 250;
     double ffr_e1_deg = 5.0;

@@ -23,7 +23,11 @@ public:
     const WorkloadHeader& header() const { return m_header; }
     void setName(const std::string& name, const std::string& source);
 
-    WorkloadFrame frame(int64_t index, double time_ms, const Pose& head, const Gaze& gaze) const;
+    // Triangles are binned in rings up to count_to_deg only; everything beyond falls in the last
+    // of those rings (the BVH then accepts whole subtrees there, which makes the query several
+    // times cheaper). LIWC reads rings up to e1 + 5°; 180 counts every ring.
+    WorkloadFrame frame(int64_t index, double time_ms, const Pose& head, const Gaze& gaze,
+                        double count_to_deg = 180.0) const;
 
     // Folds one frame's measured periphery sizes (both eyes, bytes and layer pixels at s1/s2)
     // into the bits-per-pixel power law b·s^γ the next frames report.
