@@ -47,9 +47,9 @@ struct RunOptions {
     std::string designs = "local,remote,ffr,sw,qvr";
     std::string out = "qvr-run";
     std::string codec = "x264";
-    int frames = 240;
+    int frames = 150;
     uint64_t seed = 1;
-    double remote_timeout_ms = 100.0;
+    double remote_timeout_ms = 250.0;
     bool video = true;
     int video_max_frames = 900;
     std::string command_line;
