@@ -23,7 +23,10 @@ void LiwcTable::clear() {
 int LiwcTable::bucketOf(double e_deg) {
     if (!(e_deg > 0.0))
         return 0;
-    return std::min(kEccentricityBuckets - 1, static_cast<int>(e_deg / kBucketDeg));
+    // Compare before converting: a float-to-int cast of a huge value is undefined.
+    if (e_deg >= kEccentricityBuckets * kBucketDeg)
+        return kEccentricityBuckets - 1;
+    return static_cast<int>(e_deg / kBucketDeg);
 }
 
 size_t LiwcTable::indexOf(uint16_t motion, int bucket) {

@@ -7,7 +7,6 @@
 
 #include "qvr/controller/policy.h"
 #include "qvr/controller/remote_size_table.h"
-#include "qvr/core/minimize.h"
 
 namespace qvr {
 
@@ -130,8 +129,16 @@ public:
             consider(e);
         consider(hi);
         // max(T_local, T_remote) is unimodal near its minimum: refine by golden section.
-        consider(goldenSectionMin(cost, std::max(m_e1_min, best_e - 1.0),
-                                  std::min(hi, best_e + 1.0), 24));
+        // Whole-pixel framebuffers make T_remote a staircase in e1 with dips a bracket search
+        // can settle in; refine by scanning ever finer grids around the best point instead.
+        for (const auto& [step, reach] : {std::pair{0.1, 10}, std::pair{0.01, 25}}) {
+            const double centre = best_e;
+            for (int k = -reach; k <= reach; ++k) {
+                const double e = centre + k * step;
+                if (e >= m_e1_min && e <= hi)
+                    consider(e);
+            }
+        }
         const FrameCost c = m_truth.cost(frame, best_e);
         return {best_e, c.local_ms, c.remote_ms};
     }

@@ -53,10 +53,18 @@ void ConfigReader::fail(std::string message) {
 }
 
 void ConfigReader::markUsed(std::string_view path) {
-    // Mark the key and all its parent tables as known.
+    // Mark the key and all its parent tables as known; a parent that holds a value instead of
+    // a table ("display = 3" where [display] belongs) is an error, not a silent default.
     std::string p(path);
+    bool leaf = true;
     while (true) {
         m_used.insert(p);
+        if (!leaf) {
+            const auto node = m_table.at_path(p);
+            if (node && !node.is_table())
+                fail(fmt::format("'{}' must be a table ([{}]), not a value", p, p));
+        }
+        leaf = false;
         const auto dot = p.rfind('.');
         if (dot == std::string::npos)
             break;

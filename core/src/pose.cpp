@@ -43,8 +43,17 @@ EulerDeg eulerDegFromQuat(const glm::quat& q_in) {
 }
 
 double angleBetweenDeg(const glm::quat& a, const glm::quat& b) {
-    const double d = std::fabs(static_cast<double>(glm::dot(glm::normalize(a), glm::normalize(b))));
-    return 2.0 * std::acos(std::clamp(d, 0.0, 1.0)) * kDegPerRad;
+    // In double, and through the half-angle's sine rather than the dot product's arccosine,
+    // which cannot resolve angles below ~0.06° in float.
+    const glm::dquat qa = glm::normalize(glm::dquat(a));
+    glm::dquat qb = glm::normalize(glm::dquat(b));
+    if (glm::dot(qa, qb) < 0.0)
+        qb = -qb;
+    const glm::dquat diff = qb - qa;
+    const glm::dquat sum = qb + qa;
+    const double dn = std::sqrt(glm::dot(diff, diff));
+    const double sn = std::sqrt(glm::dot(sum, sum));
+    return 4.0 * std::atan2(dn, sn) * kDegPerRad;
 }
 
 }  // namespace qvr

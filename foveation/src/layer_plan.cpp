@@ -76,7 +76,7 @@ double LayerPlanner::optimalE2Deg(const Gaze& gaze, double e1_deg) const {
 LayerPlan LayerPlanner::plan(const Gaze& gaze, double e1_deg) const {
     LayerPlan p;
     p.gaze = gaze;
-    p.e1_deg = std::clamp(std::isfinite(e1_deg) ? e1_deg : 0.0, 0.0, 180.0);
+    p.e1_deg = std::isnan(e1_deg) ? 0.0 : std::clamp(e1_deg, 0.0, 180.0);
     p.cover_deg = m_geometry.coverEccentricityDeg(gaze);
     p.full_pixels = static_cast<int64_t>(m_geometry.width()) * m_geometry.height();
     p.s1 = m_profile.scaleAt(p.e1_deg);

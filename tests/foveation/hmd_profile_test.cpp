@@ -133,10 +133,9 @@ TEST(ParseHmdProfile, FailsWithKeyInMessageWhenFileIsBad) {
 }
 
 // Reported to the lead: a plain value where a section belongs is silently ignored, because
-// ConfigReader marks the parents of every key it is asked for ("display" for
-// "display.width_px") as known without checking that they are tables. `fov = 100` or
-// `display = 3` parse as the default profile with no error.
-TEST(ParseHmdProfile, DISABLED_FailsWhenValueStandsWhereSectionBelongs) {
+// A value where a section belongs (`fov = 100`, `display = 3`) is an error, not a silent
+// default profile (found by this suite; fixed).
+TEST(ParseHmdProfile, FailsWhenValueStandsWhereSectionBelongs) {
     for (const char* text : {"display = 3\n", "fov = 100\n", "acuity = \"sharp\"\n"}) {
         auto p = parseHmdProfile(text, "bad.toml");
         EXPECT_FALSE(p.ok()) << text;

@@ -305,7 +305,7 @@ TEST(LayerPlanner, TreatsNanE1AsZeroWhenPlanning) {
 
 // Reported to the lead: plan() documents "e1 is clamped to [0, 180]" but maps every
 // non-finite e1 to 0, so e1 = +inf gives no fovea at all instead of a fully local frame.
-TEST(LayerPlanner, DISABLED_ClampsInfiniteE1To180WhenPlanning) {
+TEST(LayerPlanner, ClampsInfiniteE1To180WhenPlanning) {
     const LayerPlanner planner(defaultHmdProfile());
     const LayerPlan plan = planner.plan({0, 0}, std::numeric_limits<double>::infinity());
     EXPECT_EQ(plan.e1_deg, 180.0);

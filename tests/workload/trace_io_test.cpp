@@ -446,7 +446,8 @@ TEST(ReadWorkloadTrace, NamesLineWhenLineExceedsFourMebibytes) {
 }
 
 TEST(ReadWorkloadTrace, RejectsNegativeRingValuesAndBackwardTimeWhenValidating) {
-    // These are caught after parsing, by validateTrace; the message names the frame.
+    // These pass the field parser and are caught by the per-frame validation; the message names the
+    // line.
     auto lines = validLines();
     auto l = lines;
     l[2] = replaced(l[2], "\"tri\":[", "\"tri\":[-1.0,");
@@ -457,20 +458,19 @@ TEST(ReadWorkloadTrace, RejectsNegativeRingValuesAndBackwardTimeWhenValidating) 
     }
     auto neg = readText(joinLines(l));
     ASSERT_FALSE(neg.ok());
-    EXPECT_THAT(neg.error(), HasSubstr("frame 1"));
+    EXPECT_THAT(neg.error(), HasSubstr(":3:"));  // the line, not only the frame
     EXPECT_THAT(neg.error(), HasSubstr("non-negative"));
     l = lines;
     l[3] = replaced(l[3], "\"t_ms\":", "\"t_ms\":0.05,\"t_old\":");
     auto back = readText(joinLines(l));
     ASSERT_FALSE(back.ok());
-    EXPECT_THAT(back.error(), HasSubstr("frame 2"));
+    EXPECT_THAT(back.error(), HasSubstr(":4:"));
     EXPECT_THAT(back.error(), HasSubstr("time_ms"));
 }
 
-// Reported to the lead: negative ring values and time going backwards are rejected by
-// validateTrace after the whole file is read, so the message names the frame index
-// ("t.jsonl: frame 1: …") rather than the line, unlike every other malformed-trace error.
-TEST(ReadWorkloadTrace, DISABLED_NamesLineWhenRingValueIsNegativeOrTimeGoesBackwards) {
+// Negative ring values and time going backwards name the line, like every other
+// malformed-trace error (found by this suite; fixed).
+TEST(ReadWorkloadTrace, NamesLineWhenRingValueIsNegativeOrTimeGoesBackwards) {
     auto lines = validLines();
     auto l = lines;
     l[2] = replaced(l[2], "\"pix\":[", "\"pix\":[-1.0,");

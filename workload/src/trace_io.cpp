@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <istream>
+#include <limits>
 #include <ostream>
 #include <vector>
 
@@ -248,6 +249,7 @@ Expected<WorkloadTrace> readWorkloadTrace(std::istream& in, const std::string& s
     bool too_long = false;
     int64_t line_no = 0;
     bool have_header = false;
+    double last_time_ms = -std::numeric_limits<double>::infinity();
     FieldReader r;
     auto fail = [&](const std::string& what) {
         return makeError(fmt::format("{}:{}: {}", source_name, line_no, what));
@@ -266,6 +268,8 @@ Expected<WorkloadTrace> readWorkloadTrace(std::istream& in, const std::string& s
         if (!have_header) {
             if (!parseHeader(j, trace.header, r))
                 return fail(r.error);
+            if (auto st = validateHeader(trace.header); !st)
+                return fail(st.error());
             have_header = true;
             continue;
         }
@@ -274,6 +278,9 @@ Expected<WorkloadTrace> readWorkloadTrace(std::istream& in, const std::string& s
         WorkloadFrame f;
         if (!parseFrame(j, trace.header, f, r))
             return fail(r.error);
+        if (auto st = validateFrame(trace.header, f, last_time_ms); !st)
+            return fail(st.error());
+        last_time_ms = f.time_ms;
         trace.frames.push_back(std::move(f));
     }
     if (in.bad())

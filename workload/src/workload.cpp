@@ -4,15 +4,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
 namespace qvr {
 
 double sumWithinDeg(const std::vector<double>& per_ring, double ring_deg, double e_deg) {
-    if (e_deg <= 0.0 || per_ring.empty())
+    if (!(e_deg > 0.0) || per_ring.empty())  // also NaN
         return 0.0;
     const double rings = e_deg / ring_deg;
+    if (rings >= static_cast<double>(per_ring.size()))
+        return sumTotal(per_ring);
     const size_t whole = static_cast<size_t>(std::floor(rings));
     double sum = 0.0;
     const size_t n = std::min(whole, per_ring.size());
@@ -66,8 +69,7 @@ bool finiteNonNegative(const std::vector<double>& v) {
 }
 }  // namespace
 
-Status validateTrace(const WorkloadTrace& trace) {
-    const WorkloadHeader& h = trace.header;
+Status validateHeader(const WorkloadHeader& h) {
     if (!(h.ring_deg > 0.0 && h.ring_deg <= 10.0))
         return makeError(fmt::format("ring_deg {} is outside (0, 10]", h.ring_deg));
     if (h.rings < 1 || h.rings > kMaxRings)
@@ -83,36 +85,47 @@ Status validateTrace(const WorkloadTrace& trace) {
         if (i > 0 && h.scales[i] <= h.scales[i - 1])
             return makeError("scales must be strictly increasing");
     }
+    return Status::success();
+}
+
+Status validateFrame(const WorkloadHeader& h, const WorkloadFrame& f, double previous_time_ms) {
+    if (f.triangles_per_ring.size() != static_cast<size_t>(h.rings))
+        return makeError(
+            fmt::format("{} triangle rings, header says {}", f.triangles_per_ring.size(), h.rings));
+    if (f.pixels_per_ring.size() != static_cast<size_t>(h.rings))
+        return makeError(
+            fmt::format("{} pixel rings, header says {}", f.pixels_per_ring.size(), h.rings));
+    if (f.bits_per_pixel.size() != h.scales.size())
+        return makeError(fmt::format("{} bits-per-pixel values, header has {} scales",
+                                     f.bits_per_pixel.size(), h.scales.size()));
+    if (!finiteNonNegative(f.triangles_per_ring))
+        return makeError("'tri' values must be finite and non-negative");
+    if (!finiteNonNegative(f.pixels_per_ring))
+        return makeError("'pix' values must be finite and non-negative");
+    if (!finiteNonNegative(f.bits_per_pixel))
+        return makeError("'bpp' values must be finite and non-negative");
+    if (!std::isfinite(f.time_ms) || f.time_ms < previous_time_ms)
+        return makeError("'t_ms' (time_ms) must be finite and non-decreasing");
+    if (!std::isfinite(f.gaze.x_deg) || !std::isfinite(f.gaze.y_deg) ||
+        std::fabs(f.gaze.x_deg) > 80.0 || std::fabs(f.gaze.y_deg) > 80.0)
+        return makeError("gaze must be finite and within ±80°");
+    const StaticSplit& s = f.static_split;
+    if (!finiteNonNegative({s.fg_triangles, s.bg_bytes, s.depth_bytes}) ||
+        !(s.fg_screen_fraction >= 0.0 && s.fg_screen_fraction <= 1.0))
+        return makeError("static split values must be finite, non-negative, fraction in [0, 1]");
+    return Status::success();
+}
+
+Status validateTrace(const WorkloadTrace& trace) {
+    if (auto st = validateHeader(trace.header); !st)
+        return st;
     if (trace.frames.size() > static_cast<size_t>(kMaxTraceFrames))
         return makeError(fmt::format("more than {} frames", kMaxTraceFrames));
-    double last_time = -1e300;
+    double last_time = -std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < trace.frames.size(); ++i) {
-        const WorkloadFrame& f = trace.frames[i];
-        auto bad = [&](const std::string& what) {
-            return makeError(fmt::format("frame {}: {}", i, what));
-        };
-        if (f.triangles_per_ring.size() != static_cast<size_t>(h.rings))
-            return bad(fmt::format("{} triangle rings, header says {}", f.triangles_per_ring.size(),
-                                   h.rings));
-        if (f.pixels_per_ring.size() != static_cast<size_t>(h.rings))
-            return bad(
-                fmt::format("{} pixel rings, header says {}", f.pixels_per_ring.size(), h.rings));
-        if (f.bits_per_pixel.size() != h.scales.size())
-            return bad(fmt::format("{} bits-per-pixel values, header has {} scales",
-                                   f.bits_per_pixel.size(), h.scales.size()));
-        if (!finiteNonNegative(f.triangles_per_ring) || !finiteNonNegative(f.pixels_per_ring) ||
-            !finiteNonNegative(f.bits_per_pixel))
-            return bad("ring and bits-per-pixel values must be finite and non-negative");
-        if (!std::isfinite(f.time_ms) || f.time_ms < last_time)
-            return bad("time_ms must be finite and non-decreasing");
-        last_time = f.time_ms;
-        if (!std::isfinite(f.gaze.x_deg) || !std::isfinite(f.gaze.y_deg) ||
-            std::fabs(f.gaze.x_deg) > 80.0 || std::fabs(f.gaze.y_deg) > 80.0)
-            return bad("gaze must be finite and within ±80°");
-        const StaticSplit& s = f.static_split;
-        if (!finiteNonNegative({s.fg_triangles, s.bg_bytes, s.depth_bytes}) ||
-            !(s.fg_screen_fraction >= 0.0 && s.fg_screen_fraction <= 1.0))
-            return bad("static split values must be finite, non-negative, fraction in [0, 1]");
+        if (auto st = validateFrame(trace.header, trace.frames[i], last_time); !st)
+            return makeError(fmt::format("frame {}: {}", i, st.error()));
+        last_time = trace.frames[i].time_ms;
     }
     return Status::success();
 }

@@ -65,6 +65,8 @@ public:
     PixelRect roundOut(const RealRect& r) const;
 
 private:
+    double computeCoverDeg(const Gaze& gaze) const;
+
     int m_width;
     int m_height;
     double m_fx;

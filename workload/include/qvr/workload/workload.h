@@ -79,5 +79,10 @@ PeripheryBytes peripheryBytes(const WorkloadHeader& header, const WorkloadFrame&
 // Checks the invariants the reader enforces (sizes, finiteness, signs, monotonic time); used
 // by the generator and the recorder before they write.
 Status validateTrace(const WorkloadTrace& trace);
+Status validateHeader(const WorkloadHeader& header);
+// One frame against its header; previous_time_ms is the previous frame's time (−∞ for the
+// first). The reader calls this per line so that errors name the line.
+Status validateFrame(const WorkloadHeader& header, const WorkloadFrame& frame,
+                     double previous_time_ms);
 
 }  // namespace qvr
