@@ -7,6 +7,9 @@ cd "$(dirname "$0")/.."
 source scripts/deps.sh
 qvr_install_deps
 preset=${QVR_PRESET:-dev}
+# Mesa's llvmpipe is installed by deps.sh, so a GL test that cannot get a context is a failure
+# here, not a skip.
+export QVR_REQUIRE_GL=${QVR_REQUIRE_GL:-1}
 cmake --preset "$preset"
 cmake --build --preset "$preset" -j "$(nproc)"
 if [ "${QVR_SOAK:-0}" = 1 ]; then
