@@ -21,6 +21,8 @@
 #include "commands.h"
 #include "qvr/codec/frame_header.h"
 #include "qvr/codec/video_codec.h"
+#include "qvr/compose/warp.h"
+#include "qvr/foveation/eye_geometry.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/headset_client.h"
@@ -51,6 +53,7 @@ struct RunOptions {
     uint64_t seed = 1;
     double remote_timeout_ms = 250.0;
     bool video = true;
+    bool fovea_border = true;
     int video_max_frames = 900;
     std::string command_line;
 };
@@ -59,8 +62,9 @@ struct RunOptions {
 // encoded after the run so the video costs the measured run nothing.
 class ScanoutRecorder final : public DisplaySink {
 public:
-    explicit ScanoutRecorder(int max_frames) : m_max_frames(max_frames) {}
-    void onScanout(const FrameTelemetry&, const LayerPlan&,
+    ScanoutRecorder(const HmdProfile& profile, int max_frames, bool fovea_border)
+        : m_profile(profile), m_max_frames(max_frames), m_fovea_border(fovea_border) {}
+    void onScanout(const FrameTelemetry&, const LayerPlan& plan,
                    const std::array<ImageRgba8, 2>& eyes) override {
         if (static_cast<int>(m_frames.size()) >= m_max_frames || eyes[0].empty())
             return;
@@ -76,6 +80,29 @@ public:
                         img.at(e * w + x, y, c) = static_cast<uint8_t>((sum + 2) / 4);
                     }
         m_frames.push_back(std::move(img));
+        const bool has_fovea = !plan.eyes[0].fovea.empty() && plan.e1_deg < plan.cover_deg;
+        m_foveae.push_back({plan.gaze, has_fovea ? plan.e1_deg : -1.0});
+    }
+    // The e1 circle of the shown frame, through the lens map (display pose = render pose, so
+    // it ignores the few tenths of a degree of timewarp): where the fovea layer ends.
+    void drawFoveaBorder(ImageRgba8& img, const Gaze& gaze, double e1_deg) const {
+        const EyeWarp warp(m_profile, glm::quat(1, 0, 0, 0), glm::quat(1, 0, 0, 0));
+        const EyeGeometry geometry(m_profile);
+        const double band_deg = 1.5 * m_profile.pixelAngleDeg();
+        const int w = img.width() / 2;
+        for (int y = 0; y < img.height(); ++y)
+            for (int x = 0; x < w; ++x) {
+                const WarpSample s = warp.map(2.0 * x + 1.0, 2.0 * y + 1.0);
+                if (!s.inside)
+                    continue;
+                if (std::fabs(geometry.eccentricityDeg(gaze, s.px, s.py) - e1_deg) > band_deg)
+                    continue;
+                for (int e = 0; e < 2; ++e) {
+                    img.at(e * w + x, y, 0) = 255;
+                    img.at(e * w + x, y, 1) = 220;
+                    img.at(e * w + x, y, 2) = 0;
+                }
+            }
     }
     // An H.264 Annex B elementary stream (plays in ffplay/mpv/VLC).
     Status writeH264(const std::string& path) const {
@@ -88,7 +115,10 @@ public:
         std::ofstream out(path, std::ios::binary);
         if (!out)
             return makeError("cannot write " + path);
-        for (const ImageRgba8& f : m_frames) {
+        for (size_t i = 0; i < m_frames.size(); ++i) {
+            ImageRgba8 f = m_frames[i];
+            if (m_fovea_border && m_foveae[i].e1_deg > 0)
+                drawFoveaBorder(f, m_foveae[i].gaze, m_foveae[i].e1_deg);
             auto e = (*enc)->encode(f);
             if (!e)
                 return makeError("video: " + e.error());
@@ -103,8 +133,15 @@ public:
     size_t frames() const { return m_frames.size(); }
 
 private:
+    struct Fovea {
+        Gaze gaze;
+        double e1_deg = -1.0;
+    };
+    HmdProfile m_profile;
     int m_max_frames;
+    bool m_fovea_border;
     std::vector<ImageRgba8> m_frames;
+    std::vector<Fovea> m_foveae;
 };
 
 std::string shellQuote(const std::string& s) {
@@ -252,7 +289,7 @@ int runRun(const RunOptions& o) {
         HeadsetResult result;
     };
     std::vector<DesignRun> runs;
-    ScanoutRecorder recorder(o.video_max_frames);
+    ScanoutRecorder recorder(*profile, o.video_max_frames, o.fovea_border);
     const fs::path workload_path = out / "workload.jsonl";
     bool recorded_workload = false;
     std::ofstream all_csv(out / "telemetry.csv");
@@ -420,8 +457,8 @@ int runRun(const RunOptions& o) {
         if (auto st = recorder.writeH264(video.string()); st)
             video_note = fmt::format(
                 "qvr_display.h264: {} frames, both eyes side by side at half "
-                "resolution, H.264 Annex B at 90 fps (ffplay -f h264)",
-                recorder.frames());
+                "resolution{}, H.264 Annex B at 90 fps (ffplay -f h264)",
+                recorder.frames(), o.fovea_border ? ", fovea edge (e1) drawn in yellow" : "");
         else
             video_note = "video failed: " + st.error();
     }
@@ -549,6 +586,8 @@ static Registered registerRun(CLI::App& app) {
         ->check(CLI::Range(1.0, 10000.0))
         ->capture_default_str();
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
+    cmd->add_flag("!--no-fovea-border", o->fovea_border,
+                  "Do not draw the e1 circle (the fovea layer's edge) in the video");
     return {cmd, [o] {
                 o->command_line = fmt::format(
                     "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "

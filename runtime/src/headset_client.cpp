@@ -174,6 +174,11 @@ private:
             m_pending.clear();
         } else {
             ++m_stats.connect_failures;
+            // A server that cannot prove the key will not learn it in 250 ms: back off.
+            const uint64_t proof_failures = m_client->stats().server_proof_failures;
+            if (proof_failures > m_proof_failures_seen)
+                m_last_connect_try_ns = now_ns + int64_t(kKeyMismatchBackoffMs) * 1'000'000;
+            m_proof_failures_seen = proof_failures;
         }
     }
 
@@ -502,6 +507,7 @@ private:
     }
 
     static constexpr size_t kMaxPendingFrames = 8;
+    static constexpr int kKeyMismatchBackoffMs = 2000;
 
     const HeadsetConfig& m_config;
     PacingClock& m_clock;
@@ -523,6 +529,7 @@ private:
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
     double m_last_e1_deg = 5.0;
+    uint64_t m_proof_failures_seen = 0;
     bool m_was_connected = false;
 };
 
