@@ -713,11 +713,9 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         ".bad{{text-decoration:underline;color:#b00}}.no{{color:#b00}}.yes{{color:#070}}"
         "</style></head><body><h1>Q-VR simulator evaluation</h1><p>Command: <code>{}</code>"
         "<br>Frames per run: {} (Q-VR at the default point: {}, of which Fig. 14 plots the "
-        "first 300); runs: {}; {}.<br>Workloads are the seeded "
-        "<b>synthetic</b> stand-ins for Table 3's games, not the games. Models and constants: "
-        "docs/MODEL.md.</p>",
+        "first 300); runs: {}; {}.<br>{} Models and constants: docs/MODEL.md.</p>",
         htmlEscape(options.command_line), options.frames, frames, output.runs.size(),
-        output.plot_note);
+        output.plot_note, suiteDescription());
     html +=
         "<h2>Headline figures: paper vs. this simulator</h2><table><tr><th>metric</th>"
         "<th>paper</th><th>ours</th></tr>";
