@@ -6,10 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <numeric>
 
 #include <fmt/format.h>
 
@@ -30,8 +29,10 @@ constexpr double kPi = 3.14159265358979323846;
 bool endsWithNoCase(const std::string& s, const std::string& suffix) {
     if (s.size() < suffix.size())
         return false;
-    return std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(),
-                      [](char a, char b) { return std::tolower(a) == std::tolower(b); });
+    return std::equal(suffix.rbegin(), suffix.rend(), s.rbegin(), [](char a, char b) {
+        return std::tolower(static_cast<unsigned char>(a)) ==
+               std::tolower(static_cast<unsigned char>(b));
+    });
 }
 
 // Numbers are rounded before writing so a 300-frame trace stays a few hundred kilobytes: the
