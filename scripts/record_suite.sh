@@ -8,7 +8,7 @@
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")/.." && pwd)"
-frames=150
+frames=300
 out="$here/data/workloads"
 qvr="$here/build/record/apps/qvr/qvr"
 jobs=1
