@@ -28,8 +28,8 @@ struct Aabb {
 struct SceneVertex {
     glm::vec3 position{0.0f};  // metres
     glm::vec3 normal{0.0f, 1.0f, 0.0f};
-    glm::vec2 uv{0.0f};          // texture coordinates
-    glm::vec2 lightmap_uv{0.0f}; // lightmap coordinates (0 when the batch has no lightmap)
+    glm::vec2 uv{0.0f};           // texture coordinates
+    glm::vec2 lightmap_uv{0.0f};  // lightmap coordinates (0 when the batch has no lightmap)
     glm::u8vec4 color{255, 255, 255, 255};
 };
 
