@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_parse.h"
 #include "commands.h"
 #include "qvr/foveation/layer_plan.h"
 
@@ -19,17 +20,6 @@ struct PlanOptions {
     std::string profile = "default";
     bool json = false;
 };
-
-bool parseGaze(const std::string& text, Gaze& gaze) {
-    double x = 0, y = 0;
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%lf,%lf%c", &x, &y, &tail) != 2)
-        return false;
-    if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(x) > 80 || std::fabs(y) > 80)
-        return false;
-    gaze = {x, y};
-    return true;
-}
 
 nlohmann::json rectJson(const LayerRect& l) {
     return {{"x0", l.rect.x0},          {"y0", l.rect.y0},     {"x1", l.rect.x1},
@@ -83,7 +73,7 @@ static Registered registerPlan(CLI::App& app) {
     cmd->add_flag("--json", opts->json, "Print machine-readable JSON");
     Action action = [opts]() -> int {
         Gaze gaze;
-        if (!parseGaze(opts->gaze, gaze)) {
+        if (!parseGazeDeg(opts->gaze, gaze)) {
             std::fprintf(stderr, "qvr plan: --gaze must be X,Y in degrees within ±80, got '%s'\n",
                          opts->gaze.c_str());
             return 2;

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_parse.h"
 #include "commands.h"
 #include "qvr/compose/png_io.h"
 #include "qvr/foveation/layer_plan.h"
@@ -47,17 +48,6 @@ bool parsePose(const std::string& text, Pose& pose) {
     pose.orientation = quatFromEulerDeg({v[0], v[1], v[2]});
     pose.position_m = {static_cast<float>(v[3]), static_cast<float>(v[4]),
                        static_cast<float>(v[5])};
-    return true;
-}
-
-bool parseGazeDeg(const std::string& text, Gaze& gaze) {
-    double x = 0, y = 0;
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%lf,%lf%c", &x, &y, &tail) != 2)
-        return false;
-    if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(x) > 80 || std::fabs(y) > 80)
-        return false;
-    gaze = {x, y};
     return true;
 }
 

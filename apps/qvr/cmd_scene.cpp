@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_parse.h"
 #include "commands.h"
 #include "qvr/core/pose.h"
 #include "qvr/foveation/eye_geometry.h"
@@ -142,20 +143,9 @@ int runInfo(const SceneOptions& o) {
     return 0;
 }
 
-bool parseGaze(const std::string& text, Gaze& gaze) {
-    double x = 0, y = 0;
-    char tail = 0;
-    if (std::sscanf(text.c_str(), "%lf,%lf%c", &x, &y, &tail) != 2)
-        return false;
-    if (!std::isfinite(x) || !std::isfinite(y) || std::fabs(x) > 80 || std::fabs(y) > 80)
-        return false;
-    gaze = {x, y};
-    return true;
-}
-
 int runCount(const SceneOptions& o) {
     Gaze gaze;
-    if (!parseGaze(o.gaze, gaze)) {
+    if (!parseGazeDeg(o.gaze, gaze)) {
         std::fprintf(stderr,
                      "qvr scene count: --gaze must be X,Y in degrees within ±80, got '%s'\n",
                      o.gaze.c_str());
