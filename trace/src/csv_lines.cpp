@@ -3,6 +3,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <fstream>
 
 #include <fmt/format.h>
 
@@ -68,6 +69,16 @@ Status csvRows(std::string_view text, std::string_view source, std::string_view 
     }
     if (line == 0)
         return makeError(fmt::format("{}: empty file (expected header '{}')", source, header));
+    return Status::success();
+}
+
+Status writeCsvFile(const std::string& text, const std::string& path) {
+    std::ofstream f(path, std::ios::binary);
+    if (!f)
+        return makeError(fmt::format("cannot write '{}'", path));
+    f.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!f)
+        return makeError(fmt::format("error writing '{}'", path));
     return Status::success();
 }
 

@@ -17,4 +17,7 @@ Status csvRows(std::string_view text, std::string_view source, std::string_view 
                size_t columns, size_t max_rows, std::vector<std::vector<double>>& rows,
                std::vector<int>& lines);
 
+// Writes a whole trace's text to path, with errors that name the file.
+Status writeCsvFile(const std::string& text, const std::string& path);
+
 }  // namespace qvr::detail

@@ -25,14 +25,7 @@ std::string gazeTraceToCsv(const GazeTrace& trace) {
 }
 
 Status writeGazeCsv(const GazeTrace& trace, const std::string& path) {
-    std::ofstream f(path, std::ios::binary);
-    if (!f)
-        return makeError(fmt::format("cannot write '{}'", path));
-    const std::string text = gazeTraceToCsv(trace);
-    f.write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!f)
-        return makeError(fmt::format("error writing '{}'", path));
-    return Status::success();
+    return detail::writeCsvFile(gazeTraceToCsv(trace), path);
 }
 
 Expected<GazeTrace> parseGazeCsv(std::string_view text, std::string_view source) {

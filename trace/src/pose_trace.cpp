@@ -125,14 +125,7 @@ std::string poseTraceToCsv(const PoseTrace& trace) {
 }
 
 Status writePoseCsv(const PoseTrace& trace, const std::string& path) {
-    std::ofstream f(path, std::ios::binary);
-    if (!f)
-        return makeError(fmt::format("cannot write '{}'", path));
-    const std::string text = poseTraceToCsv(trace);
-    f.write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!f)
-        return makeError(fmt::format("error writing '{}'", path));
-    return Status::success();
+    return detail::writeCsvFile(poseTraceToCsv(trace), path);
 }
 
 Expected<PoseTrace> parsePoseCsv(std::string_view text, std::string_view source) {
