@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -27,6 +29,7 @@
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/render_server.h"
+#include "qvr/runtime/server_process.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
 #include "qvr/sim/network.h"
@@ -55,6 +58,8 @@ struct RunOptions {
     bool video = true;
     bool fovea_border = true;
     int video_max_frames = 900;
+    bool one_pass_periphery = true;
+    int pipeline_depth = 2;
     std::string command_line;
 };
 
@@ -267,13 +272,48 @@ int runRun(const RunOptions& o) {
     const int client_core = 0;
     const int server_core = cores > 1 ? cores - 1 : -1;
     const net::PresharedKey key = net::PresharedKey::random();
-    RenderServerConfig sc;
-    sc.net.key = key;
-    sc.net.link = *link;
-    sc.profile = *profile;
-    sc.codec.backend = o.codec;
-    sc.core = server_core;
-    auto server = RenderServer::start(sc, scene);
+    // The server is `qvr server` in a child process (server_process.h says why). Its key goes
+    // through a file only it and we can read, removed once it is listening.
+    auto exe = selfExecutable();
+    if (!exe) {
+        std::fprintf(stderr, "qvr run: %s\n", exe.error().c_str());
+        return 1;
+    }
+    char key_path[] = "/tmp/qvr-run-key-XXXXXX";
+    const int key_fd = mkstemp(key_path);
+    if (key_fd < 0) {
+        std::fprintf(stderr, "qvr run: cannot create a key file in /tmp\n");
+        return 1;
+    }
+    const std::string key_hex = key.toHex() + "\n";
+    const bool key_written =
+        write(key_fd, key_hex.data(), key_hex.size()) == static_cast<ssize_t>(key_hex.size());
+    close(key_fd);
+    const fs::path server_stats_path = out / "server_stats.json";
+    std::vector<std::string> server_args = {"server",
+                                            "--bind",
+                                            "127.0.0.1",
+                                            "--port",
+                                            "0",
+                                            "--key-file",
+                                            key_path,
+                                            "--scene",
+                                            o.scene,
+                                            "--profile",
+                                            o.profile,
+                                            "--net",
+                                            o.net,
+                                            "--codec",
+                                            o.codec,
+                                            "--core",
+                                            std::to_string(server_core),
+                                            "--stats-json",
+                                            server_stats_path.string()};
+    if (!o.one_pass_periphery)
+        server_args.push_back("--two-pass-periphery");
+    auto server = key_written ? ServerProcess::start(*exe, server_args)
+                              : Expected<ServerProcess>(makeError("cannot write the key file"));
+    unlink(key_path);
     if (!server) {
         std::fprintf(stderr, "qvr run: %s\n", server.error().c_str());
         return 1;
@@ -282,7 +322,7 @@ int runRun(const RunOptions& o) {
                scene->name, scene->triangleCount(), profile->width_px, profile->height_px,
                profile->refresh_hz, o.net, o.frames);
     fmt::print("  server on 127.0.0.1:{} pinned to core {}, headset pinned to core {} ({} cores)\n",
-               (*server)->port(), server_core, client_core, cores);
+               server->port(), server_core, client_core, cores);
 
     struct DesignRun {
         RuntimeDesign design;
@@ -299,11 +339,12 @@ int runRun(const RunOptions& o) {
         hc.design = d;
         hc.profile = *profile;
         hc.codec.backend = o.codec;
-        hc.port = (*server)->port();
+        hc.port = server->port();
         hc.key = key;
         hc.frames = o.frames;
         hc.core = client_core;
         hc.remote_timeout_ms = o.remote_timeout_ms;
+        hc.pipeline_depth = o.pipeline_depth;
         std::ofstream workload_out;
         std::unique_ptr<WorkloadTraceWriter> writer;
         if (d == RuntimeDesign::kQvr) {
@@ -341,8 +382,15 @@ int runRun(const RunOptions& o) {
         // Let the server finish the last session before the next one starts.
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
-    const RenderServerStats server_stats = (*server)->stats();
-    (*server)->stop();
+    const int server_status = server->stop();
+    nlohmann::json server_stats = nlohmann::json::object();
+    if (std::ifstream f(server_stats_path); f) {
+        server_stats = nlohmann::json::parse(f, nullptr, false);
+        if (server_stats.is_discarded())
+            server_stats = nlohmann::json::object();
+    }
+    if (server_status != 0)
+        std::fprintf(stderr, "qvr run: the server exited with status %d\n", server_status);
     const double run_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
@@ -395,8 +443,10 @@ int runRun(const RunOptions& o) {
                     {"server_core", server_core},
                     {"cores", cores},
                     {"how",
-                     "pthread_setaffinity_np on the headset thread and the server's render "
-                     "thread; threads they create (llvmpipe, x264) inherit the mask"}};
+                     "two processes: the server (qvr server --core N) pins its main thread before "
+                     "it creates any other, so all its threads (render, llvmpipe, x264, asio) run "
+                     "on its core; the headset thread of this process is pinned to the other core "
+                     "and its threads (llvmpipe, x264, asio) inherit the mask"}};
     j["run_seconds"] = run_s;
     nlohmann::json dj = nlohmann::json::object();
     const DesignSummary* local = nullptr;
@@ -433,21 +483,16 @@ int runRun(const RunOptions& o) {
     j["sim_prediction"] = sim_json;
     if (!sim_note.empty())
         j["sim_note"] = sim_note;
-    j["server"] = {{"frames_rendered", server_stats.frames_rendered},
-                   {"requests", server_stats.requests},
-                   {"requests_dropped", server_stats.requests_dropped},
-                   {"streams_sent", server_stats.streams_sent},
-                   {"stream_send_failures", server_stats.stream_send_failures},
-                   {"render_ms_per_layer",
-                    server_stats.layers_rendered
-                        ? server_stats.render_ms_total / double(server_stats.layers_rendered)
-                        : 0.0},
-                   {"encode_ms_per_layer",
-                    server_stats.layers_rendered
-                        ? server_stats.encode_ms_total / double(server_stats.layers_rendered)
-                        : 0.0},
-                   {"auth_failures", server_stats.net.auth_failures},
-                   {"control_drops", server_stats.net.control_drops.total()}};
+    // The server's own counters (all designs together), as its process wrote them on exit.
+    j["server"] = server_stats;
+    j["server"]["exit_status"] = server_status;
+    const double layers = server_stats.value("layers_rendered", 0.0);
+    const double frames_rendered = server_stats.value("frames_rendered", 0.0);
+    if (layers > 0)
+        j["server"]["encode_ms_per_layer"] = server_stats.value("encode_ms_total", 0.0) / layers;
+    if (frames_rendered > 0)
+        j["server"]["render_ms_per_frame"] =
+            server_stats.value("render_ms_total", 0.0) / frames_rendered;
     std::ofstream(out / "summary.json") << j.dump(2) << "\n";
 
     // Video of what the headset displayed for qvr.
@@ -584,6 +629,13 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_option("--remote-timeout-ms", o->remote_timeout_ms,
                     "Remote layers later than this after the local render are late (frame reuse)")
         ->check(CLI::Range(1.0, 10000.0))
+        ->capture_default_str();
+    cmd->add_flag("!--two-pass-periphery", o->one_pass_periphery,
+                  "Server renders middle and outer as two sub-frusta, not one pass per eye");
+    cmd->add_option("--pipeline", o->pipeline_depth,
+                    "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
+                    "finishing n)")
+        ->check(CLI::Range(1, 2))
         ->capture_default_str();
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
     cmd->add_flag("!--no-fovea-border", o->fovea_border,

@@ -4,14 +4,17 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "qvr/net/link_emulator.h"
+#include "qvr/runtime/affinity.h"
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
@@ -39,9 +42,17 @@ struct ServerCmdOptions {
     std::string codec = "x264";
     int core = -1;
     double duration_s = 0.0;
+    std::string stats_json;
+    bool one_pass_periphery = true;
 };
 
 int runServer(const ServerCmdOptions& o) {
+    // Pin the whole process: threads made from here on (asio, the render thread, llvmpipe's
+    // rasterizers, x264) inherit the mask.
+    if (o.core >= 0) {
+        if (auto st = pinCurrentThread(o.core); !st)
+            std::fprintf(stderr, "qvr server: %s (running unpinned)\n", st.error().c_str());
+    }
     auto key = keyFromOptions(o.key, o.key_file);
     if (!key) {
         std::fprintf(stderr, "qvr server: %s\n", key.error().c_str());
@@ -70,6 +81,7 @@ int runServer(const ServerCmdOptions& o) {
     cfg.profile = *profile;
     cfg.codec.backend = o.codec;
     cfg.core = o.core;
+    cfg.one_pass_periphery = o.one_pass_periphery;
     auto server = RenderServer::start(cfg, std::make_shared<const Scene>(std::move(*scene)));
     if (!server) {
         std::fprintf(stderr, "qvr server: %s\n", server.error().c_str());
@@ -90,6 +102,28 @@ int runServer(const ServerCmdOptions& o) {
     }
     const RenderServerStats s = (*server)->stats();
     (*server)->stop();
+    if (!o.stats_json.empty()) {
+        const nlohmann::json j = {{"requests", s.requests},
+                                  {"requests_dropped", s.requests_dropped},
+                                  {"requests_invalid", s.requests_invalid},
+                                  {"frames_rendered", s.frames_rendered},
+                                  {"layers_rendered", s.layers_rendered},
+                                  {"periphery_passes", s.periphery_passes},
+                                  {"streams_sent", s.streams_sent},
+                                  {"stream_send_failures", s.stream_send_failures},
+                                  {"render_failures", s.render_failures},
+                                  {"encode_failures", s.encode_failures},
+                                  {"key_frame_requests", s.key_frame_requests},
+                                  {"render_ms_total", s.render_ms_total},
+                                  {"encode_ms_total", s.encode_ms_total},
+                                  {"auth_failures", s.net.auth_failures},
+                                  {"control_drops", s.net.control_drops.total()},
+                                  {"core", o.core}};
+        std::ofstream f(o.stats_json);
+        f << j.dump(2) << "\n";
+        if (!f)
+            std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
+    }
     fmt::print(
         "qvr server: {} requests ({} dropped, {} invalid), {} frames, {} streams sent, {} auth "
         "failures, {} malformed control messages\n",
@@ -116,6 +150,9 @@ static Registered registerServer(CLI::App& app) {
     cmd->add_option("--codec", o->codec, "x264 or raw")->capture_default_str();
     cmd->add_option("--core", o->core, "Pin the render thread to this core (-1: no)")
         ->capture_default_str();
+    cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit");
+    cmd->add_flag("!--two-pass-periphery", o->one_pass_periphery,
+                  "Render middle and outer as two sub-frusta instead of one pass per eye");
     cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")
         ->capture_default_str();
     return {cmd, [o] { return runServer(*o); }};

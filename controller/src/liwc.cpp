@@ -108,9 +108,7 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
         m_first_decision = false;
         m_e1_deg = std::clamp(m_config.e1_initial_deg, lo, std::max(lo, hi));
         Decision d{m_e1_deg, localMs(m_e1_deg), remoteMs(frame.gaze, m_e1_deg)};
-        m_pending_model_imbalance_ms = d.t_remote_pred_ms - d.t_local_pred_ms;
-        m_pending_bucket = LiwcTable::bucketOf(m_e1_deg);
-        m_pending = true;
+        remember(d);
         return d;
     }
     // One candidate per delta tag; the table's offset is indexed by the candidate's
@@ -150,21 +148,31 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
     d.e1_deg = chosen;
     d.t_local_pred_ms = localMs(chosen);
     d.t_remote_pred_ms = remoteMs(frame.gaze, chosen);
-    m_pending_model_imbalance_ms = d.t_remote_pred_ms - d.t_local_pred_ms;
-    m_pending_bucket = LiwcTable::bucketOf(chosen);
-    m_pending = true;
+    remember(d);
     return d;
+}
+
+void LiwcPolicy::remember(const Decision& d) {
+    m_pending.push_back(PendingDecision{m_motion, LiwcTable::bucketOf(d.e1_deg),
+                                        d.t_remote_pred_ms - d.t_local_pred_ms});
+    // A caller that decides without ever observing must not grow this without bound.
+    while (m_pending.size() > kMaxPendingDecisions)
+        m_pending.pop_front();
 }
 
 void LiwcPolicy::observe(const FrameMeasurement& m) {
     // The table learns what the model mispredicted for this motion and eccentricity: the
     // measured imbalance against the one Eq. 2 predicted with the pre-frame estimates. During
     // warm-up the estimates are still far off and their error is not the motion's.
-    if (m_pending && m_observed >= m_config.table_warmup_frames) {
-        const double delta = (m.t_remote_ms - m.t_local_ms) - m_pending_model_imbalance_ms;
-        m_table.fold(m_motion, m_pending_bucket, static_cast<float>(delta), m_config.alpha);
+    // Observations arrive in frame order, so this one belongs to the oldest open decision.
+    if (!m_pending.empty()) {
+        const PendingDecision p = m_pending.front();
+        m_pending.pop_front();
+        if (m_observed >= m_config.table_warmup_frames) {
+            const double delta = (m.t_remote_ms - m.t_local_ms) - p.model_imbalance_ms;
+            m_table.fold(p.motion, p.bucket, static_cast<float>(delta), m_config.alpha);
+        }
     }
-    m_pending = false;
     ++m_observed;
     const double b = m_config.rate_ema;
     if (m.t_local_ms > 0.0)
@@ -188,7 +196,10 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
         m_log_bits_at_1 = (1.0 - b) * m_log_bits_at_1 + b * log_b1;
     }
-    m_e1_deg = m.e1_deg;
+    // The next candidates step from the newest decision; the measured e1 replaces it only when
+    // no later decision is already out (a pipelined headset has one in flight).
+    if (m_pending.empty())
+        m_e1_deg = m.e1_deg;
 }
 
 void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {

@@ -51,6 +51,11 @@ struct PendingFrame {
     uint8_t decoded = 0;
     uint8_t failed = 0;
     int64_t request_ns = 0;
+    // When the server could start on this frame: its request, or the moment the previous frame's
+    // last stream arrived if that was later (the server renders one frame at a time, so with
+    // frames in flight a request waits in its queue). T_remote is measured from here.
+    int64_t service_start_ns = 0;
+    int64_t last_rx_ns = 0;  // the newest packet of any of its streams
     std::array<double, net::kMaxStreams> bytes{};
     bool complete() const { return expected != 0 && (decoded & expected) == expected; }
     bool broken() const { return (failed & expected) != 0; }
@@ -138,10 +143,19 @@ public:
         m_pacer.reset();
         if (m_client)
             tryConnect(true);
+        // Frames are prepared (pose, decision, request) up to pipeline_depth ahead of the one
+        // being finished (fovea, wait, UCA, scan-out).
+        // Without a server there is nothing to overlap: one core renders and composes in turn.
+        const size_t depth = usesServer(m_config.design)
+                                 ? static_cast<size_t>(std::clamp(m_config.pipeline_depth, 1, 4))
+                                 : 1;
+        std::deque<Prepared> ahead;
+        int64_t next = 0;
         for (int64_t i = 0; i < m_config.frames; ++i) {
-            if (m_config.before_frame)
-                m_config.before_frame(i);
-            runFrame(i, result);
+            while (ahead.size() < depth && next < m_config.frames)
+                ahead.push_back(prepare(next++, result));
+            finish(ahead.front(), result);
+            ahead.pop_front();
         }
         // Streams still in flight belong to frames already shown: drain them so the server's
         // acks complete, then leave.
@@ -208,6 +222,7 @@ private:
         if (p) {
             FrameTelemetry& t = result.frames[p->telemetry];
             t.stream_rx_ns[cs.stream_id] = rel(cs.last_rx_ns);
+            p->last_rx_ns = std::max(p->last_rx_ns, cs.last_rx_ns);
             t.bytes += static_cast<int64_t>(cs.bytes.size());
             p->bytes[cs.stream_id] += static_cast<double>(cs.bytes.size());
         }
@@ -248,8 +263,13 @@ private:
         p->decoded |= static_cast<uint8_t>(1u << cs.stream_id);
         FrameTelemetry& t = result.frames[p->telemetry];
         t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
-        if (p->complete())
+        if (p->complete()) {
             t.remote_done_ns = rel(m_clock.nowNs());
+            m_last_complete_rx_ns = std::max(m_last_complete_rx_ns, p->last_rx_ns);
+            for (PendingFrame& later : m_pending)
+                if (later.frame > p->frame)
+                    later.service_start_ns = std::max(later.service_start_ns, p->last_rx_ns);
+        }
     }
 
     // Takes what the transport has, waiting up to wait_ms for the first stream.
@@ -281,7 +301,25 @@ private:
         }
     }
 
-    void runFrame(int64_t i, HeadsetResult& result) {
+    // A frame between its request and its scan-out.
+    struct Prepared {
+        int64_t frame = 0;
+        size_t telemetry = 0;
+        int64_t pose_ns = 0;
+        double content_ms = 0.0;
+        Pose head;
+        Gaze gaze;
+        LayerPlan plan;
+        std::optional<WorkloadFrame> wf;
+        bool decided = false;
+        uint8_t expected = 0;
+        std::shared_ptr<LayerFrame> layers;
+    };
+
+    // Steps 1–3: pose sample, decision, request.
+    Prepared prepare(int64_t i, HeadsetResult& result) {
+        if (m_config.before_frame)
+            m_config.before_frame(i);
         result.frames.emplace_back();
         const size_t ti = result.frames.size() - 1;
         FrameTelemetry& t0 = result.frames[ti];
@@ -376,6 +414,7 @@ private:
                 p.layers = layers;
                 p.expected = expected;
                 p.request_ns = m_clock.nowNs();
+                p.service_start_ns = std::max(p.request_ns, m_last_complete_rx_ns);
                 t->request_ns = rel(p.request_ns);
                 t->remote_requested = true;
                 m_pending.push_back(p);
@@ -383,6 +422,35 @@ private:
                     m_pending.pop_front();
             }
         }
+
+        Prepared prep;
+        prep.frame = i;
+        prep.telemetry = ti;
+        prep.pose_ns = pose_ns;
+        prep.content_ms = content_ms;
+        prep.head = head;
+        prep.gaze = gaze;
+        prep.plan = plan;
+        prep.wf = std::move(wf);
+        prep.decided = decided;
+        prep.expected = expected;
+        prep.layers = std::move(layers);
+        return prep;
+    }
+
+    // Steps 4–7: fovea, remote layers, UCA, scan-out, what the policy learns.
+    void finish(Prepared& prep, HeadsetResult& result) {
+        const int64_t i = prep.frame;
+        const size_t ti = prep.telemetry;
+        const int64_t pose_ns = prep.pose_ns;
+        const double content_ms = prep.content_ms;
+        const Pose& head = prep.head;
+        const LayerPlan& plan = prep.plan;
+        const std::optional<WorkloadFrame>& wf = prep.wf;
+        const bool decided = prep.decided;
+        const uint8_t expected = prep.expected;
+        const std::shared_ptr<LayerFrame>& layers = prep.layers;
+        FrameTelemetry* t = &result.frames[ti];
 
         // 4. The fovea (or the whole frame) locally.
         const int64_t local_start_ns = m_clock.nowNs();
@@ -420,7 +488,8 @@ private:
             t = &result.frames[ti];
             have_current = p && p->complete();
             const int64_t end_ns = have_current ? m_origin_ns + t->remote_done_ns : m_clock.nowNs();
-            t->t_remote_ms = double(end_ns - (m_origin_ns + t->request_ns)) * 1e-6;
+            const int64_t start_ns = p ? p->service_start_ns : m_origin_ns + t->request_ns;
+            t->t_remote_ms = double(end_ns - std::min(start_ns, end_ns)) * 1e-6;
             if (!have_current)
                 ++m_stats.late_frames;
         }
@@ -528,6 +597,7 @@ private:
     int64_t m_origin_ns = 0;
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
+    int64_t m_last_complete_rx_ns = 0;
     double m_last_e1_deg = 5.0;
     uint64_t m_proof_failures_seen = 0;
     bool m_was_connected = false;

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "qvr/render/gl_renderer.h"
+#include "qvr/render/periphery_pass.h"
 #include "qvr/runtime/affinity.h"
 
 namespace qvr::runtime {
@@ -152,6 +153,8 @@ struct RenderServer::Impl final : net::ServerHandler {
             return;
         Renderer& r = **renderer;
         ImageRgba8 image;
+        ImageRgba8 outer_image;
+        ImageRgba8 scratch;
         net::ClientId id = 0;
         std::shared_ptr<ClientState> state;
         net::FrameRequest req;
@@ -164,13 +167,52 @@ struct RenderServer::Impl final : net::ServerHandler {
             }
             const uint8_t key_mask = state->key_frame_mask.exchange(0);
             RenderServerStats delta;
+            auto send = [&](uint8_t sid, const ImageRgba8& layer_image) {
+                auto& enc = state->encoders[sid];
+                if (!enc) {
+                    auto made = makeVideoEncoder(config.codec);
+                    if (!made) {
+                        ++delta.encode_failures;
+                        return;
+                    }
+                    enc = std::move(*made);
+                }
+                if (key_mask & (1u << sid))
+                    enc->requestKeyframe();
+                auto encoded = enc->encode(layer_image);
+                if (!encoded) {
+                    ++delta.encode_failures;
+                    return;
+                }
+                delta.encode_ms_total += encoded->encode_ms;
+                const bool key = encoded->is_keyframe;
+                if (server->sendStream(id, req.frame_id, sid, key, std::move(encoded->bytes)))
+                    ++delta.streams_sent;
+                else
+                    ++delta.stream_send_failures;
+            };
             for (int eye = 0; eye < 2; ++eye) {
+                const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+                if (config.one_pass_periphery && onePassPays(layers)) {
+                    const auto t0 = std::chrono::steady_clock::now();
+                    auto rs = renderPeriphery(r, config.profile, plan, req.pose,
+                                              static_cast<Eye>(eye), image, outer_image, scratch);
+                    delta.render_ms_total += msSince(t0);
+                    if (!rs) {
+                        delta.render_failures += 2;
+                        continue;
+                    }
+                    delta.layers_rendered += 2;
+                    ++delta.periphery_passes;
+                    send(net::streamId(eye, net::Layer::kMiddle), image);
+                    send(net::streamId(eye, net::Layer::kOuter), outer_image);
+                    continue;
+                }
                 for (net::Layer layer : {net::Layer::kMiddle, net::Layer::kOuter}) {
                     const LayerKind kind =
                         layer == net::Layer::kMiddle ? LayerKind::kMiddle : LayerKind::kOuter;
-                    if (layerOf(plan.eyes[static_cast<size_t>(eye)], kind).empty())
+                    if (layerOf(layers, kind).empty())
                         continue;
-                    const uint8_t sid = net::streamId(eye, layer);
                     const auto t0 = std::chrono::steady_clock::now();
                     auto rs = renderLayer(r, config.profile, plan, req.pose, static_cast<Eye>(eye),
                                           kind, image);
@@ -180,33 +222,13 @@ struct RenderServer::Impl final : net::ServerHandler {
                         continue;
                     }
                     ++delta.layers_rendered;
-                    auto& enc = state->encoders[sid];
-                    if (!enc) {
-                        auto made = makeVideoEncoder(config.codec);
-                        if (!made) {
-                            ++delta.encode_failures;
-                            continue;
-                        }
-                        enc = std::move(*made);
-                    }
-                    if (key_mask & (1u << sid))
-                        enc->requestKeyframe();
-                    auto encoded = enc->encode(image);
-                    if (!encoded) {
-                        ++delta.encode_failures;
-                        continue;
-                    }
-                    delta.encode_ms_total += encoded->encode_ms;
-                    const bool key = encoded->is_keyframe;
-                    if (server->sendStream(id, req.frame_id, sid, key, std::move(encoded->bytes)))
-                        ++delta.streams_sent;
-                    else
-                        ++delta.stream_send_failures;
+                    send(net::streamId(eye, layer), image);
                 }
             }
             std::lock_guard lock(mutex);
             ++stats.frames_rendered;
             stats.layers_rendered += delta.layers_rendered;
+            stats.periphery_passes += delta.periphery_passes;
             stats.streams_sent += delta.streams_sent;
             stats.stream_send_failures += delta.stream_send_failures;
             stats.render_failures += delta.render_failures;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <deque>
 #include <memory>
 
 #include "qvr/controller/liwc_table.h"
@@ -68,6 +69,8 @@ public:
 
 private:
     void updateGpuRates(double triangles, double pixels, double t_local_ms);
+    void remember(const Decision& d);
+    static constexpr size_t kMaxPendingDecisions = 8;
     // Per-frame quantities every candidate shares: computed once in decide().
     void prepareFrame(const WorkloadFrame& frame) const;
     double localMs(double e1_deg) const;
@@ -97,9 +100,14 @@ private:
     double m_e1_deg;
     uint16_t m_motion = 0;
     std::array<LiwcCandidate, 11> m_candidates{};
-    double m_pending_model_imbalance_ms = 0.0;
-    int m_pending_bucket = 0;
-    bool m_pending = false;
+    // Decisions not yet observed, oldest first. observe() comes in frame order, but a pipelined
+    // headset decides frame n+1 before frame n completes, so more than one can be outstanding.
+    struct PendingDecision {
+        uint16_t motion = 0;
+        int bucket = 0;
+        double model_imbalance_ms = 0.0;
+    };
+    std::deque<PendingDecision> m_pending;
     int m_observed = 0;
     bool m_first_decision = true;
 };

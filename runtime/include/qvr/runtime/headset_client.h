@@ -61,6 +61,11 @@ struct HeadsetConfig {
     int connect_timeout_ms = 500;
     int reconnect_interval_ms = 250;
     double ffr_e1_deg = 5.0;
+    // Frames in flight (docs/RUNTIME.md): 1 runs each frame to its scan-out before the next
+    // frame's pose is sampled; 2 samples frame n+1 and sends its request before frame n's fovea
+    // renders, so the server renders n+1 while the headset finishes n (paper Fig. 4's overlap
+    // across frames). The policy then decides n+1 before it has observed n.
+    int pipeline_depth = 2;
     PacingClock* clock = nullptr;  // steady clock when null
     DisplaySink* display = nullptr;
     WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set

@@ -30,6 +30,9 @@ struct RenderServerConfig {
     int core = -1;  // pin the render thread to this core (-1: no pinning)
     // Requests waiting per headset; a newer request pushes the oldest out (it would be late).
     size_t max_pending_requests = 2;
+    // Render an eye's middle and outer layers in one geometry pass when that is cheaper
+    // (render/periphery_pass.h); false renders each layer's own sub-frustum.
+    bool one_pass_periphery = true;
 };
 
 struct RenderServerStats {
@@ -38,6 +41,7 @@ struct RenderServerStats {
     uint64_t requests_invalid = 0;  // a plan that does not fit the profile
     uint64_t frames_rendered = 0;
     uint64_t layers_rendered = 0;
+    uint64_t periphery_passes = 0;  // eyes whose two layers came from one pass
     uint64_t streams_sent = 0;
     uint64_t stream_send_failures = 0;  // the transport's queue was full or the client gone
     uint64_t render_failures = 0;

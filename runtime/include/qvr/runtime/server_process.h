@@ -1,0 +1,46 @@
+// The render server in a process of its own, as `qvr run` starts it. One process for both sides
+// would share Mesa's llvmpipe screen — and with it one set of rasterizer threads, created by
+// whichever side made the first GL context and pinned to that side's core — so the headset would
+// rasterize on the server's core (or the other way round). Two processes give each side its own
+// GL stack on its own core, as two machines would.
+#pragma once
+
+#include <sys/types.h>
+
+#include <string>
+#include <vector>
+
+#include "qvr/core/expected.h"
+
+namespace qvr::runtime {
+
+class ServerProcess {
+public:
+    // Starts `executable` with `args` (e.g. {"server", "--port", "0", …}) and waits up to
+    // `ready_timeout_ms` for the line "qvr server: listening on HOST:PORT" on its standard
+    // output; its other output is passed through to ours. Errors when it exits or stays silent.
+    static Expected<ServerProcess> start(const std::string& executable,
+                                         const std::vector<std::string>& args,
+                                         int ready_timeout_ms = 30000);
+    ServerProcess(ServerProcess&& other) noexcept;
+    ServerProcess& operator=(ServerProcess&& other) noexcept;
+    ServerProcess(const ServerProcess&) = delete;
+    ServerProcess& operator=(const ServerProcess&) = delete;
+    ~ServerProcess();
+
+    uint16_t port() const { return m_port; }
+    pid_t pid() const { return m_pid; }
+    // SIGTERM, then SIGKILL after `grace_ms`; returns the exit status (128 + signal if killed).
+    int stop(int grace_ms = 5000);
+
+private:
+    ServerProcess() = default;
+    pid_t m_pid = -1;
+    int m_stdout_fd = -1;
+    uint16_t m_port = 0;
+};
+
+// The path of the running executable (/proc/self/exe).
+Expected<std::string> selfExecutable();
+
+}  // namespace qvr::runtime
