@@ -44,7 +44,45 @@ struct KernelParams {
     // outer layer of a border. inv = 0 disables a border.
     float border_c_hi[2] = {2, 2};
     float border_inv[2] = {0, 0};
+    // Tests only: fetch every tap with gathers even where the contiguous-load path applies, so
+    // the two fetch paths can be held to each other.
+    bool force_gather = false;
 };
+
+// The map of one display row, in the form the kernels evaluate it: with xt = u·ax + bx,
+// r² = xt² + yt², f = (1 + k1·r² + k2·r⁴)·chroma,
+//   num_x = f·(xt·mx + cx_row) − ox,  num_y = f·(xt·my + cy_row) − oy,  depth = dz − f·(xt·mz + cz_row)
+// and px = num_x/depth + cx, py = num_y/depth + cy: the rotation's columns pre-multiplied by the
+// focal lengths, the row's yt folded into constants. Both kernels build it with rowMap().
+struct RowMap {
+    float yt = 0, yt2 = 0;
+    float mx = 0, cx_row = 0, ox = 0;
+    float my = 0, cy_row = 0, oy = 0;
+    float mz = 0, cz_row = 0, dz = 0;
+};
+
+inline RowMap rowMap(const KernelParams& p, float v) {
+    RowMap r;
+    // Written as products and one fused add so that the vector and scalar builds agree.
+    r.yt = v * p.ay + p.by;
+    r.yt2 = r.yt * r.yt;
+    r.mx = p.fx * p.m[0];
+    r.cx_row = (p.fx * p.m[1]) * r.yt;
+    r.ox = p.fx * p.m[2];
+    r.my = -p.fy * p.m[3];
+    r.cy_row = (-p.fy * p.m[4]) * r.yt;
+    r.oy = -p.fy * p.m[5];
+    r.mz = p.m[6];
+    r.cz_row = p.m[7] * r.yt;
+    r.dz = p.m[8];
+    return r;
+}
+
+// Fixed-point filtering (docs/UCA.md, "Fixed-point filter"): a texel coordinate is rounded to
+// 1/128 texel horizontally (weights (128 − w, w)) and kept to 1/32768 vertically; a filtered
+// channel is held as q = −128·value in int16, and rounded to a byte as (64 − q) >> 7.
+inline constexpr int kSubTexel = 128;
+inline constexpr int kWeightOne = 32768;
 
 // The output window of one tile: rows y0..y1, columns x0..x1 (half-open), written into `out`
 // (RGBA8, `out_stride_px` pixels a row). slot_mask: bit k set when slot k may contribute; a
