@@ -44,14 +44,12 @@ struct KernelParams {
     // outer layer of a border. inv = 0 disables a border.
     float border_c_hi[2] = {2, 2};
     float border_inv[2] = {0, 0};
-    // Tests only: fetch every tap with gathers even where the contiguous-load path applies, so
-    // the two fetch paths can be held to each other.
-    bool force_gather = false;
 };
 
 // The map of one display row, in the form the kernels evaluate it: with xt = u·ax + bx,
 // r² = xt² + yt², f = (1 + k1·r² + k2·r⁴)·chroma,
-//   num_x = f·(xt·mx + cx_row) − ox,  num_y = f·(xt·my + cy_row) − oy,  depth = dz − f·(xt·mz + cz_row)
+//   num_x = f·(xt·mx + cx_row) − ox,  num_y = f·(xt·my + cy_row) − oy,  depth = dz − f·(xt·mz +
+//   cz_row)
 // and px = num_x/depth + cx, py = num_y/depth + cy: the rotation's columns pre-multiplied by the
 // focal lengths, the row's yt folded into constants. Both kernels build it with rowMap().
 struct RowMap {
@@ -77,12 +75,6 @@ inline RowMap rowMap(const KernelParams& p, float v) {
     r.dz = p.m[8];
     return r;
 }
-
-// Fixed-point filtering (docs/UCA.md, "Fixed-point filter"): a texel coordinate is rounded to
-// 1/128 texel horizontally (weights (128 − w, w)) and kept to 1/32768 vertically; a filtered
-// channel is held as q = −128·value in int16, and rounded to a byte as (64 − q) >> 7.
-inline constexpr int kSubTexel = 128;
-inline constexpr int kWeightOne = 32768;
 
 // The output window of one tile: rows y0..y1, columns x0..x1 (half-open), written into `out`
 // (RGBA8, `out_stride_px` pixels a row). slot_mask: bit k set when slot k may contribute; a

@@ -1,6 +1,6 @@
 // The scalar twin of the UCA tile kernel (paper §4.2, Eq. 4): one pixel at a time, the same
-// arithmetic in the same order as the Highway kernel (std::fma wherever it fuses), so tests can
-// require the two to agree bit for bit.
+// float operations in the same order as the Highway kernel (std::fma wherever it fuses), so tests
+// can require the two to agree bit for bit.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -64,79 +64,84 @@ uint32_t loadTexel(const KernelLayer& l, int index) {
     return t;
 }
 
-// q = −128·(bilinear value) of channels 0–3 of one layer at a rendered-image point, in the
-// vector kernel's fixed point.
-void sampleLayer(const KernelLayer& l, float px, float py, int q[4]) {
+float channelOf(uint32_t texel, int c) {
+    return static_cast<float>((texel >> (8 * c)) & 0xFFu);
+}
+
+// Bilinear, clamp-to-edge, RGB of one layer at a rendered-image point.
+void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
     // Clamping the texel coordinate to [0, size − 1] is clamp-to-edge: at the edge the weight
-    // of the tap beyond it is 0 (or the left tap stops one short and the right one weighs 1).
+    // of the tap beyond it is 0, and that tap is redirected onto the edge texel.
     const float max_x = static_cast<float>(l.width - 1);
     const float max_y = static_cast<float>(l.height - 1);
-    const float xq = std::min(
-        std::max(std::fma(px, l.inv_scale * kSubTexel, l.offset_x * kSubTexel), 0.0f),
-        max_x * kSubTexel);
-    const int xi = static_cast<int>(xq + 0.5f);
-    const int x0 = std::min(xi >> 7, std::max(l.width - 2, 0));
-    const int wx = xi - (x0 << 7);
+    const float lx = std::min(std::max(std::fma(px, l.inv_scale, l.offset_x), 0.0f), max_x);
     const float ly = std::min(std::max(std::fma(py, l.inv_scale, l.offset_y), 0.0f), max_y);
-    const float fly = std::min(std::floor(ly), std::max(max_y - 1.0f, 0.0f));
+    float flx = std::floor(lx);
+    float fly = std::floor(ly);
+    int dx = flx < max_x ? 1 : 0;
+    int dy = fly < max_y ? 1 : 0;
+    if (l.width >= 2 && l.height >= 2) {
+        // The vector kernel's pair fetch: the left tap stops one short of the edge, where the
+        // right tap's weight becomes exactly 1 — the same value.
+        flx = std::min(flx, max_x - 1.0f);
+        fly = std::min(fly, max_y - 1.0f);
+        dx = 1;
+        dy = 1;
+    }
+    const float wx = lx - flx;
     const float wy = ly - fly;
-    const int wy15 = static_cast<int>(std::min(wy * kWeightOne + 0.5f, kWeightOne - 1.0f));
-    const int i00 = static_cast<int>(fly * static_cast<float>(l.width)) + x0;
-    const int dx = l.width >= 2 ? 1 : 0;
-    const int dy = l.height >= 2 ? l.width : 0;
-    const uint32_t t[4] = {loadTexel(l, i00), loadTexel(l, i00 + dx), loadTexel(l, i00 + dy),
-                           loadTexel(l, i00 + dy + dx)};
-    for (int c = 0; c < 4; ++c) {
-        auto ch = [&](uint32_t texel) { return static_cast<int>((texel >> (8 * c)) & 0xFFu); };
-        const int top = -(ch(t[0]) * (kSubTexel - wx) + ch(t[1]) * wx);
-        const int bottom = -(ch(t[2]) * (kSubTexel - wx) + ch(t[3]) * wx);
-        q[c] = top + (((bottom - top) * wy15 + (1 << 14)) >> 15);
+    // The texel index is formed in float like the vector kernel's (exact below 2^24 texels).
+    const int i00 = static_cast<int>(std::fma(fly, static_cast<float>(l.width), flx));
+    const int i01 = i00 + dy * l.width;
+    const uint32_t t00 = loadTexel(l, i00);
+    const uint32_t t10 = loadTexel(l, i00 + dx);
+    const uint32_t t01 = loadTexel(l, i01);
+    const uint32_t t11 = loadTexel(l, i01 + dx);
+    for (int c = 0; c < 3; ++c) {
+        const float a = channelOf(t00, c);
+        const float b = channelOf(t10, c);
+        const float d = channelOf(t01, c);
+        const float e = channelOf(t11, c);
+        const float top = std::fma(wx, b - a, a);
+        const float bot = std::fma(wx, e - d, d);
+        rgb[c] = std::fma(wy, bot - top, top);
     }
 }
 
-// Eq. 4's ramp share t in 1/32768 steps.
-int rampWeight(float c_hi, float inv, float cos_e) {
-    const float t = std::min(std::max((c_hi - cos_e) * inv, 0.0f), 1.0f);
-    return static_cast<int>(t * kWeightOne + 0.5f);
-}
-
-// a + (b − a)·t in the kernel's fixed point; t = 1 is exactly b.
-int lerpQ(int t, int a, int b) {
-    return t == kWeightOne ? b : a + (((b - a) * t + (1 << 14)) >> 15);
-}
-
-// Eq. 4 for one pixel as bytes (alpha included); false off the rendered image.
+// Eq. 4 for one pixel: the slots the tile may touch, weighted by the blend ramps.
 bool shade(const KernelParams& p, const RowMap& r, float u, float v, float chroma,
-           uint8_t slot_mask, uint8_t rgba[4]) {
+           uint8_t slot_mask, float rgb[3]) {
     const Mapped m = mapPixel(p, r, u, v, chroma);
-    int q[4] = {0, 0, 0, 0};
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    if (!m.valid)
+        return false;
     if ((slot_mask & (slot_mask - 1)) == 0) {
         const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
-        sampleLayer(p.slots[k], m.px, m.py, q);
-    } else {
-        // ω₀ = 1 − t₀, ω₁ = t₀(1 − t₁), ω₂ = t₀t₁ as nested lerps; a layer whose weight is 0 is
-        // not sampled (its value is ignored exactly).
-        const int t0 = rampWeight(p.border_c_hi[0], p.border_inv[0], m.cos_e);
-        const int t1 = rampWeight(p.border_c_hi[1], p.border_inv[1], m.cos_e);
-        int s[3][4] = {};
-        const bool need[3] = {t0 < kWeightOne, t0 > 0 && t1 < kWeightOne, t0 > 0 && t1 > 0};
-        for (int k = 0; k < p.slot_count; ++k) {
-            if ((slot_mask & (1u << k)) != 0 && need[k])
-                sampleLayer(p.slots[k], m.px, m.py, s[k]);
-        }
-        for (int c = 0; c < 4; ++c)
-            q[c] = lerpQ(t0, s[0][c], lerpQ(t1, s[1][c], s[2][c]));
+        sampleLayer(p.slots[k], m.px, m.py, rgb);
+        return true;
     }
-    for (int c = 0; c < 4; ++c)
-        rgba[c] = static_cast<uint8_t>((64 - q[c]) >> 7);
-    return m.valid;
+    const float t1 = std::min(std::max((p.border_c_hi[0] - m.cos_e) * p.border_inv[0], 0.0f), 1.0f);
+    const float t2 = std::min(std::max((p.border_c_hi[1] - m.cos_e) * p.border_inv[1], 0.0f), 1.0f);
+    const float w[3] = {1.0f - t1, t1 - t1 * t2, t1 * t2};
+    for (int k = 0; k < p.slot_count; ++k) {
+        if ((slot_mask & (1u << k)) == 0 || w[k] == 0.0f)
+            continue;
+        float s[3];
+        sampleLayer(p.slots[k], m.px, m.py, s);
+        for (int c = 0; c < 3; ++c)
+            rgb[c] = std::fma(w[k], s[c], rgb[c]);
+    }
+    return true;
+}
+
+uint32_t quantize(float value) {
+    // A convex combination of bytes stays within [0, 255], so +0.5 and truncation round it.
+    return static_cast<uint32_t>(static_cast<int>(value + 0.5f));
 }
 
 }  // namespace
 
 void ucaTileScalar(const KernelParams& p, const TileJob& job) {
-    const float scales[3] = {1.0f, p.chroma_red, p.chroma_blue};
-    const int channel_of[3] = {1, 0, 2};  // green from the unscaled map, then red, then blue
     for (int y = job.y0; y < job.y1; ++y) {
         uint8_t* row = job.out + static_cast<size_t>(y) * job.out_stride_px * 4;
         const float v = static_cast<float>(y);
@@ -145,21 +150,20 @@ void ucaTileScalar(const KernelParams& p, const TileJob& job) {
             const float u = static_cast<float>(x);
             uint32_t packed = kOpaqueBlack;
             if (job.slot_mask != 0) {
-                uint8_t rgba[4];
+                float rgb[3];
                 if (!p.chroma) {
-                    if (shade(p, r, u, v, 1.0f, job.slot_mask, rgba)) {
-                        packed |= uint32_t{rgba[0]} | (uint32_t{rgba[1]} << 8) |
-                                  (uint32_t{rgba[2]} << 16);
-                    }
+                    shade(p, r, u, v, 1.0f, job.slot_mask, rgb);
                 } else {
-                    // Lateral chromatic aberration: each channel has its own map and validity.
-                    for (int c = 0; c < 3; ++c) {
-                        if (shade(p, r, u, v, scales[c], job.slot_mask, rgba)) {
-                            const int ch = channel_of[c];
-                            packed |= uint32_t{rgba[ch]} << (8 * ch);
-                        }
-                    }
+                    // Lateral chromatic aberration: each channel has its own radial scale.
+                    float tmp[3];
+                    shade(p, r, u, v, p.chroma_red, job.slot_mask, tmp);
+                    rgb[0] = tmp[0];
+                    shade(p, r, u, v, 1.0f, job.slot_mask, tmp);
+                    rgb[1] = tmp[1];
+                    shade(p, r, u, v, p.chroma_blue, job.slot_mask, tmp);
+                    rgb[2] = tmp[2];
                 }
+                packed |= quantize(rgb[0]) | (quantize(rgb[1]) << 8) | (quantize(rgb[2]) << 16);
             }
             std::memcpy(row + static_cast<size_t>(x) * 4, &packed, sizeof packed);
         }
