@@ -30,6 +30,7 @@ struct RenderBenchOptions {
     std::string gaze = "0,0";
     int frames = 5;
     int msaa = 1;
+    float lod_px = 0.0f;
     bool json = false;
 };
 
@@ -195,6 +196,10 @@ static Registered registerRenderBench(CLI::App& bench) {
     cmd->add_option("--frames", opts->frames, "Timed frames per scene (median reported)")
         ->check(CLI::Range(1, 10000))
         ->capture_default_str();
+    cmd->add_option("--lod-px", opts->lod_px,
+                    "Level of detail: largest vertex move in each view's own pixels (0: off)")
+        ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
     cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
         ->check(CLI::Range(1, 32))
         ->capture_default_str();
@@ -223,6 +228,7 @@ static Registered registerRenderBench(CLI::App& bench) {
         }
         GlRendererOptions gl_options;
         gl_options.msaa_samples = opts->msaa;
+        gl_options.lod_error_px = opts->lod_px;
         auto gl = GlRenderer::create(gl_options);
         if (!gl) {
             std::fprintf(stderr, "%s: %s\n", kCmd, gl.error().c_str());

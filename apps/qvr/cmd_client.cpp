@@ -26,7 +26,7 @@ struct ClientCmdOptions {
     std::string key;
     std::string key_file;
     std::string scene = "builtin:room";
-    std::string profile = "run";
+    std::string profile = "default";
     std::string motion = "default";
     std::string gaze = "model";
     std::string design = "qvr";
@@ -35,6 +35,7 @@ struct ClientCmdOptions {
     int core = -1;
     uint64_t seed = 1;
     std::string out = "qvr-client";
+    float lod_px = 1.0f;
 };
 
 int runClient(const ClientCmdOptions& o) {
@@ -86,6 +87,9 @@ int runClient(const ClientCmdOptions& o) {
     hc.key = *key;
     hc.frames = o.frames;
     hc.core = o.core;
+    GlRendererOptions gl;
+    gl.lod_error_px = o.lod_px;
+    hc.renderer = glRendererFactory(gl);
     auto result = runHeadset(hc, scene, bvh, *traces);
     if (!result) {
         std::fprintf(stderr, "qvr client: %s\n", result.error().c_str());
@@ -146,6 +150,11 @@ static Registered registerClient(CLI::App& app) {
     cmd->add_option("--codec", o->codec, "x264 or raw (must match the server)")
         ->capture_default_str();
     cmd->add_option("--frames", o->frames, "Frames to run")->capture_default_str();
+    cmd->add_option(
+           "--lod-px", o->lod_px,
+           "Level of detail: largest vertex move in the view's own pixels (0: full detail)")
+        ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
     cmd->add_option("--core", o->core, "Pin the headset loop to this core (-1: no)")
         ->capture_default_str();
     cmd->add_option("--seed", o->seed, "Gaze model seed")->capture_default_str();

@@ -30,6 +30,7 @@ struct RenderOptions {
     double ipd_mm = 64.0;
     double lightmap_gain = 1.0;
     int msaa = 1;
+    float lod_px = 0.0f;
     std::string out_dir;
     bool json = false;
 };
@@ -102,6 +103,7 @@ int run(const RenderOptions& o) {
     GlRendererOptions gl_options;
     gl_options.lightmap_gain = static_cast<float>(o.lightmap_gain);
     gl_options.msaa_samples = o.msaa;
+    gl_options.lod_error_px = o.lod_px;
     auto renderer = GlRenderer::create(gl_options);
     if (!renderer) {
         std::fprintf(stderr, "%s: %s\n", kCmd, renderer.error().c_str());
@@ -230,6 +232,10 @@ static Registered registerRender(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--lightmap-gain", opts->lightmap_gain,
                     "Extra lightmap brightening on top of the loader's overbright shift")
+        ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
+    cmd->add_option("--lod-px", opts->lod_px,
+                    "Level of detail: largest vertex move in each view's own pixels (0: off)")
         ->check(CLI::Range(0.0, 16.0))
         ->capture_default_str();
     cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")

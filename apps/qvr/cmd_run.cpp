@@ -48,7 +48,7 @@ struct RunOptions {
     std::string motion = "default";
     std::string gaze = "model";
     std::string net = "wifi";
-    std::string profile = "run";
+    std::string profile = "default";
     std::string designs = "local,remote,ffr,sw,qvr";
     std::string out = "qvr-run";
     std::string codec = "x264";
@@ -58,8 +58,9 @@ struct RunOptions {
     bool video = true;
     bool fovea_border = true;
     int video_max_frames = 900;
-    bool one_pass_periphery = true;
+    bool one_pass_periphery = false;
     int pipeline_depth = 2;
+    float lod_px = 1.0f;
     std::string command_line;
 };
 
@@ -308,9 +309,11 @@ int runRun(const RunOptions& o) {
                                             "--core",
                                             std::to_string(server_core),
                                             "--stats-json",
-                                            server_stats_path.string()};
-    if (!o.one_pass_periphery)
-        server_args.push_back("--two-pass-periphery");
+                                            server_stats_path.string(),
+                                            "--lod-px",
+                                            fmt::format("{}", o.lod_px)};
+    if (o.one_pass_periphery)
+        server_args.push_back("--one-pass-periphery");
     auto server = key_written ? ServerProcess::start(*exe, server_args)
                               : Expected<ServerProcess>(makeError("cannot write the key file"));
     unlink(key_path);
@@ -345,6 +348,9 @@ int runRun(const RunOptions& o) {
         hc.core = client_core;
         hc.remote_timeout_ms = o.remote_timeout_ms;
         hc.pipeline_depth = o.pipeline_depth;
+        GlRendererOptions gl;
+        gl.lod_error_px = o.lod_px;
+        hc.renderer = glRendererFactory(gl);
         std::ofstream workload_out;
         std::unique_ptr<WorkloadTraceWriter> writer;
         if (d == RuntimeDesign::kQvr) {
@@ -630,8 +636,14 @@ static Registered registerRun(CLI::App& app) {
                     "Remote layers later than this after the local render are late (frame reuse)")
         ->check(CLI::Range(1.0, 10000.0))
         ->capture_default_str();
-    cmd->add_flag("!--two-pass-periphery", o->one_pass_periphery,
-                  "Server renders middle and outer as two sub-frusta, not one pass per eye");
+    cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
+                  "Server renders middle and outer in one geometry pass per eye (pays when "
+                  "vertex-bound: no LOD, small displays)");
+    cmd->add_option("--lod-px", o->lod_px,
+                    "Level of detail on both sides: largest vertex move in each view's own pixels "
+                    "(0: full detail)")
+        ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
     cmd->add_option("--pipeline", o->pipeline_depth,
                     "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
                     "finishing n)")
@@ -643,9 +655,10 @@ static Registered registerRun(CLI::App& app) {
     return {cmd, [o] {
                 o->command_line = fmt::format(
                     "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
-                    "--profile {} --codec {} --seed {}",
+                    "--profile {} --codec {} --seed {} --lod-px {} --pipeline {}{}",
                     o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile,
-                    o->codec, o->seed);
+                    o->codec, o->seed, o->lod_px, o->pipeline_depth,
+                    o->one_pass_periphery ? " --one-pass-periphery" : "");
                 return runRun(*o);
             }};
 }

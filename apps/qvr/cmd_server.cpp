@@ -37,13 +37,14 @@ struct ServerCmdOptions {
     std::string key;
     std::string key_file;
     std::string scene = "builtin:room";
-    std::string profile = "run";
+    std::string profile = "default";
     std::string net = "none";
     std::string codec = "x264";
     int core = -1;
     double duration_s = 0.0;
     std::string stats_json;
-    bool one_pass_periphery = true;
+    bool one_pass_periphery = false;
+    float lod_px = 1.0f;
 };
 
 int runServer(const ServerCmdOptions& o) {
@@ -82,6 +83,9 @@ int runServer(const ServerCmdOptions& o) {
     cfg.codec.backend = o.codec;
     cfg.core = o.core;
     cfg.one_pass_periphery = o.one_pass_periphery;
+    GlRendererOptions gl;
+    gl.lod_error_px = o.lod_px;
+    cfg.renderer = glRendererFactory(gl);
     auto server = RenderServer::start(cfg, std::make_shared<const Scene>(std::move(*scene)));
     if (!server) {
         std::fprintf(stderr, "qvr server: %s\n", server.error().c_str());
@@ -150,9 +154,14 @@ static Registered registerServer(CLI::App& app) {
     cmd->add_option("--codec", o->codec, "x264 or raw")->capture_default_str();
     cmd->add_option("--core", o->core, "Pin the render thread to this core (-1: no)")
         ->capture_default_str();
+    cmd->add_option(
+           "--lod-px", o->lod_px,
+           "Level of detail: largest vertex move in the view's own pixels (0: full detail)")
+        ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
     cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit");
-    cmd->add_flag("!--two-pass-periphery", o->one_pass_periphery,
-                  "Render middle and outer as two sub-frusta instead of one pass per eye");
+    cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
+                  "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
     cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")
         ->capture_default_str();
     return {cmd, [o] { return runServer(*o); }};

@@ -79,7 +79,7 @@ double LiwcPolicy::remoteMs(const Gaze& gaze, double e1_deg) const {
     const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
     const double bits =
         2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
-    return bits / m_throughput_bps * 1000.0;
+    return m_remote_base_ms + bits / m_throughput_bps * 1000.0;
 }
 
 double LiwcPolicy::predictLocalMs(const WorkloadFrame& frame, double e1_deg) const {
@@ -179,6 +179,12 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         updateGpuRates(m.triangles_local, m.pixels_local, m.t_local_ms);
     if (m.throughput_bps > 0.0)
         m_throughput_bps = (1.0 - b) * m_throughput_bps + b * m.throughput_bps;
+    if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
+        const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
+        const double transmission_ms = sent_bits / m_throughput_bps * 1000.0;
+        const double rest = std::max(0.0, m.t_remote_ms - transmission_ms);
+        m_remote_base_ms = (1.0 - b) * m_remote_base_ms + b * rest;
+    }
     // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
     const bool have_mid = m.middle_pixels > 0 && m.middle_bytes > 0;
     const bool have_out = m.outer_pixels > 0 && m.outer_bytes > 0;

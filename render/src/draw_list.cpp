@@ -3,11 +3,17 @@
 #include "qvr/render/draw_list.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <numeric>
+#include <unordered_map>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 
 namespace qvr {
 
@@ -28,6 +34,17 @@ uint32_t mortonCode(const glm::vec3& unit) {
     return (spreadBits(static_cast<uint32_t>(q.x)) << 2) |
            (spreadBits(static_cast<uint32_t>(q.y)) << 1) | spreadBits(static_cast<uint32_t>(q.z));
 }
+
+using Triangle = std::array<uint32_t, 3>;
+
+struct TriangleHash {
+    size_t operator()(const Triangle& t) const {
+        uint64_t h = t[0] * 0x9E3779B97F4A7C15ull;
+        h ^= (h >> 29) + t[1] * 0xBF58476D1CE4E5B9ull;
+        h ^= (h >> 31) + t[2] * 0x94D049BB133111EBull;
+        return static_cast<size_t>(h ^ (h >> 32));
+    }
+};
 
 }  // namespace
 
@@ -116,22 +133,131 @@ DrawList buildDrawList(const Scene& scene, uint32_t cluster_triangles) {
     return list;
 }
 
-DrawSelection selectDraws(const DrawList& list, const RenderView& view) {
+void buildLods(DrawList& list, const Scene& scene, const LodOptions& options) {
+    // Drop any earlier levels: their indices are the tail after the scene's own.
+    size_t base_indices = list.indices.size();
+    for (const DrawLodLevel& l : list.lods)
+        for (uint32_t n : l.index_count)
+            base_indices -= n;
+    list.indices.resize(base_indices);
+    list.lods.clear();
+    list.lod_vertices.clear();
+    if (scene.vertices.empty() || list.clusters.empty() || options.levels <= 0)
+        return;
+    Aabb box = scene.bounds;
+    if (!box.valid()) {
+        box = Aabb{};
+        for (const SceneVertex& v : scene.vertices)
+            box.extend(v.position);
+    }
+    const float diagonal = glm::length(box.max - box.min);
+    float cell = options.finest_cell_m > 0.0f ? options.finest_cell_m : diagonal / 4096.0f;
+    if (!(cell > 0.0f))
+        return;
+    const uint32_t vertex_base = static_cast<uint32_t>(scene.vertices.size());
+    std::unordered_map<uint64_t, uint32_t> cell_vertex;  // (batch, cell) → LOD vertex
+    std::unordered_set<Triangle, TriangleHash> seen;     // triangles already in a cluster
+    for (int level = 0; level < options.levels; ++level, cell *= 2.0f) {
+        // Cells are counted from the box's corner with 20 bits an axis; past that, stop.
+        if (diagonal / cell > float(1u << 20))
+            continue;
+        DrawLodLevel lod;
+        lod.cell_m = cell;
+        lod.first_index.reserve(list.clusters.size());
+        lod.index_count.reserve(list.clusters.size());
+        cell_vertex.clear();
+        uint32_t batch_of_map = UINT32_MAX;
+        for (const DrawCluster& c : list.clusters) {
+            if (c.batch != batch_of_map) {
+                // Vertices keep their batch's texture coordinates: one set per batch.
+                cell_vertex.clear();
+                batch_of_map = c.batch;
+            }
+            const uint32_t first = static_cast<uint32_t>(list.indices.size());
+            seen.clear();
+            auto mapped = [&](uint32_t vi) {
+                const SceneVertex& v = scene.vertices[vi];
+                const glm::vec3 q = glm::floor((v.position - box.min) / cell);
+                const glm::uvec3 k =
+                    glm::uvec3(glm::clamp(q, glm::vec3(0.0f), glm::vec3(1048575.0f)));
+                const uint64_t key = (uint64_t(k.x) << 40) | (uint64_t(k.y) << 20) | uint64_t(k.z);
+                auto [it, fresh] = cell_vertex.try_emplace(key, 0u);
+                if (fresh) {
+                    SceneVertex lv = v;
+                    lv.position = box.min + (glm::vec3(k) + 0.5f) * cell;
+                    it->second = vertex_base + static_cast<uint32_t>(list.lod_vertices.size());
+                    list.lod_vertices.push_back(lv);
+                }
+                return it->second;
+            };
+            for (uint32_t i = 0; i < c.index_count; i += 3) {
+                const uint32_t* t = list.indices.data() + c.first_index + i;
+                const uint32_t a = mapped(t[0]), b = mapped(t[1]), d = mapped(t[2]);
+                if (a == b || b == d || a == d)
+                    continue;
+                // The same triangle twice (same winding, any rotation) draws nothing new.
+                const uint32_t lo = std::min({a, b, d});
+                const uint32_t r0 = lo, r1 = lo == a ? b : (lo == b ? d : a),
+                               r2 = lo == a ? d : (lo == b ? a : b);
+                if (!seen.insert(Triangle{r0, r1, r2}).second)
+                    continue;
+                list.indices.push_back(a);
+                list.indices.push_back(b);
+                list.indices.push_back(d);
+            }
+            lod.first_index.push_back(first);
+            lod.index_count.push_back(static_cast<uint32_t>(list.indices.size()) - first);
+        }
+        list.lods.push_back(std::move(lod));
+    }
+}
+
+DrawSelection selectDraws(const DrawList& list, const RenderView& view, float lod_error_px) {
     DrawSelection s;
     const FrustumPlanes planes = frustumPlanes(view.viewProjection());
-    for (const DrawCluster& c : list.clusters) {
+    const bool lod = lod_error_px > 0.0f && !list.lods.empty();
+    glm::vec3 eye(0.0f);
+    float px_per_rad = 0.0f;
+    if (lod) {
+        eye = glm::vec3(glm::inverse(view.view)[3]);
+        // Pixels per unit of tangent: the projection's scale times half the framebuffer.
+        px_per_rad = std::max(std::fabs(view.projection[0][0]) * 0.5f * float(view.width_px),
+                              std::fabs(view.projection[1][1]) * 0.5f * float(view.height_px));
+    }
+    for (size_t ci = 0; ci < list.clusters.size(); ++ci) {
+        const DrawCluster& c = list.clusters[ci];
         if (!boxMayBeVisible(planes, c.bounds)) {
             ++s.clusters_culled;
             continue;
         }
         ++s.clusters_drawn;
-        s.triangles += c.index_count / 3;
+        uint32_t first = c.first_index;
+        uint32_t count = c.index_count;
+        if (lod && px_per_rad > 0.0f) {
+            const glm::vec3 nearest = glm::clamp(eye, c.bounds.min, c.bounds.max);
+            const float d = glm::length(nearest - eye);
+            // A vertex moves at most half a cell diagonal: √3/2 · cell.
+            const float max_cell = lod_error_px * d / (0.8660254f * px_per_rad);
+            int level = -1;
+            while (level + 1 < static_cast<int>(list.lods.size()) &&
+                   list.lods[static_cast<size_t>(level + 1)].cell_m <= max_cell)
+                ++level;
+            if (level >= 0) {
+                const DrawLodLevel& l = list.lods[static_cast<size_t>(level)];
+                first = l.first_index[ci];
+                count = l.index_count[ci];
+                ++s.clusters_coarsened;
+            }
+        }
+        s.triangles += count / 3;
+        if (count == 0)
+            continue;
         // Clusters of one batch are adjacent in the index buffer: extend the last draw.
         if (!s.draws.empty() && s.draws.back().batch == c.batch &&
-            s.draws.back().first_index + s.draws.back().index_count == c.first_index) {
-            s.draws.back().index_count += c.index_count;
+            s.draws.back().first_index + s.draws.back().index_count == first) {
+            s.draws.back().index_count += count;
         } else {
-            s.draws.push_back({c.first_index, c.index_count, c.batch});
+            s.draws.push_back({first, count, c.batch});
         }
     }
     return s;

@@ -237,6 +237,9 @@ struct GlRenderer::Impl {
                 fmt::format("render: {} samples per pixel asked for; the driver "
                             "offers 1 to {}",
                             options.msaa_samples, max_samples));
+        if (!(options.lod_error_px >= 0.0f && options.lod_error_px <= 1000.0f))
+            return makeError(fmt::format(
+                "render: LOD error of {} pixels asked for; give 0 (off) to 1000", options.lod_error_px));
         GLint max_rb = 0;
         GLint max_vp[2] = {0, 0};
         glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
@@ -354,6 +357,8 @@ struct GlRenderer::Impl {
         if (Status s = checkDrawable(scene); !s)
             return s;
         DrawList list = buildDrawList(scene);
+        if (options.lod_error_px > 0.0f)
+            buildLods(list, scene);
         if (Status s = egl->makeCurrent(); !s)
             return s;
         releaseScene();
@@ -372,10 +377,22 @@ struct GlRenderer::Impl {
         glCreateBuffers(1, &vertex_buffer);
         glCreateBuffers(1, &index_buffer);
         // Zero-size immutable storage is an error in GL; an empty scene keeps a 1-byte buffer.
-        glNamedBufferStorage(vertex_buffer,
-                             std::max<GLsizeiptr>(1, static_cast<GLsizeiptr>(scene.vertices.size() *
-                                                                             sizeof(SceneVertex))),
-                             scene.vertices.empty() ? nullptr : scene.vertices.data(), 0);
+        // The scene's vertices, then the ones its LOD levels add.
+        const size_t vertex_count = scene.vertices.size() + list.lod_vertices.size();
+        glNamedBufferStorage(
+            vertex_buffer,
+            std::max<GLsizeiptr>(1, static_cast<GLsizeiptr>(vertex_count * sizeof(SceneVertex))),
+            nullptr, GL_DYNAMIC_STORAGE_BIT);
+        if (!scene.vertices.empty())
+            glNamedBufferSubData(
+                vertex_buffer, 0,
+                static_cast<GLsizeiptr>(scene.vertices.size() * sizeof(SceneVertex)),
+                scene.vertices.data());
+        if (!list.lod_vertices.empty())
+            glNamedBufferSubData(
+                vertex_buffer, static_cast<GLintptr>(scene.vertices.size() * sizeof(SceneVertex)),
+                static_cast<GLsizeiptr>(list.lod_vertices.size() * sizeof(SceneVertex)),
+                list.lod_vertices.data());
         glNamedBufferStorage(index_buffer,
                              std::max<GLsizeiptr>(1, static_cast<GLsizeiptr>(list.indices.size() *
                                                                              sizeof(uint32_t))),
@@ -493,7 +510,7 @@ struct GlRenderer::Impl {
         glUniform1f(1, options.lightmap_gain);
         glBindVertexArray(vao);
 
-        const DrawSelection selection = selectDraws(draw_list, view);
+        const DrawSelection selection = selectDraws(draw_list, view, options.lod_error_px);
         glBeginQuery(GL_TIME_ELAPSED, query_time);
         glBeginQuery(GL_PRIMITIVES_GENERATED, query_primitives);
         if (info.pipeline_statistics) {

@@ -95,6 +95,13 @@ public:
           m_probe(config.profile, std::move(bvh)),
           m_compositor(config.profile, composeOptions()) {}
 
+    static LiwcConfig liwcConfig() {
+        LiwcConfig c;
+        // A real server takes time to render and encode; Eq. 2 alone would not see it.
+        c.learn_remote_base = true;
+        return c;
+    }
+
     static ComposeOptions composeOptions() {
         ComposeOptions o;
         o.threads = 1;  // the headset has one core
@@ -114,7 +121,7 @@ public:
             return makeError("headset: " + st.error());
         switch (m_config.design) {
             case RuntimeDesign::kQvr:
-                m_policy = std::make_unique<LiwcPolicy>(m_probe.header());
+                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig());
                 break;
             case RuntimeDesign::kSw:
                 m_policy = makeSoftwareReactivePolicy(m_probe.header());
@@ -149,6 +156,7 @@ public:
         const size_t depth = usesServer(m_config.design)
                                  ? static_cast<size_t>(std::clamp(m_config.pipeline_depth, 1, 4))
                                  : 1;
+        m_depth = depth;
         std::deque<Prepared> ahead;
         int64_t next = 0;
         for (int64_t i = 0; i < m_config.frames; ++i) {
@@ -278,7 +286,10 @@ private:
             return;
         int timeout_ms = wait_ms;
         for (;;) {
+            const int64_t block_start_ns = timeout_ms > 0 ? m_clock.nowNs() : 0;
             auto next = m_client->nextStream(timeout_ms);
+            if (timeout_ms > 0)
+                m_idle_ns += m_clock.nowNs() - block_start_ns;
             if (!next) {
                 if (m_was_connected) {
                     ++m_stats.disconnects;
@@ -471,8 +482,13 @@ private:
         // 5. Wait for this frame's remote layers, decoding each as it arrives.
         bool have_current = expected == 0;
         if (expected != 0) {
-            const int64_t deadline_ns = std::max(local_end_ns, pose_ns) +
-                                        static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
+            // The wait limit runs from when the server could start on this frame: with frames
+            // in flight its request waits behind the previous frame's.
+            const PendingFrame* started = pendingFor(i);
+            const int64_t wait_from_ns =
+                std::max({local_end_ns, pose_ns, started ? started->service_start_ns : 0});
+            const int64_t deadline_ns =
+                wait_from_ns + static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
             for (;;) {
                 PendingFrame* p = pendingFor(i);
                 if (!p || p->complete() || p->broken())
@@ -533,7 +549,18 @@ private:
             m_last_shown = t->shown_frame;
         }
         t->throughput_bps = m_client ? m_client->throughputBps() : 0.0;
+        const int64_t vsync_wait_start_ns = m_clock.nowNs();
         const int64_t display_ns = m_pacer.waitForScanout(uca_end_ns);
+        m_idle_ns += std::max<int64_t>(0, m_clock.nowNs() - vsync_wait_start_ns);
+        // Busy time since the previous frame finished: the headset's cost of one frame.
+        {
+            const int64_t now_ns = m_clock.nowNs();
+            if (m_last_finish_ns > 0)
+                result.frames[ti].headset_busy_ms =
+                    double(std::max<int64_t>(0, now_ns - m_last_finish_ns - m_idle_ns)) * 1e-6;
+            m_last_finish_ns = now_ns;
+            m_idle_ns = 0;
+        }
         t = &result.frames[ti];
         t->display_ns = rel(display_ns);
         if (m_config.display && report) {
@@ -547,7 +574,10 @@ private:
             FrameMeasurement m;
             m.index = i;
             m.e1_deg = plan.e1_deg;
-            m.t_local_ms = t->t_local_ms;
+            // With frames in flight the headset's whole frame competes with the server, not
+            // only its fovea render (LIWC's GPU fit takes the fixed part as its intercept).
+            m.t_local_ms =
+                m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
             m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
             if (wf) {
                 m.triangles_local =
@@ -598,6 +628,9 @@ private:
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
     int64_t m_last_complete_rx_ns = 0;
+    int64_t m_idle_ns = 0;  // waiting for the network or vsync since the last frame finished
+    int64_t m_last_finish_ns = 0;
+    size_t m_depth = 1;
     double m_last_e1_deg = 5.0;
     uint64_t m_proof_failures_seen = 0;
     bool m_was_connected = false;

@@ -18,9 +18,9 @@
 
 namespace qvr::runtime {
 
-RendererFactory glRendererFactory() {
-    return []() -> Expected<std::unique_ptr<Renderer>> {
-        auto r = GlRenderer::create();
+RendererFactory glRendererFactory(GlRendererOptions options) {
+    return [options]() -> Expected<std::unique_ptr<Renderer>> {
+        auto r = GlRenderer::create(options);
         if (!r)
             return makeError(r.error());
         return std::unique_ptr<Renderer>(std::move(*r));

@@ -35,6 +35,12 @@ struct LiwcConfig {
     double throughput_bps_initial = 200e6;
     double bits_per_pixel_initial = 1.0;
     double bits_scale_exponent_initial = 0.7;
+    // Eq. 2 charges the remote side only the transmission of the periphery, as if the server
+    // rendered and encoded in no time (the paper's server is far stronger than the headset).
+    // When set, LIWC also learns the rest of the measured T_remote — the server's render and
+    // encode time, the decode — as a running mean, and adds it to every candidate (docs/LIWC.md).
+    // The runtime sets it; the simulator keeps the paper's Eq. 2.
+    bool learn_remote_base = false;
 };
 
 struct LiwcCandidate {
@@ -91,8 +97,9 @@ private:
     std::array<double, 3> m_gpu_theta;
     std::array<double, 9> m_gpu_cov;
     double m_throughput_bps;
-    double m_log_bits_at_1;  // log of bits per pixel at scale 1
-    double m_bits_exponent;  // growth with scale
+    double m_log_bits_at_1;         // log of bits per pixel at scale 1
+    double m_bits_exponent;         // growth with scale
+    double m_remote_base_ms = 0.0;  // learn_remote_base: T_remote beyond the transmission
     // State between decide() and observe().
     bool m_have_previous = false;
     Pose m_previous_head;

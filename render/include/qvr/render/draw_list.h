@@ -21,12 +21,36 @@ struct DrawCluster {
     Aabb bounds;
 };
 
+// A coarser version of every cluster (docs/RENDER.md "Level of detail"): vertex clustering on a
+// grid of cubic cells — every vertex moves to the centre of its cell, triangles that collapse
+// are dropped — so no vertex moves by more than half a cell diagonal, and neighbouring clusters
+// and batches move shared positions alike (no cracks).
+struct DrawLodLevel {
+    float cell_m = 0.0f;
+    std::vector<uint32_t> first_index;  // per cluster, into DrawList::indices
+    std::vector<uint32_t> index_count;  // per cluster; may be 0 when the cluster vanished
+};
+
 struct DrawList {
     // The scene's indices with each batch's triangles reordered along a Morton curve of their
     // centroids; every batch keeps its index range, so a batch is still one contiguous span.
+    // The LOD levels' indices follow the scene's.
     std::vector<uint32_t> indices;
     std::vector<DrawCluster> clusters;  // in index order
+    // Vertices the LOD levels add, indexed after the scene's own: vertex
+    // scene.vertices.size() + i is lod_vertices[i].
+    std::vector<SceneVertex> lod_vertices;
+    std::vector<DrawLodLevel> lods;  // finest first; each cell twice the previous
 };
+
+struct LodOptions {
+    int levels = 6;
+    // The finest cell; 0 picks the scene's box diagonal / 4096.
+    float finest_cell_m = 0.0f;
+};
+
+// Adds LOD levels to a draw list built from `scene` (replacing any it had).
+void buildLods(DrawList& list, const Scene& scene, const LodOptions& options = {});
 
 inline constexpr uint32_t kDefaultClusterTriangles = 256;
 
@@ -50,9 +74,13 @@ struct DrawSelection {
     uint64_t triangles = 0;
     uint32_t clusters_drawn = 0;
     uint32_t clusters_culled = 0;
+    uint32_t clusters_coarsened = 0;  // drawn at a LOD level
 };
 
 // The clusters a view may see (conservative plane test on their boxes), merged into draw calls.
-DrawSelection selectDraws(const DrawList& list, const RenderView& view);
+// With lod_error_px > 0 and LOD levels built, each cluster is drawn at the coarsest level whose
+// largest vertex move (half a cell diagonal), seen from the eye at the cluster box's nearest
+// point, stays within lod_error_px of the view's own pixels.
+DrawSelection selectDraws(const DrawList& list, const RenderView& view, float lod_error_px = 0.0f);
 
 }  // namespace qvr

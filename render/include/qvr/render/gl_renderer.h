@@ -18,6 +18,11 @@ struct GlRendererOptions {
     // Samples per pixel (1 = no multisampling). 4 smooths geometry edges, which the periphery's
     // video encoder would otherwise spend bits on; llvmpipe pays for it in fill time.
     int msaa_samples = 1;
+    // Level of detail (draw_list.h): each cluster is drawn at the coarsest vertex-clustering
+    // level that moves no vertex by more than this many of the view's pixels. 0 draws the
+    // scene's own triangles everywhere. The bound is per view, so a layer rendered at scale s
+    // may use cells s times larger than a full-resolution view of the same place.
+    float lod_error_px = 0.0f;
 };
 
 struct GlInfo {

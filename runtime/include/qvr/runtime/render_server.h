@@ -12,6 +12,7 @@
 #include "qvr/core/expected.h"
 #include "qvr/foveation/hmd_profile.h"
 #include "qvr/net/server.h"
+#include "qvr/render/gl_renderer.h"
 #include "qvr/render/renderer.h"
 #include "qvr/scene/scene.h"
 
@@ -19,7 +20,7 @@ namespace qvr::runtime {
 
 // Renderers are made on the thread that uses them (an OpenGL context is current on one thread).
 using RendererFactory = std::function<Expected<std::unique_ptr<Renderer>>()>;
-RendererFactory glRendererFactory();
+RendererFactory glRendererFactory(GlRendererOptions options = {});
 RendererFactory nullRendererFactory();
 
 struct RenderServerConfig {
@@ -30,9 +31,11 @@ struct RenderServerConfig {
     int core = -1;  // pin the render thread to this core (-1: no pinning)
     // Requests waiting per headset; a newer request pushes the oldest out (it would be late).
     size_t max_pending_requests = 2;
-    // Render an eye's middle and outer layers in one geometry pass when that is cheaper
-    // (render/periphery_pass.h); false renders each layer's own sub-frustum.
-    bool one_pass_periphery = true;
+    // Render an eye's middle and outer layers in one geometry pass (render/periphery_pass.h)
+    // instead of each layer's own sub-frustum. It pays when geometry dominates (no LOD, small
+    // displays); with LOD at the paper's display the extended grid's fill costs more than the
+    // second pass saves (docs/RUNTIME.md), so it is off by default.
+    bool one_pass_periphery = false;
 };
 
 struct RenderServerStats {

@@ -38,6 +38,10 @@ struct FrameTelemetry {
     double t_local_ms = 0.0;
     double t_remote_ms = 0.0;
     double uca_ms = 0.0;
+    // The headset's busy time for this frame (its decision, fovea, decodes, UCA, bookkeeping:
+    // everything but waiting for the network and for vsync). With frames in flight this, not the
+    // fovea render alone, is what LIWC balances against T_remote (docs/RUNTIME.md).
+    double headset_busy_ms = 0.0;
     double mtp_ms = 0.0;  // pose sample → UCA output complete
     double throughput_bps = 0.0;
     double fovea_triangles = 0.0;  // both eyes, in the e1 cone (LIWC's input)
