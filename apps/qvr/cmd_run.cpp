@@ -226,6 +226,66 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
             {"client_core", st.core}};
 }
 
+struct DesignRun {
+    RuntimeDesign design;
+    HeadsetResult result;
+};
+
+// What limits each design's frame rate on this machine: the headset's busy time per frame (its
+// core) against the server's service time per frame (T_remote: render, encode, link, decode
+// of the other core's work), and the headset's largest stage.
+std::string limitsHtml(const std::vector<DesignRun>& runs) {
+    std::string html =
+        "<h2>What limits the frame rate</h2>\n<table><tr><th>design</th><th>headset busy "
+        "ms/frame (core 0)</th><th>decision ms</th><th>fovea/local render ms</th><th>UCA "
+        "ms</th><th>T_remote ms (server, core 1)</th><th>limit</th></tr>\n";
+    for (const DesignRun& r : runs) {
+        double busy = 0, decision = 0, local = 0, uca = 0, remote = 0;
+        int n = 0, n_busy = 0, n_remote = 0;
+        for (const FrameTelemetry& t : r.result.frames) {
+            ++n;
+            decision += double(t.decision_ns - t.pose_ns) * 1e-6;
+            local += t.t_local_ms;
+            uca += t.uca_ms;
+            if (t.headset_busy_ms > 0) {
+                busy += t.headset_busy_ms;
+                ++n_busy;
+            }
+            if (t.remote_requested) {
+                remote += t.t_remote_ms;
+                ++n_remote;
+            }
+        }
+        if (n == 0)
+            continue;
+        busy = n_busy ? busy / n_busy : 0;
+        remote = n_remote ? remote / n_remote : 0;
+        decision /= n;
+        local /= n;
+        uca /= n;
+        std::string limit;
+        if (remote > busy) {
+            limit = "server: its render + encode per frame (T_remote) exceeds the headset's work";
+        } else {
+            const double top = std::max({decision, local, uca});
+            const char* stage = top == local ? "the local render"
+                                : top == uca ? "UCA"
+                                             : "the decision (BVH ring counts)";
+            limit = fmt::format("headset: busiest stage {}", stage);
+        }
+        html += fmt::format(
+            "<tr><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}"
+            "</td><td style='text-align:left'>{}</td></tr>\n",
+            designName(r.design), busy, decision, local, uca, remote, htmlEscape(limit));
+    }
+    html +=
+        "</table>\n<p>Both sides run llvmpipe on one core each of this machine; the paper's "
+        "premise is a mobile GPU on the headset and a far stronger server GPU. Frames in flight "
+        "(two by default) let the server render frame n+1 while the headset finishes n, so a "
+        "design runs at the pace of the slower side.</p>\n";
+    return html;
+}
+
 int runRun(const RunOptions& o) {
     auto designs = parseDesignList(o.designs);
     if (!designs) {
@@ -327,10 +387,6 @@ int runRun(const RunOptions& o) {
     fmt::print("  server on 127.0.0.1:{} pinned to core {}, headset pinned to core {} ({} cores)\n",
                server->port(), server_core, client_core, cores);
 
-    struct DesignRun {
-        RuntimeDesign design;
-        HeadsetResult result;
-    };
     std::vector<DesignRun> runs;
     ScanoutRecorder recorder(*profile, o.video_max_frames, o.fovea_border);
     const fs::path workload_path = out / "workload.jsonl";
@@ -563,8 +619,9 @@ int runRun(const RunOptions& o) {
     html += fmt::format(
         "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
         "the "
-        "server's egress), {} frames per design. Headset pinned to core {}, server render thread "
-        "to core {}. Motion-to-photon is pose sample → UCA output complete on the headset's "
+        "server's egress), {} frames per design. The headset (this process) is pinned to core {}, "
+        "the server (a child <code>qvr server</code> process) to core {}. Motion-to-photon is pose "
+        "sample → UCA output complete on the headset's "
         "steady clock.</p>\n",
         htmlEscape(scene->name), profile->width_px, profile->height_px, profile->refresh_hz,
         htmlEscape(o.net), o.frames, client_core, server_core);
@@ -582,7 +639,9 @@ int runRun(const RunOptions& o) {
             s.e1_deg_mean, s.t_local_ms_mean, s.t_remote_ms_mean, s.uca_ms_mean, s.frames_displayed,
             s.frames_reused);
     }
-    html += "</table>\n<h2>Against the paper and the simulator</h2>\n<pre>" +
+    html += "</table>\n";
+    html += limitsHtml(runs);
+    html += "<h2>Against the paper and the simulator</h2>\n<pre>" +
             htmlEscape(j["ratios"].dump(2)) + "\n" + htmlEscape(sim_json.dump(2)) + "</pre>\n";
     if (!sim_note.empty())
         html += "<p>" + htmlEscape(sim_note) + "</p>\n";
