@@ -53,21 +53,29 @@ void BM_Uca(benchmark::State& state) {
     ComposeOptions o;
     o.threads = static_cast<int>(state.range(0));
     o.simd = state.range(1) != 0;
+    o.mesh_map = state.range(2) != 0;
     Compositor c(s.profile, o);
     std::array<ImageRgba8, 2> out;
+    TileStats tiles;
     for (auto _ : state) {
         auto r = c.compose(s.frame, s.display, out);
         benchmark::DoNotOptimize(out[0].data());
-        if (!r)
+        if (!r) {
             state.SkipWithError(r.error().c_str());
+            break;
+        }
+        tiles = r->tiles;
     }
     report(state, s);
+    state.counters["single_tiles"] = static_cast<double>(tiles.single);
+    state.counters["mesh_tiles"] = static_cast<double>(tiles.mesh);
 }
 BENCHMARK(BM_Uca)
-    ->ArgNames({"threads", "simd"})
-    ->Args({1, 1})
-    ->Args({2, 1})
-    ->Args({2, 0})
+    ->ArgNames({"threads", "simd", "mesh"})
+    ->Args({1, 1, 1})
+    ->Args({1, 1, 0})
+    ->Args({2, 1, 1})
+    ->Args({2, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

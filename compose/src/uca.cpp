@@ -4,6 +4,7 @@
 #include "qvr/compose/uca.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -141,6 +142,10 @@ struct EyeJob {
     // The display image streams past the caches; the two-pass eye buffer, read right back by
     // its second pass, does not.
     bool stream_output = true;
+    // UCA may interpolate its map on the mesh where the error bound holds (docs/UCA.md, "Mesh
+    // tiles"); the two-pass reference maps every pixel exactly, so the quality bar it sets
+    // does not move.
+    bool mesh = false;
 };
 
 double angleRad(const glm::dvec3& a, const glm::dvec3& b) {
@@ -230,22 +235,20 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
     const int lattice_cols = tile_cols + 1;
     const int points[4] = {ty * lattice_cols + tx, ty * lattice_cols + tx + 1,
                            (ty + 1) * lattice_cols + tx, (ty + 1) * lattice_cols + tx + 1};
-    bool empty = true;
-    double lo_deg = kInf, hi_deg = -kInf;
-    for (int c = 0; c < chroma_count; ++c) {
-        const CornerSample* k[4];
-        int front = 0;
-        double e_min = kInf, e_max = -kInf;
+    auto corners = [&](int c, const CornerSample* k[4]) {
         for (int i = 0; i < 4; ++i) {
             k[i] = &lattice[static_cast<size_t>(points[i]) * static_cast<size_t>(chroma_count) +
                             static_cast<size_t>(c)];
-            front += k[i]->in_front ? 1 : 0;
-            e_min = std::min(e_min, k[i]->e_deg);
-            e_max = std::max(e_max, k[i]->e_deg);
         }
-        auto unit = [](const CornerSample* a) { return glm::dvec3(a->ux, a->uy, a->uz); };
-        const double diag_rad = std::max(smallAngleBoundRad(unit(k[0]), unit(k[3])),
-                                         smallAngleBoundRad(unit(k[1]), unit(k[2])));
+    };
+    // Emptiness first: about half the tiles of a frame are empty and need no eccentricities.
+    bool empty = true;
+    for (int c = 0; c < chroma_count && empty; ++c) {
+        const CornerSample* k[4];
+        corners(c, k);
+        int front = 0;
+        for (int i = 0; i < 4; ++i)
+            front += k[i]->in_front ? 1 : 0;
         bool channel_empty = front == 0;
         if (front == 4) {
             // sqrt of squares: libm's hypot guards against overflow at several times the cost.
@@ -261,7 +264,20 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
             const double y_max = std::max({k[0]->py, k[1]->py, k[2]->py, k[3]->py}) + margin;
             channel_empty = x_max < 0.0 || x_min > width || y_max < 0.0 || y_min > height;
         }
-        empty = empty && channel_empty;
+        empty = channel_empty;
+    }
+    double lo_deg = kInf, hi_deg = -kInf;
+    for (int c = 0; c < chroma_count && !empty; ++c) {
+        const CornerSample* k[4];
+        corners(c, k);
+        double e_min = kInf, e_max = -kInf;
+        for (int i = 0; i < 4; ++i) {
+            e_min = std::min(e_min, k[i]->e_deg);
+            e_max = std::max(e_max, k[i]->e_deg);
+        }
+        auto unit = [](const CornerSample* a) { return glm::dvec3(a->ux, a->uy, a->uz); };
+        const double diag_rad = std::max(smallAngleBoundRad(unit(k[0]), unit(k[3])),
+                                         smallAngleBoundRad(unit(k[1]), unit(k[2])));
         // Eccentricity is convex within the hemisphere around the gaze, so over the tile's
         // (near-geodesic) quadrilateral its maximum is at a corner and its minimum on an edge,
         // or 0 when the gaze is inside; the slack covers the edges' curvature.
@@ -309,6 +325,7 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options,
                                static_cast<size_t>(chroma_count));
         }
     }
+    std::atomic<int64_t> mesh_tiles{0};
     arena.execute([&] {
         if (options.classify_tiles) {
             const int lattice_total = lattice_per_eye * static_cast<int>(jobs.size());
@@ -327,6 +344,7 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options,
         }
         tbb::parallel_for(tbb::blocked_range<int>(0, total, 4),
                           [&](const tbb::blocked_range<int>& r) {
+                              int64_t meshes = 0;
                               for (int i = r.begin(); i < r.end(); ++i) {
                                   const size_t e = static_cast<size_t>(i / per_eye);
                                   const EyeJob& j = jobs[e];
@@ -348,14 +366,20 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options,
                                   t.out = j.out->data();
                                   t.out_stride_px = static_cast<size_t>(j.out->width());
                                   t.stream = j.stream_output;
-                                  if (simd) {
-                                      detail::ucaTileSimd(j.params, t);
-                                  } else {
-                                      detail::ucaTileScalar(j.params, t);
-                                  }
+                                  t.mesh = j.mesh && options.mesh_map;
+                                  const bool meshed = simd ? detail::ucaTileSimd(j.params, t)
+                                                           : detail::ucaTileScalar(j.params, t);
+                                  meshes += meshed ? 1 : 0;
                               }
+                              // Streaming stores are weakly ordered: make this range's visible
+                              // before it counts as done. Once per range, not per tile: each
+                              // fence waits for the write-combining buffers to drain, which
+                              // per tile cost more than a millisecond a frame.
+                              detail::ucaFenceStreams();
+                              mesh_tiles.fetch_add(meshes, std::memory_order_relaxed);
                           });
     });
+    stats.mesh += mesh_tiles.load(std::memory_order_relaxed);
     for (const auto& j : jobs) {
         for (TileKind k : *j.kinds) {
             if (k == TileKind::kEmpty)
@@ -504,6 +528,7 @@ Expected<ComposeReport> Compositor::compose(const LayerFrame& frame, const Pose&
         }
         setBorders(j.params, j.slots);
         ensureSize(out[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
+        j.mesh = true;
         jobs.push_back(std::move(j));
     }
     ComposeReport report;

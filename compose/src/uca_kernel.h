@@ -85,13 +85,92 @@ struct TileJob {
     uint8_t* out = nullptr;
     size_t out_stride_px = 0;
     // Write with streaming (non-temporal) stores where aligned: the display image is written
-    // once and read by someone else, so it need not displace the layers from the caches.
+    // once and read by someone else, so it need not displace the layers from the caches. The
+    // caller fences them (ucaFenceStreams) before it reports the tile done.
     bool stream = false;
+    // Let a single-layer tile interpolate its map on the 8-pixel mesh where the mesh's error is
+    // within kMeshBoundTexels (MeshLattice); false maps every pixel exactly.
+    bool mesh = false;
 };
+
+// Mesh tiles (docs/UCA.md, "Mesh tiles"): the exact map at the nodes (x0 + 8i, y0 + 8j) of a
+// single-layer tile, converted to the layer's texel coordinates, and bilinear interpolation of
+// those in between. A tile qualifies per frame when
+//  * the exact map at every cell centre and edge midpoint (the 9×9 lattice at a 4-pixel step,
+//    nodes at even indices) is within kMeshBoundTexels of the interpolation, in texels;
+//  * every lattice point is at least kMeshMarginPx inside the rendered image (no pixel of the
+//    tile is invalid), and its texel coordinate lies in [kMeshTexelMargin, size − 1 −
+//    kMeshTexelMargin] (the interpolated coordinates then need no clamp).
+// Both kernels evaluate the lattice with the same float arithmetic and decide here.
+inline constexpr int kMeshStepPx = 8;
+static_assert(kTilePx % kMeshStepPx == 0);
+inline constexpr int kMeshCells = kTilePx / kMeshStepPx;
+inline constexpr int kMeshLatticeSide = 2 * kMeshCells + 1;
+inline constexpr int kMeshLatticePoints = kMeshLatticeSide * kMeshLatticeSide;
+// Storage rounded up to whole vectors of the widest target.
+inline constexpr int kMeshLatticeStorage = 96;
+inline constexpr float kMeshBoundTexels = 1.0f / 16.0f;
+inline constexpr float kMeshMarginPx = 1.0f;
+inline constexpr float kMeshTexelMargin = 1.0f / 64.0f;
+
+// The lattice of one tile, row-major (point (i, j) is display pixel (x0 + 4i, y0 + 4j)): the
+// exact rendered-image point — (0, 0) when invalid (off the image, behind the eye), which fails
+// the margin — and its texel coordinate lx = px·inv_scale + offset_x (one fused multiply-add).
+struct MeshLattice {
+    float px[kMeshLatticeStorage];
+    float py[kMeshLatticeStorage];
+    float lx[kMeshLatticeStorage];
+    float ly[kMeshLatticeStorage];
+};
+
+inline bool meshAcceptable(const MeshLattice& m, const KernelParams& p, const KernelLayer& l) {
+    const float max_lx = static_cast<float>(l.width - 1) - kMeshTexelMargin;
+    const float max_ly = static_cast<float>(l.height - 1) - kMeshTexelMargin;
+    for (int k = 0; k < kMeshLatticePoints; ++k) {
+        // Written so that a NaN fails too.
+        if (!(m.px[k] >= kMeshMarginPx && m.px[k] <= p.width - kMeshMarginPx &&
+              m.py[k] >= kMeshMarginPx && m.py[k] <= p.height - kMeshMarginPx &&
+              m.lx[k] >= kMeshTexelMargin && m.lx[k] <= max_lx && m.ly[k] >= kMeshTexelMargin &&
+              m.ly[k] <= max_ly)) {
+            return false;
+        }
+    }
+    constexpr int n = kMeshLatticeSide;
+    // Interpolation at a midpoint from the two (edge) or four (centre) nodes around it.
+    auto within = [&](const float* v, int j, int i) {
+        float interp;
+        if ((i & 1) != 0 && (j & 1) != 0) {
+            interp = 0.25f * ((v[(j - 1) * n + i - 1] + v[(j - 1) * n + i + 1]) +
+                              (v[(j + 1) * n + i - 1] + v[(j + 1) * n + i + 1]));
+        } else if ((i & 1) != 0) {
+            interp = 0.5f * (v[j * n + i - 1] + v[j * n + i + 1]);
+        } else {
+            interp = 0.5f * (v[(j - 1) * n + i] + v[(j + 1) * n + i]);
+        }
+        const float err = v[j * n + i] - interp;
+        return err <= kMeshBoundTexels && err >= -kMeshBoundTexels;
+    };
+    for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+            if (((i | j) & 1) == 0)
+                continue;  // a node
+            if (!within(m.lx, j, i) || !within(m.ly, j, i))
+                return false;
+        }
+    }
+    return true;
+}
 
 inline constexpr uint32_t kOpaqueBlack = 0xFF000000u;
 
-void ucaTileScalar(const KernelParams& p, const TileJob& job);
+// Biased channels (docs/UCA.md): a texel byte c is filtered as the float 2^15 + c, whose bit
+// pattern is kTexelBiasBits | c << 8 — no int → float conversion — and whose 1/256 resolution
+// is kept by every lerp.
+inline constexpr float kTexelBias = 32768.0f;
+inline constexpr uint32_t kTexelBiasBits = 0x47000000u;
+
+// Both return true when the tile used the interpolated (mesh) map.
+bool ucaTileScalar(const KernelParams& p, const TileJob& job);
 // The kernel parameters of the composition pass (identity map) for one eye of a validated frame:
 // its slots and blend ramps, shared with the OpenCV anchor so that all paths blend alike.
 KernelParams composeParams(const HmdProfile& profile, const LayerFrame& frame, int eye,
@@ -113,7 +192,9 @@ SlotInfo slotBands(const HmdProfile& profile, const LayerPlan& plan, int eye,
                    double blend_band_texels);
 // Which plan layer (0 fovea, 1 middle, 2 outer) each kernel slot holds.
 void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count);
-void ucaTileSimd(const KernelParams& p, const TileJob& job);
+bool ucaTileSimd(const KernelParams& p, const TileJob& job);
+// Orders the calling thread's streaming stores before its later stores (sfence).
+void ucaFenceStreams();
 
 }  // namespace qvr::detail
 

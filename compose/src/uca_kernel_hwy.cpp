@@ -117,27 +117,35 @@ HWY_INLINE MapV mapPixels(const KernelParams& p, const RowMap& r, VF u, VF v, fl
     return m;
 }
 
-// Byte c of every RGBA8 texel as a float: one byte shuffle (zeroing the other three bytes of
-// each lane) instead of a shift and a mask.
+// Byte c of every RGBA8 texel as the float kTexelBias + c (docs/UCA.md, "Biased channels"):
+// the byte lands in bits 8–15 of a float whose exponent is 2^15, so one byte shuffle (masked
+// into a constant on AVX-512) replaces a shuffle and an int → float conversion.
 template <int kChannel>
 HWY_INLINE VF channel(VU texel) {
     const DF df;
-    const DI di;
     const DU du;
 #if HWY_TARGET == HWY_SCALAR
-    // One lane cannot be viewed as bytes; shift and mask instead.
-    return hn::ConvertTo(
-        df, hn::BitCast(di, hn::And(hn::ShiftRight<8 * kChannel>(texel), hn::Set(du, 0xFFu))));
+    return hn::BitCast(
+        df,
+        hn::Or(hn::ShiftLeft<8>(hn::And(hn::ShiftRight<8 * kChannel>(texel), hn::Set(du, 0xFFu))),
+               hn::Set(du, kTexelBiasBits)));
 #else
     const hn::Repartition<uint8_t, DU> d8;
     // Shuffle indices are byte positions within each 16-byte block: lane j of a block holds its
-    // texel in bytes 4j…4j+3.
+    // texel in bytes 4j…4j+3; byte 1 of lane j takes byte 4j + c, the others stay zero.
     const VU lane_in_block = hn::And(hn::Iota(du, 0u), hn::Set(du, 3u));
-    const VU index = hn::Add(hn::ShiftLeft<2>(lane_in_block),
-                             hn::Set(du, 0x80808000u | static_cast<uint32_t>(kChannel)));
+    const VU index = hn::Add(hn::ShiftLeft<10>(lane_in_block),
+                             hn::Set(du, 0x80800080u | (static_cast<uint32_t>(kChannel) << 8)));
     const auto pick = hn::BitCast(d8, index);
+#if HWY_TARGET <= HWY_AVX3
+    (void)d8;
+    return hn::BitCast(
+        df, VU{_mm512_mask_shuffle_epi8(hn::Set(du, kTexelBiasBits).raw, 0x2222222222222222ull,
+                                        texel.raw, pick.raw)});
+#else
     const auto bytes = hn::TableLookupBytesOr0(hn::BitCast(d8, texel), pick);
-    return hn::ConvertTo(df, hn::BitCast(di, bytes));
+    return hn::BitCast(df, hn::Or(hn::BitCast(du, bytes), hn::Set(du, kTexelBiasBits)));
+#endif
 #endif
 }
 
@@ -145,7 +153,11 @@ HWY_INLINE VF lerp(VF w, VF a, VF b) {
     return hn::MulAdd(w, hn::Sub(b, a), a);
 }
 
-HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
+// Bilinear RGB of one layer at texel coordinates (lx, ly). kClamp: clamp to the edge. Without
+// it the caller guarantees 0 ≤ lx < width − 1 and 0 ≤ ly < height − 1 (mesh tiles), where the
+// clamps below change nothing.
+template <bool kClamp>
+HWY_INLINE Rgb sampleTexels(const KernelLayer& l, VF lx, VF ly) {
     const DF df;
     const DI di;
     const DU du;
@@ -153,11 +165,11 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
     // of the tap beyond it is 0, and that tap is redirected onto the edge texel.
     const VF max_x = hn::Set(df, static_cast<float>(l.width - 1));
     const VF max_y = hn::Set(df, static_cast<float>(l.height - 1));
-    const VF zero = hn::Zero(df);
-    const VF lx = hn::Min(
-        hn::Max(hn::MulAdd(px, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_x)), zero), max_x);
-    const VF ly = hn::Min(
-        hn::Max(hn::MulAdd(py, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_y)), zero), max_y);
+    if (kClamp) {
+        const VF zero = hn::Zero(df);
+        lx = hn::Min(hn::Max(lx, zero), max_x);
+        ly = hn::Min(hn::Max(ly, zero), max_y);
+    }
     const auto* base = reinterpret_cast<const uint32_t*>(l.texels);
     VU t00, t10, t01, t11;
     VF flx, fly;
@@ -166,8 +178,12 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
         // The two taps of a row are neighbours in memory: fetch them as one 64-bit element, half
         // the gathered elements. The left tap stops one short of the edge, where the weight of
         // the right tap becomes exactly 1, so no fetch passes the end of a row.
-        flx = hn::Min(hn::Floor(lx), hn::Sub(max_x, hn::Set(df, 1.0f)));
-        fly = hn::Min(hn::Floor(ly), hn::Sub(max_y, hn::Set(df, 1.0f)));
+        flx = hn::Floor(lx);
+        fly = hn::Floor(ly);
+        if (kClamp) {
+            flx = hn::Min(flx, hn::Sub(max_x, hn::Set(df, 1.0f)));
+            fly = hn::Min(fly, hn::Sub(max_y, hn::Set(df, 1.0f)));
+        }
         // Texel index in float is exact: layers hold fewer than 2^24 texels (validateFrame).
         const VI i00 = truncToInt(hn::MulAdd(fly, hn::Set(df, static_cast<float>(l.width)), flx));
         const hn::Half<DI> dh;
@@ -214,6 +230,19 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
     return out;
 }
 
+HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
+    const DF df;
+    return sampleTexels<true>(l, hn::MulAdd(px, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_x)),
+                              hn::MulAdd(py, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_y)));
+}
+
+// Biased channels → values (exact: both lie on the same 1/256 grid).
+HWY_INLINE Rgb unbias(const Rgb& c) {
+    const DF df;
+    const VF bias = hn::Set(df, kTexelBias);
+    return {hn::Sub(c.r, bias), hn::Sub(c.g, bias), hn::Sub(c.b, bias)};
+}
+
 // Eq. 4 for a vector of pixels; lanes off the rendered image come back in `valid`.
 HWY_INLINE Rgb shade(const KernelParams& p, const RowMap& r, VF u, VF v, float chroma,
                      uint8_t slot_mask, MF& valid) {
@@ -223,7 +252,7 @@ HWY_INLINE Rgb shade(const KernelParams& p, const RowMap& r, VF u, VF v, float c
     Rgb rgb;
     if (single) {
         const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
-        rgb = sampleLayer(p.slots[k], m.px, m.py);
+        rgb = unbias(sampleLayer(p.slots[k], m.px, m.py));
     } else {
         const VF zero = hn::Zero(df);
         const VF one = hn::Set(df, 1.0f);
@@ -244,7 +273,7 @@ HWY_INLINE Rgb shade(const KernelParams& p, const RowMap& r, VF u, VF v, float c
             // Lanes outside this layer's ramp have weight 0; skip the gathers when all do.
             if (hn::AllFalse(df, hn::Gt(w[k], zero)))
                 continue;
-            const Rgb s = sampleLayer(p.slots[k], m.px, m.py);
+            const Rgb s = unbias(sampleLayer(p.slots[k], m.px, m.py));
             rgb.r = hn::MulAdd(w[k], s.r, rgb.r);
             rgb.g = hn::MulAdd(w[k], s.g, rgb.g);
             rgb.b = hn::MulAdd(w[k], s.b, rgb.b);
@@ -270,9 +299,33 @@ HWY_INLINE VU pack(VF r, VF g, VF b) {
     return hn::Or(packed, hn::Set(du, kOpaqueBlack));
 }
 
+// RGBA8 of biased channels (each kTexelBias + value, value in [0, 255]): adding ½ and keeping
+// bits 8–15 rounds, as quantize() does for unbiased values.
+HWY_INLINE VU packBiased(const Rgb& c) {
+    const DF df;
+    const DU du;
+    const VF half = hn::Set(df, 0.5f);
+    const VU r = hn::BitCast(du, hn::Add(c.r, half));
+    const VU g = hn::BitCast(du, hn::Add(c.g, half));
+    const VU b = hn::BitCast(du, hn::Add(c.b, half));
+    // (r >> 8) holds the red byte in bits 0–7; g its green byte in bits 8–15; (b << 8) its blue
+    // byte in bits 16–23 and zeros above.
+    const VU rg = hn::IfVecThenElse(hn::Set(du, 0xFFu), hn::ShiftRight<8>(r), g);
+    const VU rgb = hn::IfVecThenElse(hn::Set(du, 0xFFFFu), rg, hn::ShiftLeft<8>(b));
+    return hn::Or(rgb, hn::Set(du, kOpaqueBlack));
+}
+
 HWY_INLINE VU shadePacked(const KernelParams& p, const RowMap& r, VF u, VF v, uint8_t slot_mask) {
     const DU du;
     MF valid;
+    if (!p.chroma && (slot_mask & (slot_mask - 1)) == 0) {
+        // One layer: its biased channels go straight to bytes.
+        const MapV m = mapPixels(p, r, u, v, 1.0f, false);
+        const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
+        return hn::IfThenElse(hn::RebindMask(du, m.valid),
+                              packBiased(sampleLayer(p.slots[k], m.px, m.py)),
+                              hn::Set(du, kOpaqueBlack));
+    }
     if (!p.chroma) {
         const Rgb c = shade(p, r, u, v, 1.0f, slot_mask, valid);
         // Off-image lanes become opaque black once, after packing.
@@ -289,9 +342,149 @@ HWY_INLINE VU shadePacked(const KernelParams& p, const RowMap& r, VF u, VF v, ui
     return pack(rv, gv, bv);
 }
 
+// The exact map (steps 1–4, no eccentricity) at the tile's 9×9 lattice (docs/UCA.md, "Mesh
+// tiles"), a vector of lattice points at a time. Each lane has its own row, so the row
+// constants of rowMap() are formed per lane with the same float operations.
+HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const KernelLayer& layer,
+                           MeshLattice& out) {
+    const DF df;
+    const int lanes = static_cast<int>(hn::Lanes(df));
+    HWY_ALIGN static const auto offsets = [] {
+        struct {
+            float u[kMeshLatticeStorage], v[kMeshLatticeStorage];
+        } o{};
+        for (int k = 0; k < kMeshLatticeStorage; ++k) {
+            const int i = k < kMeshLatticePoints ? k % kMeshLatticeSide : 0;
+            const int j = k < kMeshLatticePoints ? k / kMeshLatticeSide : 0;
+            o.u[k] = static_cast<float>(i * (kMeshStepPx / 2));
+            o.v[k] = static_cast<float>(j * (kMeshStepPx / 2));
+        }
+        return o;
+    }();
+    const RowMap r0 = rowMap(p, 0.0f);
+    const VF x0 = hn::Set(df, static_cast<float>(job.x0));
+    const VF y0 = hn::Set(df, static_cast<float>(job.y0));
+    const VF zero = hn::Zero(df);
+    for (int k = 0; k < kMeshLatticeStorage; k += lanes) {
+        const VF u = hn::Add(x0, hn::Load(df, offsets.u + k));
+        const VF v = hn::Add(y0, hn::Load(df, offsets.v + k));
+        const VF yt = hn::Add(hn::Mul(v, hn::Set(df, p.ay)), hn::Set(df, p.by));
+        const VF yt2 = hn::Mul(yt, yt);
+        const VF cx_row = hn::Mul(hn::Set(df, p.fx * p.m[1]), yt);
+        const VF cy_row = hn::Mul(hn::Set(df, -p.fy * p.m[4]), yt);
+        const VF cz_row = hn::Mul(hn::Set(df, p.m[7]), yt);
+        const VF xt = hn::MulAdd(u, hn::Set(df, p.ax), hn::Set(df, p.bx));
+        const VF r2 = hn::MulAdd(xt, xt, yt2);
+        const VF poly = hn::MulAdd(hn::Set(df, p.k2), r2, hn::Set(df, p.k1));
+        const VF f = hn::MulAdd(poly, r2, hn::Set(df, 1.0f));
+        const VF num_x =
+            hn::MulAdd(f, hn::MulAdd(xt, hn::Set(df, r0.mx), cx_row), hn::Set(df, -r0.ox));
+        const VF num_y =
+            hn::MulAdd(f, hn::MulAdd(xt, hn::Set(df, r0.my), cy_row), hn::Set(df, -r0.oy));
+        const VF depth =
+            hn::NegMulAdd(f, hn::MulAdd(xt, hn::Set(df, r0.mz), cz_row), hn::Set(df, r0.dz));
+        const MF front = hn::Gt(depth, hn::Set(df, 1e-6f));
+        const VF iz = hn::Div(hn::Set(df, 1.0f), hn::IfThenElse(front, depth, hn::Set(df, 1.0f)));
+        const VF px = hn::MulAdd(num_x, iz, hn::Set(df, p.cx));
+        const VF py = hn::MulAdd(num_y, iz, hn::Set(df, p.cy));
+        const MF in_x = hn::And(hn::Ge(px, zero), hn::Le(px, hn::Set(df, p.width)));
+        const MF in_y = hn::And(hn::Ge(py, zero), hn::Le(py, hn::Set(df, p.height)));
+        const MF valid = hn::And(front, hn::And(in_x, in_y));
+        const VF vx = hn::IfThenElseZero(valid, px);
+        const VF vy = hn::IfThenElseZero(valid, py);
+        hn::Store(vx, df, out.px + k);
+        hn::Store(vy, df, out.py + k);
+        hn::Store(hn::MulAdd(vx, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_x)), df,
+                  out.lx + k);
+        hn::Store(hn::MulAdd(vy, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_y)), df,
+                  out.ly + k);
+    }
+}
+
+// A mesh tile: the map of every pixel is the bilinear interpolation of the lattice's nodes,
+// first along x on the node rows (h), then along y between them; every pixel is valid.
+HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelLayer& layer) {
+    const DF df;
+    const DU du;
+    const int lanes = static_cast<int>(hn::Lanes(df));
+    constexpr int n = kMeshLatticeSide;
+    HWY_ALIGN static const auto frac = [] {
+        struct {
+            float a[kTilePx];
+        } f{};
+        for (int c = 0; c < kTilePx; ++c)
+            f.a[c] = static_cast<float>(c % kMeshStepPx) * (1.0f / kMeshStepPx);
+        return f;
+    }();
+    HWY_ALIGN float hx[kMeshCells + 1][kTilePx], hy[kMeshCells + 1][kTilePx];
+    HWY_ALIGN float dx[kMeshCells][kTilePx], dy[kMeshCells][kTilePx];
+    const MF upper = hn::Ge(hn::Iota(df, 0.0f), hn::Set(df, static_cast<float>(kMeshStepPx)));
+    // The node of column c's cell (offset 0) or the next (offset 1), per lane.
+    auto node = [&](const float* lattice_row, int c, int offset) {
+        const int cell = c / kMeshStepPx + offset;
+        const VF here = hn::Set(df, lattice_row[2 * cell]);
+        if (lanes <= kMeshStepPx)
+            return here;
+        return hn::IfThenElse(upper, hn::Set(df, lattice_row[2 * cell + 2]), here);
+    };
+    for (int j = 0; j <= kMeshCells; ++j) {
+        const float* rx = m.lx + 2 * j * n;
+        const float* ry = m.ly + 2 * j * n;
+        for (int c = 0; c < kTilePx; c += lanes) {
+            const VF a = hn::Load(df, frac.a + c);
+            const VF lx = node(rx, c, 0), ly = node(ry, c, 0);
+            hn::Store(hn::MulAdd(hn::Sub(node(rx, c, 1), lx), a, lx), df, hx[j] + c);
+            hn::Store(hn::MulAdd(hn::Sub(node(ry, c, 1), ly), a, ly), df, hy[j] + c);
+        }
+    }
+    for (int j = 0; j < kMeshCells; ++j) {
+        for (int c = 0; c < kTilePx; c += lanes) {
+            hn::Store(hn::Sub(hn::Load(df, hx[j + 1] + c), hn::Load(df, hx[j] + c)), df, dx[j] + c);
+            hn::Store(hn::Sub(hn::Load(df, hy[j + 1] + c), hn::Load(df, hy[j] + c)), df, dy[j] + c);
+        }
+    }
+    HWY_ALIGN uint32_t tail[HWY_MAX_BYTES / sizeof(uint32_t)];
+    const uintptr_t vector_bytes = static_cast<uintptr_t>(lanes) * sizeof(uint32_t);
+    for (int y = job.y0; y < job.y1; ++y) {
+        auto* row =
+            reinterpret_cast<uint32_t*>(job.out) + static_cast<size_t>(y) * job.out_stride_px;
+        const int j = (y - job.y0) / kMeshStepPx;
+        const VF b =
+            hn::Set(df, static_cast<float>((y - job.y0) % kMeshStepPx) * (1.0f / kMeshStepPx));
+        for (int x = job.x0; x < job.x1; x += lanes) {
+            const int c = x - job.x0;
+            const VF lx = hn::MulAdd(hn::Load(df, dx[j] + c), b, hn::Load(df, hx[j] + c));
+            const VF ly = hn::MulAdd(hn::Load(df, dy[j] + c), b, hn::Load(df, hy[j] + c));
+            const VU packed = packBiased(sampleTexels<false>(layer, lx, ly));
+            if (x + lanes <= job.x1) {
+                if (job.stream &&
+                    (reinterpret_cast<uintptr_t>(row + x) & (vector_bytes - 1)) == 0) {
+                    hn::Stream(packed, du, row + x);
+                } else {
+                    hn::StoreU(packed, du, row + x);
+                }
+            } else {
+                hn::Store(packed, du, tail);
+                std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
+            }
+        }
+    }
+}
+
 }  // namespace
 
-void UcaTile(const KernelParams& p, const TileJob& job) {
+bool UcaTile(const KernelParams& p, const TileJob& job) {
+    const bool single = job.slot_mask != 0 && (job.slot_mask & (job.slot_mask - 1)) == 0;
+    if (job.mesh && single && !p.identity_map && !p.chroma && job.x1 - job.x0 <= kTilePx &&
+        job.y1 - job.y0 <= kTilePx) {
+        const int k = job.slot_mask == 1 ? 0 : (job.slot_mask == 2 ? 1 : 2);
+        HWY_ALIGN MeshLattice lattice;
+        mapLattice(p, job, p.slots[k], lattice);
+        if (meshAcceptable(lattice, p, p.slots[k])) {
+            meshTile(job, lattice, p.slots[k]);
+            return true;
+        }
+    }
     const DF df;
     const DU du;
     const int lanes = static_cast<int>(hn::Lanes(df));
@@ -324,9 +517,7 @@ void UcaTile(const KernelParams& p, const TileJob& job) {
             }
         }
     }
-    // Streaming stores are weakly ordered: make them visible before the tile counts as done.
-    if (job.stream)
-        hwy::FlushStream();
+    return false;
 }
 
 const char* TargetName() {
@@ -346,8 +537,12 @@ const char* ucaSimdTarget() {
     return HWY_DYNAMIC_DISPATCH(TargetName)();
 }
 
-void ucaTileSimd(const KernelParams& p, const TileJob& job) {
-    HWY_DYNAMIC_DISPATCH(UcaTile)(p, job);
+void ucaFenceStreams() {
+    hwy::FlushStream();
+}
+
+bool ucaTileSimd(const KernelParams& p, const TileJob& job) {
+    return HWY_DYNAMIC_DISPATCH(UcaTile)(p, job);
 }
 }  // namespace qvr::detail
 #endif

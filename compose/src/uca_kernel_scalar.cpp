@@ -64,18 +64,20 @@ uint32_t loadTexel(const KernelLayer& l, int index) {
     return t;
 }
 
+// Byte c of a texel as the biased float kTexelBias + byte (exact), as the vector kernel forms it.
 float channelOf(uint32_t texel, int c) {
-    return static_cast<float>((texel >> (8 * c)) & 0xFFu);
+    return kTexelBias + static_cast<float>((texel >> (8 * c)) & 0xFFu);
 }
 
-// Bilinear, clamp-to-edge, RGB of one layer at a rendered-image point.
-void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
+// Bilinear, clamp-to-edge, RGB of one layer at a texel coordinate, biased (kTexelBias + value).
+void sampleTexels(const KernelLayer& l, float lx_in, float ly_in, float rgb[3]) {
     // Clamping the texel coordinate to [0, size − 1] is clamp-to-edge: at the edge the weight
-    // of the tap beyond it is 0, and that tap is redirected onto the edge texel.
+    // of the tap beyond it is 0, and that tap is redirected onto the edge texel. (The vector
+    // kernel's mesh tiles skip the clamps where they change nothing.)
     const float max_x = static_cast<float>(l.width - 1);
     const float max_y = static_cast<float>(l.height - 1);
-    const float lx = std::min(std::max(std::fma(px, l.inv_scale, l.offset_x), 0.0f), max_x);
-    const float ly = std::min(std::max(std::fma(py, l.inv_scale, l.offset_y), 0.0f), max_y);
+    const float lx = std::min(std::max(lx_in, 0.0f), max_x);
+    const float ly = std::min(std::max(ly_in, 0.0f), max_y);
     float flx = std::floor(lx);
     float fly = std::floor(ly);
     int dx = flx < max_x ? 1 : 0;
@@ -108,6 +110,12 @@ void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
     }
 }
 
+// Bilinear, clamp-to-edge, biased RGB of one layer at a rendered-image point.
+void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
+    sampleTexels(l, std::fma(px, l.inv_scale, l.offset_x), std::fma(py, l.inv_scale, l.offset_y),
+                 rgb);
+}
+
 // Eq. 4 for one pixel: the slots the tile may touch, weighted by the blend ramps.
 bool shade(const KernelParams& p, const RowMap& r, float u, float v, float chroma,
            uint8_t slot_mask, float rgb[3]) {
@@ -118,6 +126,8 @@ bool shade(const KernelParams& p, const RowMap& r, float u, float v, float chrom
     if ((slot_mask & (slot_mask - 1)) == 0) {
         const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
         sampleLayer(p.slots[k], m.px, m.py, rgb);
+        for (int c = 0; c < 3; ++c)
+            rgb[c] -= kTexelBias;
         return true;
     }
     const float t1 = std::min(std::max((p.border_c_hi[0] - m.cos_e) * p.border_inv[0], 0.0f), 1.0f);
@@ -129,7 +139,7 @@ bool shade(const KernelParams& p, const RowMap& r, float u, float v, float chrom
         float s[3];
         sampleLayer(p.slots[k], m.px, m.py, s);
         for (int c = 0; c < 3; ++c)
-            rgb[c] = std::fma(w[k], s[c], rgb[c]);
+            rgb[c] = std::fma(w[k], s[c] - kTexelBias, rgb[c]);
     }
     return true;
 }
@@ -139,9 +149,75 @@ uint32_t quantize(float value) {
     return static_cast<uint32_t>(static_cast<int>(value + 0.5f));
 }
 
+// A biased channel (kTexelBias + value) to its byte: +0.5, then bits 8–15 of the float.
+uint32_t quantizeBiased(float biased) {
+    uint32_t bits;
+    const float rounded = biased + 0.5f;
+    std::memcpy(&bits, &rounded, sizeof bits);
+    return (bits >> 8) & 0xFFu;
+}
+
+uint32_t packBiased(const float rgb[3]) {
+    return kOpaqueBlack | quantizeBiased(rgb[0]) | (quantizeBiased(rgb[1]) << 8) |
+           (quantizeBiased(rgb[2]) << 16);
+}
+
+// The tile's 9×9 lattice of exact maps (docs/UCA.md, "Mesh tiles"), point by point.
+void mapLattice(const KernelParams& p, const TileJob& job, const KernelLayer& layer,
+                MeshLattice& out) {
+    for (int k = 0; k < kMeshLatticePoints; ++k) {
+        const float u = static_cast<float>(job.x0 + (k % kMeshLatticeSide) * (kMeshStepPx / 2));
+        const float v = static_cast<float>(job.y0 + (k / kMeshLatticeSide) * (kMeshStepPx / 2));
+        const Mapped m = mapPixel(p, rowMap(p, v), u, v, 1.0f);
+        out.px[k] = m.px;
+        out.py[k] = m.py;
+        out.lx[k] = std::fma(m.px, layer.inv_scale, layer.offset_x);
+        out.ly[k] = std::fma(m.py, layer.inv_scale, layer.offset_y);
+    }
+}
+
+// A pixel of a mesh tile: the nodes of its cell interpolated along x on both node rows, then
+// along y, in the vector kernel's order.
+void meshPoint(const MeshLattice& m, int c, int r, float& lx, float& ly) {
+    constexpr int n = kMeshLatticeSide;
+    const int i = 2 * (c / kMeshStepPx);
+    const int j = 2 * (r / kMeshStepPx);
+    const float a = static_cast<float>(c % kMeshStepPx) * (1.0f / kMeshStepPx);
+    const float b = static_cast<float>(r % kMeshStepPx) * (1.0f / kMeshStepPx);
+    auto lerp2 = [&](const float* v) {
+        const float* top = v + j * n + i;
+        const float* bottom = v + (j + 2) * n + i;
+        const float h0 = std::fma(top[2] - top[0], a, top[0]);
+        const float h1 = std::fma(bottom[2] - bottom[0], a, bottom[0]);
+        return std::fma(h1 - h0, b, h0);
+    };
+    lx = lerp2(m.lx);
+    ly = lerp2(m.ly);
+}
+
 }  // namespace
 
-void ucaTileScalar(const KernelParams& p, const TileJob& job) {
+bool ucaTileScalar(const KernelParams& p, const TileJob& job) {
+    const bool single = job.slot_mask != 0 && (job.slot_mask & (job.slot_mask - 1)) == 0;
+    if (job.mesh && single && !p.identity_map && !p.chroma && job.x1 - job.x0 <= kTilePx &&
+        job.y1 - job.y0 <= kTilePx) {
+        const KernelLayer& layer = p.slots[job.slot_mask == 1 ? 0 : (job.slot_mask == 2 ? 1 : 2)];
+        MeshLattice lattice;
+        mapLattice(p, job, layer, lattice);
+        if (meshAcceptable(lattice, p, layer)) {
+            for (int y = job.y0; y < job.y1; ++y) {
+                uint8_t* row = job.out + static_cast<size_t>(y) * job.out_stride_px * 4;
+                for (int x = job.x0; x < job.x1; ++x) {
+                    float lx, ly, rgb[3];
+                    meshPoint(lattice, x - job.x0, y - job.y0, lx, ly);
+                    sampleTexels(layer, lx, ly, rgb);
+                    const uint32_t packed = packBiased(rgb);
+                    std::memcpy(row + static_cast<size_t>(x) * 4, &packed, sizeof packed);
+                }
+            }
+            return true;
+        }
+    }
     for (int y = job.y0; y < job.y1; ++y) {
         uint8_t* row = job.out + static_cast<size_t>(y) * job.out_stride_px * 4;
         const float v = static_cast<float>(y);
@@ -149,7 +225,16 @@ void ucaTileScalar(const KernelParams& p, const TileJob& job) {
         for (int x = job.x0; x < job.x1; ++x) {
             const float u = static_cast<float>(x);
             uint32_t packed = kOpaqueBlack;
-            if (job.slot_mask != 0) {
+            if (job.slot_mask != 0 && !p.chroma && single) {
+                // One layer: its biased channels go straight to bytes, as in the vector kernel.
+                const Mapped m = mapPixel(p, r, u, v, 1.0f);
+                if (m.valid) {
+                    float rgb[3];
+                    sampleLayer(p.slots[job.slot_mask == 1 ? 0 : (job.slot_mask == 2 ? 1 : 2)],
+                                m.px, m.py, rgb);
+                    packed = packBiased(rgb);
+                }
+            } else if (job.slot_mask != 0) {
                 float rgb[3];
                 if (!p.chroma) {
                     shade(p, r, u, v, 1.0f, job.slot_mask, rgb);
@@ -168,6 +253,7 @@ void ucaTileScalar(const KernelParams& p, const TileJob& job) {
             std::memcpy(row + static_cast<size_t>(x) * 4, &packed, sizeof packed);
         }
     }
+    return false;
 }
 
 }  // namespace qvr::detail

@@ -49,6 +49,9 @@ struct ComposeOptions {
     // Classify tiles (the fast path). False shades every tile as a border tile with every layer,
     // the check that classification never changes a pixel.
     bool classify_tiles = true;
+    // Let single-layer tiles interpolate the map on an 8-pixel mesh wherever its error stays
+    // within 1/16 texel (docs/UCA.md, "Mesh tiles"); false maps every pixel exactly.
+    bool mesh_map = true;
     // Worker threads for the tile loop; 0 lets oneTBB use every core.
     int threads = 0;
 };
@@ -61,6 +64,7 @@ struct TileStats {
     int64_t empty = 0;
     int64_t single = 0;
     int64_t border = 0;
+    int64_t mesh = 0;  // single-layer tiles that used the interpolated map (a subset of single)
     int64_t total() const { return empty + single + border; }
 };
 
