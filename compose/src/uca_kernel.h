@@ -163,11 +163,12 @@ inline bool meshAcceptable(const MeshLattice& m, const KernelParams& p, const Ke
 
 inline constexpr uint32_t kOpaqueBlack = 0xFF000000u;
 
-// Biased channels (docs/UCA.md): a texel byte c is filtered as the float 2^15 + c, whose bit
+// Biased channels (docs/UCA.md): a texel byte c is filtered as the float 2^15 + ½ + c, whose bit
 // pattern is kTexelBiasBits | c << 8 — no int → float conversion — and whose 1/256 resolution
-// is kept by every lerp.
-inline constexpr float kTexelBias = 32768.0f;
-inline constexpr uint32_t kTexelBiasBits = 0x47000000u;
+// is kept by every lerp. The ½ rides along (lerps of values that share it keep it), so bits
+// 8–15 of a filtered value are already its rounded byte.
+inline constexpr float kTexelBias = 32768.5f;
+inline constexpr uint32_t kTexelBiasBits = 0x47000080u;
 
 // Both return true when the tile used the interpolated (mesh) map.
 bool ucaTileScalar(const KernelParams& p, const TileJob& job);

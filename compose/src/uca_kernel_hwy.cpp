@@ -186,6 +186,17 @@ HWY_INLINE Rgb sampleTexels(const KernelLayer& l, VF lx, VF ly) {
         }
         // Texel index in float is exact: layers hold fewer than 2^24 texels (validateFrame).
         const VI i00 = truncToInt(hn::MulAdd(fly, hn::Set(df, static_cast<float>(l.width)), flx));
+        VU r0_lo, r0_hi, r1_lo, r1_hi;
+#if HWY_TARGET <= HWY_AVX3
+        // 32-bit texel indices scaled by 4 bytes in the gather itself: no widening, no shifts.
+        const VI i01 = hn::Add(i00, hn::Set(di, l.width));
+        const __m256i i00_hi = _mm512_extracti64x4_epi64(i00.raw, 1);
+        const __m256i i01_hi = _mm512_extracti64x4_epi64(i01.raw, 1);
+        r0_lo = VU{_mm512_i32gather_epi64(_mm512_castsi512_si256(i00.raw), l.texels, 4)};
+        r0_hi = VU{_mm512_i32gather_epi64(i00_hi, l.texels, 4)};
+        r1_lo = VU{_mm512_i32gather_epi64(_mm512_castsi512_si256(i01.raw), l.texels, 4)};
+        r1_hi = VU{_mm512_i32gather_epi64(i01_hi, l.texels, 4)};
+#else
         const hn::Half<DI> dh;
         const hn::Repartition<uint64_t, DU> d64;
         const hn::RebindToSigned<decltype(d64)> di64;
@@ -193,10 +204,11 @@ HWY_INLINE Rgb sampleTexels(const KernelLayer& l, VF lx, VF ly) {
         const auto lo = hn::ShiftLeft<2>(hn::PromoteTo(di64, hn::LowerHalf(dh, i00)));
         const auto hi = hn::ShiftLeft<2>(hn::PromoteTo(di64, hn::UpperHalf(dh, i00)));
         const auto row_bytes = hn::Set(di64, int64_t{4} * l.width);
-        const VU r0_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, lo));
-        const VU r0_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hi));
-        const VU r1_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(lo, row_bytes)));
-        const VU r1_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(hi, row_bytes)));
+        r0_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, lo));
+        r0_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hi));
+        r1_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(lo, row_bytes)));
+        r1_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(hi, row_bytes)));
+#endif
         t00 = hn::ConcatEven(du, r0_hi, r0_lo);
         t10 = hn::ConcatOdd(du, r0_hi, r0_lo);
         t01 = hn::ConcatEven(du, r1_hi, r1_lo);
@@ -236,7 +248,7 @@ HWY_INLINE Rgb sampleLayer(const KernelLayer& l, VF px, VF py) {
                               hn::MulAdd(py, hn::Set(df, l.inv_scale), hn::Set(df, l.offset_y)));
 }
 
-// Biased channels → values (exact: both lie on the same 1/256 grid).
+// Biased channels → values (exact: both lie on the same 1/256 grid within a factor of 2).
 HWY_INLINE Rgb unbias(const Rgb& c) {
     const DF df;
     const VF bias = hn::Set(df, kTexelBias);
@@ -299,15 +311,13 @@ HWY_INLINE VU pack(VF r, VF g, VF b) {
     return hn::Or(packed, hn::Set(du, kOpaqueBlack));
 }
 
-// RGBA8 of biased channels (each kTexelBias + value, value in [0, 255]): adding ½ and keeping
-// bits 8–15 rounds, as quantize() does for unbiased values.
+// RGBA8 of biased channels (each kTexelBias + value, value in [0, 255]): bits 8–15 of each are
+// the rounded byte, as quantize() gives for unbiased values.
 HWY_INLINE VU packBiased(const Rgb& c) {
-    const DF df;
     const DU du;
-    const VF half = hn::Set(df, 0.5f);
-    const VU r = hn::BitCast(du, hn::Add(c.r, half));
-    const VU g = hn::BitCast(du, hn::Add(c.g, half));
-    const VU b = hn::BitCast(du, hn::Add(c.b, half));
+    const VU r = hn::BitCast(du, c.r);
+    const VU g = hn::BitCast(du, c.g);
+    const VU b = hn::BitCast(du, c.b);
     // (r >> 8) holds the red byte in bits 0–7; g its green byte in bits 8–15; (b << 8) its blue
     // byte in bits 16–23 and zeros above.
     const VU rg = hn::IfVecThenElse(hn::Set(du, 0xFFu), hn::ShiftRight<8>(r), g);

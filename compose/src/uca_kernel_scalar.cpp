@@ -149,11 +149,10 @@ uint32_t quantize(float value) {
     return static_cast<uint32_t>(static_cast<int>(value + 0.5f));
 }
 
-// A biased channel (kTexelBias + value) to its byte: +0.5, then bits 8–15 of the float.
+// A biased channel (kTexelBias + value, the ½ included) to its rounded byte: bits 8–15.
 uint32_t quantizeBiased(float biased) {
     uint32_t bits;
-    const float rounded = biased + 0.5f;
-    std::memcpy(&bits, &rounded, sizeof bits);
+    std::memcpy(&bits, &biased, sizeof bits);
     return (bits >> 8) & 0xFFu;
 }
 
