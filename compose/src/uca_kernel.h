@@ -121,8 +121,12 @@ struct MeshLattice {
     float py[kMeshLatticeStorage];
     float lx[kMeshLatticeStorage];
     float ly[kMeshLatticeStorage];
+    // The vector kernel reads neighbours up to a lattice row and one point past the end of ly.
+    float tail[16];
 };
 
+// The scalar statement of the test; the vector kernel evaluates the same comparisons on the
+// same floats a vector of lattice points at a time (meshAcceptableV) and must agree.
 inline bool meshAcceptable(const MeshLattice& m, const KernelParams& p, const KernelLayer& l) {
     const float max_lx = static_cast<float>(l.width - 1) - kMeshTexelMargin;
     const float max_ly = static_cast<float>(l.height - 1) - kMeshTexelMargin;

@@ -375,6 +375,8 @@ HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const Kern
     const VF x0 = hn::Set(df, static_cast<float>(job.x0));
     const VF y0 = hn::Set(df, static_cast<float>(job.y0));
     const VF zero = hn::Zero(df);
+    for (int k = 0; k < 16; k += lanes)
+        hn::StoreU(zero, df, out.tail + k);
     for (int k = 0; k < kMeshLatticeStorage; k += lanes) {
         const VF u = hn::Add(x0, hn::Load(df, offsets.u + k));
         const VF v = hn::Add(y0, hn::Load(df, offsets.v + k));
@@ -409,6 +411,74 @@ HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const Kern
         hn::Store(hn::MulAdd(vy, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_y)), df,
                   out.ly + k);
     }
+}
+
+// meshAcceptable() a vector of lattice points at a time: the same comparisons on the same
+// floats (each midpoint's interpolation is formed exactly as there), lanes selected by the
+// point's kind — node, horizontal or vertical edge midpoint, cell centre.
+HWY_INLINE bool meshAcceptableV(const MeshLattice& m, const KernelParams& p, const KernelLayer& l) {
+    const DF df;
+    const DU du;
+    const int lanes = static_cast<int>(hn::Lanes(df));
+    HWY_ALIGN static const auto kinds = [] {
+        struct {
+            uint32_t point[kMeshLatticeStorage], h[kMeshLatticeStorage], v[kMeshLatticeStorage],
+                c[kMeshLatticeStorage];
+        } t{};
+        for (int k = 0; k < kMeshLatticePoints; ++k) {
+            const int i = k % kMeshLatticeSide, j = k / kMeshLatticeSide;
+            t.point[k] = ~0u;
+            t.h[k] = (i & 1) != 0 && (j & 1) == 0 ? ~0u : 0u;
+            t.v[k] = (i & 1) == 0 && (j & 1) != 0 ? ~0u : 0u;
+            t.c[k] = (i & 1) != 0 && (j & 1) != 0 ? ~0u : 0u;
+        }
+        return t;
+    }();
+    constexpr int n = kMeshLatticeSide;
+    const VF margin = hn::Set(df, kMeshMarginPx);
+    const VF max_px = hn::Set(df, p.width - kMeshMarginPx);
+    const VF max_py = hn::Set(df, p.height - kMeshMarginPx);
+    const VF tmargin = hn::Set(df, kMeshTexelMargin);
+    const VF max_lx = hn::Set(df, static_cast<float>(l.width - 1) - kMeshTexelMargin);
+    const VF max_ly = hn::Set(df, static_cast<float>(l.height - 1) - kMeshTexelMargin);
+    const VF bound = hn::Set(df, kMeshBoundTexels);
+    const VF neg_bound = hn::Set(df, -kMeshBoundTexels);
+    const VF half = hn::Set(df, 0.5f);
+    const VF quarter = hn::Set(df, 0.25f);
+    auto within = [&](VF err) { return hn::And(hn::Le(err, bound), hn::Ge(err, neg_bound)); };
+    // Lanes of kind `kind` whose error is outside the bound, for one coordinate.
+    auto bad = [&](const float* v, int k, VU h, VU vert, VU c) {
+        const VF x = hn::Load(df, v + k);
+        const VF eh =
+            hn::Sub(x, hn::Mul(half, hn::Add(hn::LoadU(df, v + k - 1), hn::LoadU(df, v + k + 1))));
+        const VF ev =
+            hn::Sub(x, hn::Mul(half, hn::Add(hn::LoadU(df, v + k - n), hn::LoadU(df, v + k + n))));
+        const VF ec = hn::Sub(
+            x,
+            hn::Mul(quarter,
+                    hn::Add(hn::Add(hn::LoadU(df, v + k - n - 1), hn::LoadU(df, v + k - n + 1)),
+                            hn::Add(hn::LoadU(df, v + k + n - 1), hn::LoadU(df, v + k + n + 1)))));
+        const auto fh = hn::AndNot(hn::RebindMask(du, within(eh)), hn::MaskFromVec(h));
+        const auto fv = hn::AndNot(hn::RebindMask(du, within(ev)), hn::MaskFromVec(vert));
+        const auto fc = hn::AndNot(hn::RebindMask(du, within(ec)), hn::MaskFromVec(c));
+        return hn::Or(fh, hn::Or(fv, fc));
+    };
+    for (int k = 0; k < kMeshLatticeStorage; k += lanes) {
+        const VF px = hn::Load(df, m.px + k), py = hn::Load(df, m.py + k);
+        const VF lx = hn::Load(df, m.lx + k), ly = hn::Load(df, m.ly + k);
+        const auto inside = hn::And(hn::And(hn::And(hn::Ge(px, margin), hn::Le(px, max_px)),
+                                            hn::And(hn::Ge(py, margin), hn::Le(py, max_py))),
+                                    hn::And(hn::And(hn::Ge(lx, tmargin), hn::Le(lx, max_lx)),
+                                            hn::And(hn::Ge(ly, tmargin), hn::Le(ly, max_ly))));
+        const VU point = hn::Load(du, kinds.point + k);
+        const VU h = hn::Load(du, kinds.h + k), vert = hn::Load(du, kinds.v + k),
+                 c = hn::Load(du, kinds.c + k);
+        auto fail = hn::AndNot(hn::RebindMask(du, inside), hn::MaskFromVec(point));
+        fail = hn::Or(fail, hn::Or(bad(m.lx, k, h, vert, c), bad(m.ly, k, h, vert, c)));
+        if (!hn::AllFalse(du, fail))
+            return false;
+    }
+    return true;
 }
 
 // A mesh tile: the map of every pixel is the bilinear interpolation of the lattice's nodes,
@@ -490,7 +560,7 @@ bool UcaTile(const KernelParams& p, const TileJob& job) {
         const int k = job.slot_mask == 1 ? 0 : (job.slot_mask == 2 ? 1 : 2);
         HWY_ALIGN MeshLattice lattice;
         mapLattice(p, job, p.slots[k], lattice);
-        if (meshAcceptable(lattice, p, p.slots[k])) {
+        if (meshAcceptableV(lattice, p, p.slots[k])) {
             meshTile(job, lattice, p.slots[k]);
             return true;
         }
