@@ -146,7 +146,37 @@ struct EyeJob {
     // tiles"); the two-pass reference maps every pixel exactly, so the quality bar it sets
     // does not move.
     bool mesh = false;
+    // Stream the layers into the caches before the tiles gather from them (UCA; the two-pass
+    // passes read their inputs back warm or are the eye buffer itself).
+    bool prefetch_layers = false;
 };
+
+// Reads every cache line of the jobs' layers once, split over the arena's threads: sequential
+// reads the hardware prefetchers stream at full bandwidth, where the tiles' gathers would each
+// wait for memory. The layers are UCA's compulsory reads; this only moves them earlier.
+void prefetchLayers(const std::vector<EyeJob>& jobs) {
+    constexpr size_t kChunkBytes = size_t{64} << 10;
+    struct Span {
+        const uint8_t* data;
+        size_t bytes;
+    };
+    std::vector<Span> spans;
+    for (const EyeJob& j : jobs) {
+        if (!j.prefetch_layers)
+            continue;
+        for (int k = 0; k < j.params.slot_count; ++k) {
+            const detail::KernelLayer& l = j.params.slots[k];
+            const size_t bytes =
+                size_t{4} * static_cast<size_t>(l.width) * static_cast<size_t>(l.height);
+            for (size_t off = 0; off < bytes; off += kChunkBytes)
+                spans.push_back({l.texels + off, std::min(kChunkBytes, bytes - off)});
+        }
+    }
+    tbb::parallel_for(size_t{0}, spans.size(), [&](size_t i) {
+        for (size_t off = 0; off < spans[i].bytes; off += 64)
+            __builtin_prefetch(spans[i].data + off, 0, 3);
+    });
+}
 
 double angleRad(const glm::dvec3& a, const glm::dvec3& b) {
     // atan2 of |a×b| and a·b stays accurate for small angles.
@@ -327,6 +357,7 @@ void runJobs(std::vector<EyeJob>& jobs, const ComposeOptions& options,
     }
     std::atomic<int64_t> mesh_tiles{0};
     arena.execute([&] {
+        prefetchLayers(jobs);
         if (options.classify_tiles) {
             const int lattice_total = lattice_per_eye * static_cast<int>(jobs.size());
             tbb::parallel_for(tbb::blocked_range<int>(0, lattice_total, 64),
@@ -529,6 +560,7 @@ Expected<ComposeReport> Compositor::compose(const LayerFrame& frame, const Pose&
         setBorders(j.params, j.slots);
         ensureSize(out[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
         j.mesh = true;
+        j.prefetch_layers = true;
         jobs.push_back(std::move(j));
     }
     ComposeReport report;
