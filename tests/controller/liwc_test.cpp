@@ -284,5 +284,169 @@ TEST(LiwcPolicy, KeepsE1WithinLimitsWhenPushedHard) {
     EXPECT_LT(d.e1_deg, 5.0);
 }
 
+// A pipelined headset decides frame n+1 before it observes frame n. Each observation must fold
+// into the entry of its own decision — (that frame's motion code, its e1's bucket) — not into the
+// newest one's.
+TEST(LiwcPolicy, FoldsEachObservationIntoItsOwnDecisionWhenObservationsLagAFrame) {
+    const Fixture w;
+    LiwcConfig c;
+    c.interpolate = false;
+    c.table_warmup_frames = 0;  // fold from the first observation
+    c.alpha = 0.3f;
+    LiwcPolicy liwc(w.header, c);
+    // Frame 0 has no predecessor: motion code 0 at the initial 5° (bucket 1).
+    const WorkloadFrame f0 = w.frame;
+    const Decision d0 = liwc.decide(f0);
+    ASSERT_EQ(liwc.lastMotion(), 0);
+    const uint16_t m0 = 0;
+    const int b0 = LiwcTable::bucketOf(d0.e1_deg);
+    // Frame 1 turns the head: another motion code, whose offsets push e1 up by the +5 tag into
+    // another bucket.
+    WorkloadFrame f1 = w.frame;
+    f1.head.orientation = quatFromEulerDeg({14, 2, 0});
+    const uint16_t m1 = encodeMotion(f0.head, f1.head, f0.gaze, f1.gaze, c.motion);
+    ASSERT_NE(m1, m0);
+    for (int b = 0; b < LiwcTable::kEccentricityBuckets; ++b)
+        liwc.table().setOffsetMs(m1, b, 1000.0f);
+    const Decision d1 = liwc.decide(f1);
+    ASSERT_EQ(liwc.lastMotion(), m1);
+    ASSERT_DOUBLE_EQ(d1.e1_deg, d0.e1_deg + 5.0);
+    const int b1 = LiwcTable::bucketOf(d1.e1_deg);
+    ASSERT_NE(b1, b0);
+
+    auto fp16Near = [](double expect) { return std::fabs(expect) * std::ldexp(1.0, -10) + 1e-3; };
+    // Frame 0's measurement: its delta lands in (m0, b0); frame 1's cell keeps its 1000 ms.
+    liwc.observe(measure(f0, d0, 0, 3.0, 9.0));
+    const double delta0 = (9.0 - 3.0) - (d0.t_remote_pred_ms - d0.t_local_pred_ms);
+    EXPECT_NEAR(liwc.table().offsetMs(m0, b0), c.alpha * delta0, fp16Near(c.alpha * delta0));
+    EXPECT_EQ(liwc.table().offsetMs(m1, b1), 1000.0f);
+    EXPECT_EQ(liwc.table().offsetMs(m1, b0), 1000.0f);
+    EXPECT_EQ(liwc.table().offsetMs(m0, b1), 0.0f);
+    // Frame 1's measurement: into (m1, b1), and frame 0's cell is left as it was.
+    const float cell0 = liwc.table().offsetMs(m0, b0);
+    liwc.observe(measure(f1, d1, 1, 7.0, 2.0));
+    const double delta1 = (2.0 - 7.0) - (d1.t_remote_pred_ms - d1.t_local_pred_ms);
+    const double expect1 = (1.0 - c.alpha) * 1000.0 + c.alpha * delta1;
+    EXPECT_NEAR(liwc.table().offsetMs(m1, b1), expect1, fp16Near(expect1));
+    EXPECT_EQ(liwc.table().offsetMs(m0, b0), cell0);
+    EXPECT_EQ(liwc.table().offsetMs(m1, b0), 1000.0f);
+}
+
+// With one decision in flight, the next candidates step from the newest decision: an observation
+// of an older frame must not pull e1 back to what that frame used.
+TEST(LiwcPolicy, StepsFromTheNewestDecisionWhenObservationsLagAFrame) {
+    const Fixture w;
+    LiwcConfig c;
+    c.interpolate = false;
+    c.table_warmup_frames = 1000;  // keep the offsets as set
+    LiwcPolicy liwc(w.header, c);
+    // The same frame every time: motion code 0, whose offsets make every tag remote-bound.
+    for (int b = 0; b < LiwcTable::kEccentricityBuckets; ++b)
+        liwc.table().setOffsetMs(0, b, 1000.0f);
+    std::vector<Decision> decided;
+    decided.push_back(liwc.decide(w.frame));  // 5°, the initial e1
+    decided.push_back(liwc.decide(w.frame));  // 10°
+    for (int i = 0; i < 5; ++i) {
+        // Observe frame i (its e1 lags the newest decision by one +5 tag), then decide i + 2.
+        const Decision& seen = decided[static_cast<size_t>(i)];
+        liwc.observe(measure(w.frame, seen, i, 5.0, 5.0));
+        decided.push_back(liwc.decide(w.frame));
+    }
+    ASSERT_EQ(decided.size(), 7u);
+    for (size_t k = 0; k < decided.size(); ++k)
+        EXPECT_DOUBLE_EQ(decided[k].e1_deg, 5.0 + 5.0 * double(k)) << "decision " << k;
+    // Once nothing later is open, the measured e1 is where the next step starts.
+    liwc.observe(measure(w.frame, decided[5], 5, 5.0, 5.0));
+    Decision last = decided.back();
+    last.e1_deg = 12.0;  // the headset ran frame 6 at another e1 than decided
+    liwc.observe(measure(w.frame, last, 6, 5.0, 5.0));
+    EXPECT_DOUBLE_EQ(liwc.decide(w.frame).e1_deg, 17.0);
+}
+
+// learn_remote_base: the part of the measured T_remote beyond Eq. 2's transmission of the bytes
+// actually sent, as a running mean with weight rate_ema, added to every remote prediction.
+TEST(LiwcPolicy, AddsTheLearnedRemoteBaseOnlyWhenConfigured) {
+    const Fixture w;
+    // 250 000 bytes at the initial 200 Mbit/s take 10 ms to send; the server took 60 ms in all.
+    auto measurement = [](int64_t i, double t_remote_ms) {
+        FrameMeasurement m;
+        m.index = i;
+        m.e1_deg = 10.0;
+        m.t_local_ms = 0.0;        // leave the GPU estimates alone
+        m.throughput_bps = 0.0;    // and the throughput
+        m.middle_bytes = 250'000;  // no pixel counts: the bits-per-pixel fit is left alone too
+        m.t_remote_ms = t_remote_ms;
+        return m;
+    };
+    for (bool learn : {false, true}) {
+        LiwcConfig c;
+        c.learn_remote_base = learn;
+        LiwcPolicy liwc(w.header, c);
+        const double before = liwc.predictRemoteMs(w.frame, 10.0);
+        ASSERT_GT(before, 0.0);
+        int n = 0;
+        for (; n < 12; ++n) {
+            liwc.decide(w.frame);
+            liwc.observe(measurement(n, 60.0));
+        }
+        const double after = liwc.predictRemoteMs(w.frame, 10.0);
+        if (!learn) {
+            EXPECT_DOUBLE_EQ(after, before);
+            continue;
+        }
+        // The running mean of 50 ms after 12 halvings of its distance to it.
+        const double base = 50.0 * (1.0 - std::pow(1.0 - c.rate_ema, n));
+        EXPECT_NEAR(after - before, base, 1e-9 * base);
+        // The same base rides on every candidate, including one that sends more.
+        EXPECT_NEAR(liwc.predictRemoteMs(w.frame, 3.0) - (after - before),
+                    LiwcPolicy(w.header).predictRemoteMs(w.frame, 3.0), 1e-9);
+        // A T_remote below the transmission time teaches a base of 0, never a negative one.
+        for (int k = 0; k < 60; ++k)
+            liwc.observe(measurement(n + k, 4.0));
+        EXPECT_NEAR(liwc.predictRemoteMs(w.frame, 10.0), before, 1e-9 * before);
+        EXPECT_GE(liwc.predictRemoteMs(w.frame, 10.0), before);
+    }
+}
+
+// A caller that decides without observing keeps at most a few open decisions (liwc.h's
+// kMaxPendingDecisions, 8): later observations fold into the newest ones, and once they are used
+// up the next observation folds nothing and sets the e1 the next step starts from.
+TEST(LiwcPolicy, KeepsABoundedQueueWhenDecidingWithoutObserving) {
+    constexpr int kMaxPending = 8;
+    const Fixture w;
+    LiwcConfig c;
+    c.interpolate = false;
+    c.table_warmup_frames = 0;
+    LiwcPolicy liwc(w.header, c);
+    Decision d;
+    for (int i = 0; i < 100; ++i) {
+        d = liwc.decide(w.frame);
+        ASSERT_GE(d.e1_deg, c.e1_min_deg);
+        ASSERT_LE(d.e1_deg, c.e1_max_deg);
+    }
+    auto snapshot = [&liwc] {
+        std::vector<float> v;
+        for (int b = 0; b < LiwcTable::kEccentricityBuckets; ++b)
+            v.push_back(liwc.table().offsetMs(0, b));
+        return v;
+    };
+    int folds = 0;
+    for (int i = 0; i < 20; ++i) {
+        const std::vector<float> before = snapshot();
+        Decision ran = d;
+        ran.e1_deg = 20.0;
+        liwc.observe(measure(w.frame, ran, i, 1.0, 90.0));
+        if (snapshot() == before)
+            break;
+        ++folds;
+    }
+    EXPECT_EQ(folds, kMaxPending);
+    // The observation that folded nothing set e1: the candidates are centred on 20°.
+    liwc.decide(w.frame);
+    EXPECT_DOUBLE_EQ(liwc.lastCandidates()[5].e1_deg, 20.0);
+    for (const float v : snapshot())
+        EXPECT_TRUE(std::isfinite(v));
+}
+
 }  // namespace
 }  // namespace qvr

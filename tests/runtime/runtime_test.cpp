@@ -4,14 +4,18 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <thread>
 
+#include "qvr/net/auth.h"
 #include "qvr/net/protocol.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/runtime/headset_client.h"
@@ -285,6 +289,391 @@ TEST(Runtime, LteChoosesALargerMeanFoveaThan5g) {
     const double e1_lte = run("lte");
     const double e1_5g = run("5g");
     EXPECT_GT(e1_lte, e1_5g + 1.0) << "lte " << e1_lte << " vs 5g " << e1_5g;
+}
+
+// ---- media-level faults -------------------------------------------------------------------
+// Neither side's media port is reachable through the public API: RenderServer does not expose
+// its UDP port, the headset's is private to net::Client, and the headset's socket is connected to
+// the server's media port, so the kernel drops datagrams from anywhere else. A test that holds
+// the pre-shared key can still stand in the middle: it relays the control channel, rewrites the
+// media ports in ClientHello and Welcome (re-signing ClientAuth, whose proof covers the port), and
+// forwards the server's datagrams to the headset from its own UDP socket — the one source the
+// headset then accepts — slipping malformed ones in between.
+
+int loopbackSocket(int type) {
+    const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
+    if (fd < 0)
+        return -1;
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+        ::close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+uint16_t localPort(int fd) {
+    sockaddr_in a{};
+    socklen_t n = sizeof a;
+    ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n);
+    return ntohs(a.sin_port);
+}
+
+bool readExact(int fd, uint8_t* p, size_t n) {
+    while (n > 0) {
+        const ssize_t r = ::recv(fd, p, n, 0);
+        if (r <= 0)
+            return false;
+        p += r;
+        n -= static_cast<size_t>(r);
+    }
+    return true;
+}
+
+bool writeAll(int fd, const std::vector<uint8_t>& bytes) {
+    size_t off = 0;
+    while (off < bytes.size()) {
+        const ssize_t w = ::send(fd, bytes.data() + off, bytes.size() - off, MSG_NOSIGNAL);
+        if (w <= 0)
+            return false;
+        off += static_cast<size_t>(w);
+    }
+    return true;
+}
+
+// One control message, raw (header + payload) and decoded.
+bool readControl(int fd, std::vector<uint8_t>& raw, net::ControlMessage& message) {
+    raw.assign(net::kControlHeaderBytes, 0);
+    if (!readExact(fd, raw.data(), raw.size()))
+        return false;
+    net::ControlHeader h;
+    if (net::decodeControlHeader(raw, h) != net::WireError::kNone)
+        return false;
+    raw.resize(net::kControlHeaderBytes + h.payload_bytes);
+    if (!readExact(fd, raw.data() + net::kControlHeaderBytes, h.payload_bytes))
+        return false;
+    return net::decodeControl(raw, message) == net::WireError::kNone;
+}
+
+class MediaTamperingProxy {
+public:
+    MediaTamperingProxy(uint16_t server_port, net::PresharedKey key, int last_frame_to_tamper)
+        : m_server_port(server_port), m_key(key), m_last_frame(last_frame_to_tamper) {
+        m_listen = loopbackSocket(SOCK_STREAM);
+        m_from_server = loopbackSocket(SOCK_DGRAM);
+        m_to_headset = loopbackSocket(SOCK_DGRAM);
+        QVR_CHECK(m_listen >= 0 && m_from_server >= 0 && m_to_headset >= 0);
+        QVR_CHECK(::listen(m_listen, 1) == 0);
+        timeval tv{0, 50'000};
+        ::setsockopt(m_from_server, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+        // As deep as the headset's own socket (net::Client asks for 4 MB): a frame's burst must
+        // not overflow the relay and pass for a fault of the headset's.
+        const int buffer_bytes = 4 << 20;
+        ::setsockopt(m_from_server, SOL_SOCKET, SO_RCVBUF, &buffer_bytes, sizeof buffer_bytes);
+        ::setsockopt(m_to_headset, SOL_SOCKET, SO_SNDBUF, &buffer_bytes, sizeof buffer_bytes);
+        m_control = std::thread([this] { relayControl(); });
+        m_media = std::thread([this] { relayMedia(); });
+    }
+    ~MediaTamperingProxy() {
+        m_stop = true;
+        for (int fd : {m_headset.load(), m_server.load()})
+            if (fd >= 0)
+                ::shutdown(fd, SHUT_RDWR);
+        m_control.join();
+        m_media.join();
+        for (int fd : {m_listen, m_from_server, m_to_headset, m_headset.load(), m_server.load()})
+            if (fd >= 0)
+                ::close(fd);
+    }
+    uint16_t port() const { return localPort(m_listen); }
+    // The malformed datagrams sent, by the reason the headset should drop each for.
+    net::DropCounters injected() const {
+        std::lock_guard lock(m_mutex);
+        return m_injected;
+    }
+    uint64_t forwarded() const { return m_forwarded; }
+
+private:
+    void relayControl() {
+        pollfd p{m_listen, POLLIN, 0};
+        while (!m_stop && ::poll(&p, 1, 50) == 0) {
+        }
+        if (m_stop)
+            return;
+        const int headset = ::accept4(m_listen, nullptr, nullptr, SOCK_CLOEXEC);
+        const int server = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_port = htons(m_server_port);
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        if (headset < 0 || server < 0 ||
+            ::connect(server, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+            ADD_FAILURE() << "proxy: cannot relay to the server";
+            return;
+        }
+        m_headset = headset;
+        m_server = server;
+        std::thread down([this] { relay(m_server, m_headset); });
+        relay(m_headset, m_server);
+        ::shutdown(m_server, SHUT_RDWR);
+        down.join();
+    }
+
+    // Forwards control messages from `from` to `to`, rewriting the handshake's media ports.
+    void relay(int from, int to) {
+        std::vector<uint8_t> raw;
+        net::ControlMessage m;
+        while (readControl(from, raw, m)) {
+            std::unique_lock lock(m_mutex);
+            if (auto* hello = std::get_if<net::ClientHello>(&m)) {
+                m_client_nonce = hello->client_nonce;
+                m_headset_media_port = hello->media_port;
+                hello->media_port = localPort(m_from_server);
+                raw = net::encodeControl(*hello);
+            } else if (const auto* ch = std::get_if<net::ServerChallenge>(&m)) {
+                m_server_nonce = ch->server_nonce;
+                m_session = ch->session_id;
+            } else if (std::holds_alternative<net::ClientAuth>(m)) {
+                raw = net::encodeControl(net::ClientAuth{net::clientProof(
+                    m_key, m_client_nonce, m_server_nonce, m_session, localPort(m_from_server))});
+            } else if (auto* welcome = std::get_if<net::Welcome>(&m)) {
+                welcome->media_port = localPort(m_to_headset);
+                raw = net::encodeControl(*welcome);
+            }
+            lock.unlock();
+            if (!writeAll(to, raw))
+                break;
+        }
+        ::shutdown(to, SHUT_WR);
+    }
+
+    void relayMedia() {
+        std::vector<uint8_t> datagram(65536);
+        uint32_t tampered_up_to = 0;
+        bool tampered_any = false;
+        while (!m_stop) {
+            const ssize_t n = ::recv(m_from_server, datagram.data(), datagram.size(), 0);
+            if (n <= 0)
+                continue;
+            const std::vector<uint8_t> packet(datagram.begin(), datagram.begin() + n);
+            uint16_t port = 0;
+            uint64_t session = 0;
+            {
+                std::lock_guard lock(m_mutex);
+                port = m_headset_media_port;
+                session = m_session;
+            }
+            net::MediaPacketView view;
+            const bool valid = net::decodeMediaPacket(packet, view) == net::WireError::kNone;
+            // A burst of every kind of malformed datagram ahead of the first packet of every
+            // third frame, until the last frames, so the headset has read them all by its end.
+            const uint32_t frame = valid ? view.header.frame_id : 0;
+            if (valid && frame % 3 == 0 && int(frame) <= m_last_frame &&
+                (!tampered_any || frame > tampered_up_to)) {
+                tampered_any = true;
+                tampered_up_to = frame;
+                injectBurst(port, session, packet, frame);
+            }
+            sendTo(port, packet);
+            ++m_forwarded;
+        }
+    }
+
+    void sendTo(uint16_t port, const std::vector<uint8_t>& d) {
+        sockaddr_in a{};
+        a.sin_family = AF_INET;
+        a.sin_port = htons(port);
+        a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        ::sendto(m_to_headset, d.data(), d.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    }
+
+    void injectBurst(uint16_t port, uint64_t session, const std::vector<uint8_t>& real,
+                     uint32_t frame) {
+        using net::WireError;
+        std::vector<std::pair<WireError, std::vector<uint8_t>>> bad;
+        auto encoded = [&](net::MediaHeader h, size_t payload_bytes) {
+            std::vector<uint8_t> out;
+            net::encodeMediaPacket(h, std::vector<uint8_t>(payload_bytes, 0x77), out);
+            return out;
+        };
+        net::MediaHeader h;
+        h.session_id = session;
+        h.frame_id = frame;
+        h.stream_id = 0;
+        h.packet_count = 1;
+        h.payload_bytes = 100;
+        h.frame_bytes = 100;
+        // Garbage, too short for a header, too long for any datagram.
+        std::vector<uint8_t> garbage(64);
+        for (size_t i = 0; i < garbage.size(); ++i)
+            garbage[i] = static_cast<uint8_t>(0xA5 ^ (i * 37));
+        bad.emplace_back(WireError::kBadMagic, garbage);
+        bad.emplace_back(WireError::kTruncated, std::vector<uint8_t>(7, 0x51));
+        bad.emplace_back(WireError::kOversized,
+                         std::vector<uint8_t>(net::kMaxDatagramBytes + 500, 0));
+        // A real packet of this session cut short of its declared payload.
+        bad.emplace_back(WireError::kTruncated, std::vector<uint8_t>(real.begin(), real.end() - 1));
+        // A header declaring a full 1200-byte chunk with 100 bytes behind it.
+        {
+            net::MediaHeader full = h;
+            full.packet_count = 2;
+            full.payload_bytes = net::kMediaChunkBytes;
+            full.frame_bytes = 2 * net::kMediaChunkBytes;
+            auto d = encoded(full, net::kMediaChunkBytes);
+            d.resize(net::kMediaHeaderBytes + 100);
+            bad.emplace_back(WireError::kTruncated, d);
+        }
+        // More bytes than declared.
+        {
+            auto d = encoded(h, 100);
+            d.insert(d.end(), 50, 0x33);
+            bad.emplace_back(WireError::kTrailingBytes, d);
+        }
+        // A frame size beyond the protocol's limit.
+        {
+            net::MediaHeader big = h;
+            big.frame_bytes = net::kMaxStreamFrameBytes + 1;
+            bad.emplace_back(WireError::kOversized, encoded(big, 100));
+        }
+        // Packet 5 of a frame of one packet.
+        {
+            net::MediaHeader past = h;
+            past.packet_index = 5;
+            bad.emplace_back(WireError::kBadField, encoded(past, 100));
+        }
+        // Another protocol version.
+        {
+            auto d = real;
+            d[2] = static_cast<uint8_t>(d[2] + 1);
+            bad.emplace_back(WireError::kWrongVersion, d);
+        }
+        // A well-formed packet of another session.
+        {
+            net::MediaHeader other = h;
+            other.session_id = session + 1;
+            bad.emplace_back(WireError::kWrongSession, encoded(other, 100));
+        }
+        for (const auto& [why, d] : bad) {
+            sendTo(port, d);
+            std::lock_guard lock(m_mutex);
+            m_injected.count(why);
+        }
+    }
+
+    const uint16_t m_server_port;
+    const net::PresharedKey m_key;
+    const int m_last_frame;
+    int m_listen = -1;
+    int m_from_server = -1;  // the server sends the media here
+    int m_to_headset = -1;   // and the headset accepts it only from here
+    std::atomic<int> m_headset{-1};
+    std::atomic<int> m_server{-1};
+    std::atomic<bool> m_stop{false};
+    std::atomic<uint64_t> m_forwarded{0};
+    mutable std::mutex m_mutex;
+    net::Nonce m_client_nonce{};
+    net::Nonce m_server_nonce{};
+    uint64_t m_session = 0;
+    uint16_t m_headset_media_port = 0;
+    net::DropCounters m_injected;
+    std::thread m_control;
+    std::thread m_media;
+};
+
+TEST(Runtime, MalformedMediaDatagramsAreDroppedByReasonWhileFramesKeepComing) {
+    auto server = RenderServer::start(serverConfig("none", "raw"), world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    const int frames = 60;
+    net::DropCounters injected;
+    HeadsetResult r;
+    {
+        MediaTamperingProxy proxy((*server)->port(), keyA(), frames - 15);
+        r = runOn(headsetConfig(RuntimeDesign::kQvr, proxy.port(), "raw", frames));
+        EXPECT_GT(proxy.forwarded(), 100u);
+        injected = proxy.injected();
+    }
+    // The run went through the proxy, and the proxy did tamper.
+    EXPECT_EQ(r.stats.connects, 1u);
+    EXPECT_EQ(r.stats.disconnects, 0u);
+    ASSERT_GE(injected.total(), 10u * 10u) << "too few frames were tampered with";
+    // Every malformed datagram was dropped and counted under its reason; nothing else was.
+    const net::DropCounters& drops = r.stats.net.media_drops;
+    for (int e = 1; e < net::kWireErrorCount; ++e) {
+        const auto why = static_cast<net::WireError>(e);
+        EXPECT_EQ(drops[why], injected[why]) << net::wireErrorName(why);
+    }
+    EXPECT_GT(drops[net::WireError::kWrongSession], 0u);
+    EXPECT_GT(drops[net::WireError::kTrailingBytes], 0u);
+    EXPECT_EQ(drops[net::WireError::kTruncated], 3 * drops[net::WireError::kBadMagic]);
+    // Frames kept coming from the server: every frame displayed, nearly all of them fresh.
+    EXPECT_EQ(r.summary.frames_displayed, frames);
+    EXPECT_LT(r.summary.frames_reused, frames / 10);
+    EXPECT_EQ(r.stats.decode_failures, 0u);
+    EXPECT_EQ(r.stats.streams_lost, 0u);
+    int fresh = 0;
+    for (const FrameTelemetry& t : r.frames)
+        fresh += (t.remote_requested && !t.reused && t.bytes > 0) ? 1 : 0;
+    EXPECT_GE(fresh, frames - frames / 10);
+}
+
+// ---- frames in flight (HeadsetConfig::pipeline_depth) ------------------------------------
+
+// Pairs (n, n + 1) that both requested remote layers, and how many of them had n + 1's request
+// sent before n's UCA started.
+std::pair<int, int> requestsAheadOfUca(const HeadsetResult& r) {
+    int pairs = 0, ahead = 0;
+    for (size_t n = 0; n + 1 < r.frames.size(); ++n) {
+        const FrameTelemetry& a = r.frames[n];
+        const FrameTelemetry& b = r.frames[n + 1];
+        if (!a.remote_requested || !b.remote_requested || a.uca_start_ns < 0)
+            continue;
+        ++pairs;
+        ahead += b.request_ns < a.uca_start_ns ? 1 : 0;
+    }
+    return {pairs, ahead};
+}
+
+TEST(Runtime, TwoFramesInFlightRequestTheNextFrameBeforeComposingThisOne) {
+    auto server = RenderServer::start(serverConfig("none", "raw"), world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    const int frames = 40;
+    for (int depth : {2, 1}) {
+        HeadsetConfig h = headsetConfig(RuntimeDesign::kQvr, (*server)->port(), "raw", frames);
+        h.pipeline_depth = depth;
+        const HeadsetResult r = runOn(h);
+        ASSERT_EQ(r.frames.size(), size_t(frames));
+        EXPECT_EQ(r.summary.frames_displayed, frames);
+        // Telemetry is in frame order whatever the depth.
+        for (size_t n = 0; n < r.frames.size(); ++n)
+            EXPECT_EQ(r.frames[n].frame, int64_t(n));
+        const auto [pairs, ahead] = requestsAheadOfUca(r);
+        EXPECT_GE(pairs, frames - 5) << "depth " << depth;
+        if (depth == 2) {
+            EXPECT_GE(ahead, pairs * 9 / 10) << ahead << " of " << pairs;
+        } else {
+            EXPECT_EQ(ahead, 0) << pairs;
+            // One frame at a time: the next pose is sampled after this frame's scan-out.
+            for (size_t n = 0; n + 1 < r.frames.size(); ++n)
+                EXPECT_GE(r.frames[n + 1].pose_ns, r.frames[n].display_ns) << "frame " << n;
+        }
+    }
+}
+
+TEST(Runtime, LocalDesignIgnoresThePipelineDepth) {
+    // Nothing remote to overlap with: frame n + 1's pose is sampled after n is displayed.
+    const int frames = 30;
+    HeadsetConfig h = headsetConfig(RuntimeDesign::kLocal, 0, "raw", frames);
+    h.pipeline_depth = 2;
+    const HeadsetResult r = runOn(h);
+    ASSERT_EQ(r.frames.size(), size_t(frames));
+    EXPECT_EQ(r.summary.frames_displayed, frames);
+    for (size_t n = 0; n + 1 < r.frames.size(); ++n) {
+        ASSERT_GE(r.frames[n].display_ns, 0);
+        EXPECT_FALSE(r.frames[n].remote_requested);
+        EXPECT_GE(r.frames[n + 1].pose_ns, r.frames[n].display_ns) << "frame " << n;
+    }
 }
 
 }  // namespace
