@@ -95,6 +95,7 @@ TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
     std::uniform_real_distribution<double> e1(3.0, 40.0);
     std::uniform_real_distribution<double> k(0.0, 0.3);
     std::uniform_int_distribution<int> size(100, 420);
+    int64_t mesh_tiles = 0;
     for (int trial = 0; trial < 8; ++trial) {
         HmdProfile profile = smallProfile(size(rng), size(rng));
         profile.lens.k1 = k(rng);
@@ -112,8 +113,15 @@ TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
         scalar.simd = false;
         Compositor a(profile, fast), b(profile, scalar);
         std::array<ImageRgba8, 2> out_a, out_b;
-        ASSERT_TRUE(a.compose(frame, display, out_a).ok());
-        ASSERT_TRUE(b.compose(frame, display, out_b).ok());
+        auto ra = a.compose(frame, display, out_a);
+        auto rb = b.compose(frame, display, out_b);
+        ASSERT_TRUE(ra.ok());
+        ASSERT_TRUE(rb.ok());
+        // The twin takes the same mesh decisions (MeshLattice) tile by tile.
+        if (fma_target) {
+            EXPECT_EQ(ra->tiles.mesh, rb->tiles.mesh) << "trial " << trial;
+        }
+        mesh_tiles += ra->tiles.mesh;
         const int64_t pixels = int64_t{profile.width_px} * profile.height_px;
         for (int eye = 0; eye < 2; ++eye) {
             const Diff d = compare(out_a[eye], out_b[eye]);
@@ -139,6 +147,7 @@ TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
             }
         }
     }
+    std::printf("mesh tiles over all trials: %lld\n", static_cast<long long>(mesh_tiles));
 }
 
 TEST(ComposeUca, TileClassificationNeverChangesAPixel) {
@@ -173,6 +182,82 @@ TEST(ComposeUca, TileClassificationNeverChangesAPixel) {
             EXPECT_EQ(d.max_channel, 0) << "trial " << trial << " simd " << simd;
         }
     }
+}
+
+// A layer whose channels are triangle waves of slope 12 and 7 levels per texel (Lipschitz in
+// texel coordinates), so a sample position off by δ texels moves the value by at most 19·δ.
+ImageRgba8 rampImage(int w, int h, int phase) {
+    ImageRgba8 img(w, h);
+    auto tri = [](int t) {
+        const int m = t % 510;
+        return static_cast<uint8_t>(m <= 255 ? m : 510 - m);
+    };
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            img.at(x, y, 0) = tri(12 * x + 7 * y + phase);
+            img.at(x, y, 1) = tri(7 * x + 12 * y + 2 * phase);
+            img.at(x, y, 2) = tri(12 * x + 7 * y + 3 * phase + 100);
+            img.at(x, y, 3) = 255;
+        }
+    }
+    return img;
+}
+
+TEST(ComposeUca, MeshTilesStayWithinTheirBoundOfTheExactMap) {
+    std::mt19937 rng(std::random_device{}());
+    std::uniform_real_distribution<double> angle(-3.0, 3.0);
+    std::uniform_real_distribution<double> k(0.0, 0.4);
+    std::uniform_real_distribution<double> gaze(-15.0, 15.0);
+    int64_t mesh_tiles = 0, single_tiles = 0;
+    for (int trial = 0; trial < 6; ++trial) {
+        HmdProfile profile = smallProfile(480, 540);
+        profile.lens.k1 = k(rng);
+        profile.lens.k2 = k(rng);
+        const LayerPlan plan =
+            LayerPlanner(profile).plan({gaze(rng), gaze(rng)}, 8.0 + 5.0 * trial);
+        LayerFrame frame;
+        frame.plan = plan;
+        for (size_t eye = 0; eye < 2; ++eye) {
+            const EyeLayers& l = plan.eyes[eye];
+            const int phase = static_cast<int>(rng() % 255);
+            if (!l.fovea.empty())
+                frame.eyes[eye].fovea = rampImage(l.fovea.width_px, l.fovea.height_px, phase);
+            if (!l.middle.empty())
+                frame.eyes[eye].middle = rampImage(l.middle.width_px, l.middle.height_px, phase);
+            if (!l.outer.empty())
+                frame.eyes[eye].outer = rampImage(l.outer.width_px, l.outer.height_px, phase);
+        }
+        const Pose display = poseDeg(angle(rng), angle(rng), angle(rng));
+        std::array<std::array<ImageRgba8, 2>, 2> meshed;  // [simd][eye]
+        for (bool simd : {true, false}) {
+            ComposeOptions mesh, exact;
+            mesh.simd = exact.simd = simd;
+            exact.mesh_map = false;
+            Compositor a(profile, mesh), b(profile, exact);
+            std::array<ImageRgba8, 2>& out_a = meshed[simd ? 1 : 0];
+            std::array<ImageRgba8, 2> out_b;
+            auto ra = a.compose(frame, display, out_a);
+            auto rb = b.compose(frame, display, out_b);
+            ASSERT_TRUE(ra.ok());
+            ASSERT_TRUE(rb.ok());
+            EXPECT_EQ(rb->tiles.mesh, 0);
+            mesh_tiles += ra->tiles.mesh;
+            single_tiles += ra->tiles.single;
+            // Within 1/16 texel in x and in y: at most 19/16 of a level, plus the rounding.
+            for (int eye = 0; eye < 2; ++eye) {
+                const Diff d = compare(out_a[eye], out_b[eye]);
+                EXPECT_LE(d.max_channel, 2) << "trial " << trial << " simd " << simd;
+            }
+        }
+        // The twin interpolates the same nodes the same way (bit for bit where MulAdd fuses).
+        if (std::string(detail::ucaSimdTarget()).rfind("AVX", 0) == 0) {
+            for (int eye = 0; eye < 2; ++eye)
+                EXPECT_EQ(compare(meshed[0][eye], meshed[1][eye]).max_channel, 0);
+        }
+    }
+    // Many single-layer tiles qualify on these lenses (the rest touch the rendered image's edge
+    // at this small size); a mesh that never engages would test nothing.
+    EXPECT_GT(mesh_tiles, single_tiles / 4);
 }
 
 TEST(ComposeUca, IdentityPoseNoLensAllFoveaReproducesInput) {
