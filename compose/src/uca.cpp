@@ -296,7 +296,13 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
         }
         empty = channel_empty;
     }
-    double lo_deg = kInf, hi_deg = -kInf;
+    // The lower end of the eccentricity range lies between the corners' minimum minus the
+    // tile's extent and the corners' minimum (any point of a convex quadrilateral is within two
+    // diagonals of a corner). When both ends give the same slot mask, the nearest-edge search
+    // cannot change it and is skipped.
+    double lo_deg = kInf, hi_deg = -kInf, lo_far_deg = kInf;
+    double slack_of[3] = {0, 0, 0};
+    double e_min_of[3] = {0, 0, 0};
     for (int c = 0; c < chroma_count && !empty; ++c) {
         const CornerSample* k[4];
         corners(c, k);
@@ -312,15 +318,28 @@ void classifyTile(const EyeJob& job, int tile, int tile_cols, int chroma_count,
         // (near-geodesic) quadrilateral its maximum is at a corner and its minimum on an edge,
         // or 0 when the gaze is inside; the slack covers the edges' curvature.
         const double slack_deg = 0.125 * diag_rad * kDegPerRad + 0.01;
-        const double nearest_deg =
-            nearestEccentricityDeg(unit(k[0]), unit(k[1]), unit(k[3]), unit(k[2]), gaze_dir, e_min);
-        lo_deg = std::min(lo_deg, nearest_deg - slack_deg);
+        slack_of[c] = slack_deg;
+        e_min_of[c] = e_min;
+        lo_deg = std::min(lo_deg, e_min - slack_deg);
+        lo_far_deg = std::min(lo_far_deg, e_min - 2.0 * diag_rad * kDegPerRad - slack_deg);
         hi_deg = std::max(hi_deg, e_max + slack_deg);
     }
     uint8_t mask = 0;
     TileKind kind = TileKind::kEmpty;
     if (!empty) {
         mask = slotMaskFor(job.slots, lo_deg, hi_deg);
+        if (slotMaskFor(job.slots, lo_far_deg, hi_deg) != mask) {
+            lo_deg = kInf;
+            for (int c = 0; c < chroma_count; ++c) {
+                const CornerSample* k[4];
+                corners(c, k);
+                auto unit = [](const CornerSample* a) { return glm::dvec3(a->ux, a->uy, a->uz); };
+                const double nearest_deg = nearestEccentricityDeg(
+                    unit(k[0]), unit(k[1]), unit(k[3]), unit(k[2]), gaze_dir, e_min_of[c]);
+                lo_deg = std::min(lo_deg, nearest_deg - slack_of[c]);
+            }
+            mask = slotMaskFor(job.slots, lo_deg, hi_deg);
+        }
         kind = (mask & (mask - 1)) == 0 ? TileKind::kSingle : TileKind::kBorder;
     }
     (*job.kinds)[static_cast<size_t>(tile)] = kind;
