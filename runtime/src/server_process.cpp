@@ -8,8 +8,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <string_view>
@@ -38,8 +42,8 @@ int waitExit(pid_t pid, int timeout_ms) {
     }
 }
 
-// Copies whatever the child printed after its ready line to our stdout, without blocking.
-void passThrough(int fd) {
+// Copies what the child has printed so far to our stdout, without blocking.
+void drainTo(int fd) {
     char buf[4096];
     for (;;) {
         const ssize_t n = read(fd, buf, sizeof buf);
@@ -59,6 +63,73 @@ Expected<std::string> selfExecutable() {
         return makeError("cannot find the running executable: " + ec.message());
     return p.string();
 }
+
+struct ServerProcess::Impl {
+    pid_t pid = -1;
+    int stdout_fd = -1;  // non-blocking once the child is ready
+    uint16_t port = 0;
+    std::atomic<bool> stop_reader{false};
+    std::thread reader;  // passes the child's output through after the ready line
+
+    void startReader() {
+        reader = std::thread([this] {
+            while (!stop_reader.load()) {
+                pollfd p{stdout_fd, POLLIN, 0};
+                const int r = poll(&p, 1, 100);
+                if (r < 0 && errno != EINTR)
+                    return;
+                if (r > 0 && (p.revents & POLLIN))
+                    drainTo(stdout_fd);
+                else if (r > 0 && (p.revents & (POLLHUP | POLLERR)))
+                    return;  // every writer is gone
+            }
+        });
+    }
+
+    int stop(int grace_ms) {
+        int status = -1;
+        if (pid > 0) {
+            kill(pid, SIGTERM);
+            status = waitExit(pid, grace_ms);
+            if (status == -2) {
+                kill(pid, SIGKILL);
+                status = waitExit(pid, 5000);
+            }
+            pid = -1;
+        }
+        stop_reader = true;
+        if (reader.joinable())
+            reader.join();
+        if (stdout_fd >= 0) {
+            // Non-blocking: a descendant that kept the pipe open must not hold us here.
+            fcntl(stdout_fd, F_SETFL, fcntl(stdout_fd, F_GETFL) | O_NONBLOCK);
+            drainTo(stdout_fd);
+            close(stdout_fd);
+            stdout_fd = -1;
+        }
+        return status;
+    }
+};
+
+namespace {
+
+// "HOST:PORT (…)" → PORT, or 0 when there is no whole number in 1…65535 after the last ':'.
+uint16_t portOfAddress(const std::string& rest) {
+    const std::string addr = rest.substr(0, rest.find(' '));
+    const size_t colon = addr.rfind(':');
+    if (colon == std::string::npos || colon + 1 >= addr.size())
+        return 0;
+    const char* digits = addr.c_str() + colon + 1;
+    char* end = nullptr;
+    errno = 0;
+    const long port = std::strtol(digits, &end, 10);
+    if (errno != 0 || end == digits || *end != '\0' || port <= 0 || port > 65535 ||
+        !std::isdigit(static_cast<unsigned char>(*digits)))
+        return 0;
+    return static_cast<uint16_t>(port);
+}
+
+}  // namespace
 
 Expected<ServerProcess> ServerProcess::start(const std::string& executable,
                                              const std::vector<std::string>& args,
@@ -84,9 +155,9 @@ Expected<ServerProcess> ServerProcess::start(const std::string& executable,
         close(fds[0]);
         return makeError("server process: cannot start " + executable + ": " + std::strerror(rc));
     }
-    ServerProcess sp;
-    sp.m_pid = pid;
-    sp.m_stdout_fd = fds[0];
+    auto impl = std::make_unique<Impl>();
+    impl->pid = pid;
+    impl->stdout_fd = fds[0];
     // Read lines until the ready line, the child's exit or the deadline.
     std::string pending;
     const auto deadline =
@@ -96,18 +167,20 @@ Expected<ServerProcess> ServerProcess::start(const std::string& executable,
                               deadline - std::chrono::steady_clock::now())
                               .count();
         if (left <= 0) {
-            sp.stop(1000);
+            impl->stop(1000);
             return makeError("server process: not ready after " + std::to_string(ready_timeout_ms) +
                              " ms");
         }
-        pollfd p{sp.m_stdout_fd, POLLIN, 0};
-        if (poll(&p, 1, static_cast<int>(std::min<long long>(left, 100))) < 0 && errno != EINTR)
+        pollfd p{impl->stdout_fd, POLLIN, 0};
+        if (poll(&p, 1, static_cast<int>(std::min<long long>(left, 100))) < 0 && errno != EINTR) {
+            impl->stop(1000);
             return makeError(std::string("server process: poll: ") + std::strerror(errno));
+        }
         if (p.revents & (POLLIN | POLLHUP)) {
             char buf[1024];
-            const ssize_t n = read(sp.m_stdout_fd, buf, sizeof buf);
+            const ssize_t n = read(impl->stdout_fd, buf, sizeof buf);
             if (n <= 0) {
-                const int status = sp.stop(1000);
+                const int status = impl->stop(1000);
                 return makeError("server process: exited before it was ready (status " +
                                  std::to_string(status) + ")");
             }
@@ -124,36 +197,29 @@ Expected<ServerProcess> ServerProcess::start(const std::string& executable,
                 std::fprintf(stdout, "%s\n", line.c_str());
                 continue;
             }
-            // "HOST:PORT (…)": the port follows the last ':' of the address.
-            const std::string rest = line.substr(at + kReadyPrefix.size());
-            const std::string addr = rest.substr(0, rest.find(' '));
-            const size_t colon = addr.rfind(':');
-            const long port = colon == std::string::npos ? -1 : std::atol(addr.c_str() + colon + 1);
-            if (port <= 0 || port > 65535) {
-                sp.stop(1000);
+            const uint16_t port = portOfAddress(line.substr(at + kReadyPrefix.size()));
+            if (port == 0) {
+                impl->stop(1000);
                 return makeError("server process: unreadable ready line: " + line);
             }
-            sp.m_port = static_cast<uint16_t>(port);
-            fcntl(sp.m_stdout_fd, F_SETFL, fcntl(sp.m_stdout_fd, F_GETFL) | O_NONBLOCK);
-            return sp;
+            impl->port = port;
+            std::fflush(stdout);
+            if (!pending.empty() && write(STDOUT_FILENO, pending.data(), pending.size()) < 0)
+                pending.clear();
+            fcntl(impl->stdout_fd, F_SETFL, fcntl(impl->stdout_fd, F_GETFL) | O_NONBLOCK);
+            impl->startReader();
+            return ServerProcess(std::move(impl));
         }
     }
 }
 
-ServerProcess::ServerProcess(ServerProcess&& o) noexcept
-    : m_pid(o.m_pid), m_stdout_fd(o.m_stdout_fd), m_port(o.m_port) {
-    o.m_pid = -1;
-    o.m_stdout_fd = -1;
-}
+ServerProcess::ServerProcess(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+ServerProcess::ServerProcess(ServerProcess&& other) noexcept = default;
 
-ServerProcess& ServerProcess::operator=(ServerProcess&& o) noexcept {
-    if (this != &o) {
-        stop();
-        m_pid = o.m_pid;
-        m_stdout_fd = o.m_stdout_fd;
-        m_port = o.m_port;
-        o.m_pid = -1;
-        o.m_stdout_fd = -1;
+ServerProcess& ServerProcess::operator=(ServerProcess&& other) noexcept {
+    if (this != &other) {
+        stop(1000);
+        m_impl = std::move(other.m_impl);
     }
     return *this;
 }
@@ -162,23 +228,16 @@ ServerProcess::~ServerProcess() {
     stop(1000);
 }
 
+uint16_t ServerProcess::port() const {
+    return m_impl ? m_impl->port : 0;
+}
+
+pid_t ServerProcess::pid() const {
+    return m_impl ? m_impl->pid : -1;
+}
+
 int ServerProcess::stop(int grace_ms) {
-    int status = -1;
-    if (m_pid > 0) {
-        kill(m_pid, SIGTERM);
-        status = waitExit(m_pid, grace_ms);
-        if (status == -2) {
-            kill(m_pid, SIGKILL);
-            status = waitExit(m_pid, 5000);
-        }
-        m_pid = -1;
-    }
-    if (m_stdout_fd >= 0) {
-        passThrough(m_stdout_fd);
-        close(m_stdout_fd);
-        m_stdout_fd = -1;
-    }
-    return status;
+    return m_impl ? m_impl->stop(grace_ms) : -1;
 }
 
 }  // namespace qvr::runtime

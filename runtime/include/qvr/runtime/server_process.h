@@ -7,6 +7,7 @@
 
 #include <sys/types.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,9 @@ class ServerProcess {
 public:
     // Starts `executable` with `args` (e.g. {"server", "--port", "0", …}) and waits up to
     // `ready_timeout_ms` for the line "qvr server: listening on HOST:PORT" on its standard
-    // output; its other output is passed through to ours. Errors when it exits or stays silent.
+    // output; its other output, before and after that line, is passed through to ours (after it
+    // by a thread, so a chatty child never blocks on a full pipe). Errors when it exits, stays
+    // silent or prints a ready line without a port.
     static Expected<ServerProcess> start(const std::string& executable,
                                          const std::vector<std::string>& args,
                                          int ready_timeout_ms = 30000);
@@ -28,16 +31,17 @@ public:
     ServerProcess& operator=(const ServerProcess&) = delete;
     ~ServerProcess();
 
-    uint16_t port() const { return m_port; }
-    pid_t pid() const { return m_pid; }
-    // SIGTERM, then SIGKILL after `grace_ms`; returns the exit status (128 + signal if killed).
+    uint16_t port() const;
+    pid_t pid() const;
+    // SIGTERM, then SIGKILL after `grace_ms`; returns the exit status (128 + signal if killed),
+    // -1 when there is no child. Never waits on the child's descendants.
     int stop(int grace_ms = 5000);
 
+    struct Impl;
+
 private:
-    ServerProcess() = default;
-    pid_t m_pid = -1;
-    int m_stdout_fd = -1;
-    uint16_t m_port = 0;
+    explicit ServerProcess(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
 };
 
 // The path of the running executable (/proc/self/exe).
