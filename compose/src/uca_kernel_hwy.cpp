@@ -481,11 +481,29 @@ HWY_INLINE bool meshAcceptableV(const MeshLattice& m, const KernelParams& p, con
     return true;
 }
 
+// Stores a vector of packed pixels at row[x…]: streaming where aligned and the job asks for it,
+// a partial store at the tile's right edge.
+HWY_INLINE void storePixels(hn::Vec<hn::ScalableTag<uint32_t>> packed, const TileJob& job,
+                            uint32_t* row, int x) {
+    const hn::ScalableTag<uint32_t> du;
+    const int lanes = static_cast<int>(hn::Lanes(du));
+    const uintptr_t vector_bytes = static_cast<uintptr_t>(lanes) * sizeof(uint32_t);
+    if (x + lanes <= job.x1) {
+        if (job.stream && (reinterpret_cast<uintptr_t>(row + x) & (vector_bytes - 1)) == 0)
+            hn::Stream(packed, du, row + x);
+        else
+            hn::StoreU(packed, du, row + x);
+        return;
+    }
+    HWY_ALIGN uint32_t tail[HWY_MAX_BYTES / sizeof(uint32_t)];
+    hn::Store(packed, du, tail);
+    std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
+}
+
 // A mesh tile: the map of every pixel is the bilinear interpolation of the lattice's nodes,
 // first along x on the node rows (h), then along y between them; every pixel is valid.
 HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelLayer& layer) {
     const DF df;
-    const DU du;
     const int lanes = static_cast<int>(hn::Lanes(df));
     constexpr int n = kMeshLatticeSide;
     HWY_ALIGN static const auto frac = [] {
@@ -523,8 +541,6 @@ HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelL
             hn::Store(hn::Sub(hn::Load(df, hy[j + 1] + c), hn::Load(df, hy[j] + c)), df, dy[j] + c);
         }
     }
-    HWY_ALIGN uint32_t tail[HWY_MAX_BYTES / sizeof(uint32_t)];
-    const uintptr_t vector_bytes = static_cast<uintptr_t>(lanes) * sizeof(uint32_t);
     for (int y = job.y0; y < job.y1; ++y) {
         auto* row =
             reinterpret_cast<uint32_t*>(job.out) + static_cast<size_t>(y) * job.out_stride_px;
@@ -535,18 +551,7 @@ HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelL
             const int c = x - job.x0;
             const VF lx = hn::MulAdd(hn::Load(df, dx[j] + c), b, hn::Load(df, hx[j] + c));
             const VF ly = hn::MulAdd(hn::Load(df, dy[j] + c), b, hn::Load(df, hy[j] + c));
-            const VU packed = packBiased(sampleTexels<false>(layer, lx, ly));
-            if (x + lanes <= job.x1) {
-                if (job.stream &&
-                    (reinterpret_cast<uintptr_t>(row + x) & (vector_bytes - 1)) == 0) {
-                    hn::Stream(packed, du, row + x);
-                } else {
-                    hn::StoreU(packed, du, row + x);
-                }
-            } else {
-                hn::Store(packed, du, tail);
-                std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
-            }
+            storePixels(packBiased(sampleTexels<false>(layer, lx, ly)), job, row, x);
         }
     }
 }
@@ -569,8 +574,6 @@ bool UcaTile(const KernelParams& p, const TileJob& job) {
     const DU du;
     const int lanes = static_cast<int>(hn::Lanes(df));
     const VF iota = hn::Iota(df, 0.0f);
-    HWY_ALIGN uint32_t tail[HWY_MAX_BYTES / sizeof(uint32_t)];
-    const uintptr_t vector_bytes = static_cast<uintptr_t>(lanes) * sizeof(uint32_t);
     for (int y = job.y0; y < job.y1; ++y) {
         auto* row =
             reinterpret_cast<uint32_t*>(job.out) + static_cast<size_t>(y) * job.out_stride_px;
@@ -584,17 +587,7 @@ bool UcaTile(const KernelParams& p, const TileJob& job) {
                 const VF u = hn::Add(iota, hn::Set(df, static_cast<float>(x)));
                 packed = shadePacked(p, r, u, v, job.slot_mask);
             }
-            if (x + lanes <= job.x1) {
-                if (job.stream &&
-                    (reinterpret_cast<uintptr_t>(row + x) & (vector_bytes - 1)) == 0) {
-                    hn::Stream(packed, du, row + x);
-                } else {
-                    hn::StoreU(packed, du, row + x);
-                }
-            } else {
-                hn::Store(packed, du, tail);
-                std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
-            }
+            storePixels(packed, job, row, x);
         }
     }
     return false;
