@@ -238,8 +238,9 @@ struct GlRenderer::Impl {
                             "offers 1 to {}",
                             options.msaa_samples, max_samples));
         if (!(options.lod_error_px >= 0.0f && options.lod_error_px <= 1000.0f))
-            return makeError(fmt::format(
-                "render: LOD error of {} pixels asked for; give 0 (off) to 1000", options.lod_error_px));
+            return makeError(
+                fmt::format("render: LOD error of {} pixels asked for; give 0 (off) to 1000",
+                            options.lod_error_px));
         GLint max_rb = 0;
         GLint max_vp[2] = {0, 0};
         glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
