@@ -66,16 +66,10 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: --frames must be within 1..1000000\n");
         return 2;
     }
-    auto scene_loaded = loadScene(o.scene);
-    if (!scene_loaded) {
-        std::fprintf(stderr, "qvr client: %s\n", scene_loaded.error().c_str());
-        return 2;
-    }
-    auto scene = std::make_shared<const Scene>(std::move(*scene_loaded));
-    auto bvh = std::make_shared<const TriangleBvh>(*scene);
-    auto traces = makeTraces(o.motion, o.gaze, *scene, profile->refresh_hz, o.frames, o.seed);
-    if (!traces) {
-        std::fprintf(stderr, "qvr client: %s\n", traces.error().c_str());
+    auto inputs =
+        loadHeadsetInputs(o.scene, o.motion, o.gaze, profile->refresh_hz, o.frames, o.seed);
+    if (!inputs) {
+        std::fprintf(stderr, "qvr client: %s\n", inputs.error().c_str());
         return 2;
     }
     HeadsetConfig hc;
@@ -90,7 +84,7 @@ int runClient(const ClientCmdOptions& o) {
     GlRendererOptions gl;
     gl.lod_error_px = o.lod_px;
     hc.renderer = glRendererFactory(gl);
-    auto result = runHeadset(hc, scene, bvh, *traces);
+    auto result = runHeadset(hc, inputs->scene, inputs->bvh, inputs->traces);
     if (!result) {
         std::fprintf(stderr, "qvr client: %s\n", result.error().c_str());
         return 1;

@@ -315,18 +315,15 @@ int runRun(const RunOptions& o) {
     }
     const fs::path out(o.out);
     const auto t_start = std::chrono::steady_clock::now();
-    auto scene_loaded = loadScene(o.scene);
-    if (!scene_loaded) {
-        std::fprintf(stderr, "qvr run: %s\n", scene_loaded.error().c_str());
+    auto inputs =
+        loadHeadsetInputs(o.scene, o.motion, o.gaze, profile->refresh_hz, o.frames, o.seed);
+    if (!inputs) {
+        std::fprintf(stderr, "qvr run: %s\n", inputs.error().c_str());
         return 2;
     }
-    auto scene = std::make_shared<const Scene>(std::move(*scene_loaded));
-    auto bvh = std::make_shared<const TriangleBvh>(*scene);
-    auto traces = makeTraces(o.motion, o.gaze, *scene, profile->refresh_hz, o.frames, o.seed);
-    if (!traces) {
-        std::fprintf(stderr, "qvr run: %s\n", traces.error().c_str());
-        return 2;
-    }
+    const std::shared_ptr<const Scene>& scene = inputs->scene;
+    const std::shared_ptr<const TriangleBvh>& bvh = inputs->bvh;
+    const HeadsetTraces& traces = inputs->traces;
 
     // Two cores: the headset on core 0, the server's render thread on the last core.
     const int cores = onlineCores();
@@ -420,7 +417,7 @@ int runRun(const RunOptions& o) {
             }
         }
         Expected<HeadsetResult> result = makeError("not run");
-        std::thread headset([&] { result = runHeadset(hc, scene, bvh, *traces); });
+        std::thread headset([&] { result = runHeadset(hc, scene, bvh, traces); });
         headset.join();
         if (!result) {
             std::fprintf(stderr, "qvr run: %s: %s\n", designName(d), result.error().c_str());

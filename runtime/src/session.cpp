@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "qvr/render/camera.h"
+#include "qvr/scene/scene_loader.h"
 #include "qvr/trace/head_motion.h"
 
 namespace qvr::runtime {
@@ -84,6 +85,22 @@ Expected<HeadsetTraces> makeTraces(const std::string& motion, const std::string&
     if (t.motion.samples.empty() || t.gaze.samples.empty())
         return makeError("empty head-motion or gaze trace");
     return t;
+}
+
+Expected<HeadsetInputs> loadHeadsetInputs(const std::string& scene, const std::string& motion,
+                                          const std::string& gaze, double refresh_hz, int frames,
+                                          uint64_t seed) {
+    auto loaded = loadScene(scene);
+    if (!loaded)
+        return makeError(loaded.error());
+    HeadsetInputs in;
+    in.scene = std::make_shared<const Scene>(std::move(*loaded));
+    in.bvh = std::make_shared<const TriangleBvh>(*in.scene);
+    auto traces = makeTraces(motion, gaze, *in.scene, refresh_hz, frames, seed);
+    if (!traces)
+        return makeError(traces.error());
+    in.traces = std::move(*traces);
+    return in;
 }
 
 Expected<net::PresharedKey> keyFromOptions(const std::string& key, const std::string& key_file) {

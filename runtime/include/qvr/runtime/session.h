@@ -11,13 +11,14 @@
 #include "qvr/net/auth.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/scene/scene.h"
+#include "qvr/scene/triangle_bvh.h"
 
 namespace qvr::runtime {
 
-// "run" (the default of `qvr run`): the default HMD's 100°×110° field at 480×540 per eye, a
-// quarter of 1920×2160 on each axis, because llvmpipe on two shared cores renders a full
-// 1920×2160 eye in ~200 ms (docs/RENDER.md). "small": 320×360 for tests. Anything else goes
-// to hmdProfileByName ("default", "low", a TOML path).
+// "run": the default HMD's 100°×110° field at 480×540 per eye, a quarter of 1920×2160 on each
+// axis, for quick runs (`qvr run` defaults to "default", the paper's display, docs/RUNTIME.md).
+// "small": 320×360 for tests. Anything else goes to hmdProfileByName ("default", "low", a TOML
+// path).
 Expected<HmdProfile> runtimeProfileByName(const std::string& name);
 
 // motion: "default" (the CMU BVH that `qvr trace motion --default` uses), a .bvh path, a pose
@@ -26,6 +27,17 @@ Expected<HmdProfile> runtimeProfileByName(const std::string& name);
 Expected<HeadsetTraces> makeTraces(const std::string& motion, const std::string& gaze,
                                    const Scene& scene, double refresh_hz, int frames,
                                    uint64_t seed);
+
+// What a headset runs on: the scene (with its BVH for LIWC's ring counts) and the traces placed
+// in it, loaded from the command line's spellings (makeTraces for motion and gaze).
+struct HeadsetInputs {
+    std::shared_ptr<const Scene> scene;
+    std::shared_ptr<const TriangleBvh> bvh;
+    HeadsetTraces traces;
+};
+Expected<HeadsetInputs> loadHeadsetInputs(const std::string& scene, const std::string& motion,
+                                          const std::string& gaze, double refresh_hz, int frames,
+                                          uint64_t seed);
 
 // --key: 64 hex digits, or "pass:TEXT" for a passphrase (hashed; loopback only). --key-file: a
 // file holding either form on its first line. Exactly one must be non-empty.
