@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "qvr/codec/frame_header.h"
 #include "qvr/codec/video_codec.h"
+#include "qvr/compose/png_io.h"
 #include "qvr/compose/warp.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/net/link_emulator.h"
@@ -137,6 +138,16 @@ public:
         return out ? Status{} : Status(makeError("error writing " + path));
     }
     size_t frames() const { return m_frames.size(); }
+    // One displayed frame as PNG (with the fovea edge when drawn in the video), for a look
+    // without a video player.
+    Status writePngFrame(size_t i, const std::string& path) const {
+        if (i >= m_frames.size())
+            return makeError("no displayed frame " + std::to_string(i));
+        ImageRgba8 f = m_frames[i];
+        if (m_fovea_border && m_foveae[i].e1_deg > 0)
+            drawFoveaBorder(f, m_foveae[i].gaze, m_foveae[i].e1_deg);
+        return writePng(path, f);
+    }
 
 private:
     struct Fovea {
@@ -565,6 +576,10 @@ int runRun(const RunOptions& o) {
                 recorder.frames(), o.fovea_border ? ", fovea edge (e1) drawn in yellow" : "");
         else
             video_note = "video failed: " + st.error();
+        // The middle frame as a still beside it.
+        const size_t still = recorder.frames() / 2;
+        if (auto st = recorder.writePngFrame(still, (out / "qvr_display_still.png").string()); st)
+            video_note += fmt::format("; frame {} of it as qvr_display_still.png", still);
     }
 
     // Figures.
@@ -651,6 +666,10 @@ int runRun(const RunOptions& o) {
     if (!have_gnuplot)
         html += "<p>gnuplot not found: CSV written, no figures.</p>\n";
     html += "<p>Video: " + htmlEscape(video_note) + "</p>\n";
+    if (fs::exists(out / "qvr_display_still.png"))
+        html +=
+            "<img src='qvr_display_still.png' width='1000' alt='a frame the headset displayed "
+            "for qvr'>\n";
     std::ofstream(out / "report.html") << html;
 
     fmt::print("  ratios: {}\n", ratios.dump());
