@@ -590,7 +590,9 @@ TEST(Runtime, MalformedMediaDatagramsAreDroppedByReasonWhileFramesKeepComing) {
     HeadsetResult r;
     {
         MediaTamperingProxy proxy((*server)->port(), keyA(), frames - 15);
-        r = runOn(headsetConfig(RuntimeDesign::kQvr, proxy.port(), "raw", frames));
+        // ffr: a fixed fovea, so every frame asks for remote layers (with the null renderer
+        // LIWC may grow the fovea over the whole field and stop asking).
+        r = runOn(headsetConfig(RuntimeDesign::kFfr, proxy.port(), "raw", frames));
         EXPECT_GT(proxy.forwarded(), 100u);
         injected = proxy.injected();
     }
@@ -640,7 +642,9 @@ TEST(Runtime, TwoFramesInFlightRequestTheNextFrameBeforeComposingThisOne) {
     ASSERT_TRUE(server.ok()) << server.error();
     const int frames = 40;
     for (int depth : {2, 1}) {
-        HeadsetConfig h = headsetConfig(RuntimeDesign::kQvr, (*server)->port(), "raw", frames);
+        // ffr: every frame requests remote layers (LIWC with the null renderer may grow the
+        // fovea over the whole field, and then a frame asks for nothing).
+        HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", frames);
         h.pipeline_depth = depth;
         const HeadsetResult r = runOn(h);
         ASSERT_EQ(r.frames.size(), size_t(frames));
