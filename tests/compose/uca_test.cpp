@@ -256,8 +256,10 @@ TEST(ComposeUca, MeshTilesStayWithinTheirBoundOfTheExactMap) {
         }
     }
     // Many single-layer tiles qualify on these lenses (the rest touch the rendered image's edge
-    // at this small size); a mesh that never engages would test nothing.
-    EXPECT_GT(mesh_tiles, single_tiles / 4);
+    // at this small size); a mesh that never engages would test nothing. The share depends on
+    // the random lens and gaze: 18–48% over 25 runs, so require a tenth.
+    RecordProperty("mesh_share", std::to_string(double(mesh_tiles) / double(single_tiles)));
+    EXPECT_GT(mesh_tiles, single_tiles / 10);
 }
 
 TEST(ComposeUca, IdentityPoseNoLensAllFoveaReproducesInput) {
