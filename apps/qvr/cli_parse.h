@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "qvr/foveation/eye_geometry.h"
 
 namespace qvr::cli {
@@ -19,6 +21,17 @@ inline bool parseGazeDeg(const std::string& text, Gaze& gaze) {
         return false;
     gaze = {x, y};
     return true;
+}
+
+// --lod-px (render/draw_list.h): each view draws every scene cluster at the coarsest level of
+// detail whose vertices move at most this many of the view's own pixels; 0 draws full detail.
+inline CLI::Option* addLodOption(CLI::App* cmd, float& lod_px) {
+    return cmd
+        ->add_option("--lod-px", lod_px,
+                     "Level of detail: largest vertex move in each view's own pixels (0: full "
+                     "detail)")
+        ->check(CLI::Range(0.0, 16.0))
+        ->capture_default_str();
 }
 
 }  // namespace qvr::cli

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_commands.h"
+#include "cli_parse.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/scene/scene_loader.h"
@@ -196,10 +197,7 @@ static Registered registerRenderBench(CLI::App& bench) {
     cmd->add_option("--frames", opts->frames, "Timed frames per scene (median reported)")
         ->check(CLI::Range(1, 10000))
         ->capture_default_str();
-    cmd->add_option("--lod-px", opts->lod_px,
-                    "Level of detail: largest vertex move in each view's own pixels (0: off)")
-        ->check(CLI::Range(0.0, 16.0))
-        ->capture_default_str();
+    addLodOption(cmd, opts->lod_px);
     cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
         ->check(CLI::Range(1, 32))
         ->capture_default_str();

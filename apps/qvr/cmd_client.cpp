@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_parse.h"
 #include "commands.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
@@ -144,11 +145,7 @@ static Registered registerClient(CLI::App& app) {
     cmd->add_option("--codec", o->codec, "x264 or raw (must match the server)")
         ->capture_default_str();
     cmd->add_option("--frames", o->frames, "Frames to run")->capture_default_str();
-    cmd->add_option(
-           "--lod-px", o->lod_px,
-           "Level of detail: largest vertex move in the view's own pixels (0: full detail)")
-        ->check(CLI::Range(0.0, 16.0))
-        ->capture_default_str();
+    addLodOption(cmd, o->lod_px);
     cmd->add_option("--core", o->core, "Pin the headset loop to this core (-1: no)")
         ->capture_default_str();
     cmd->add_option("--seed", o->seed, "Gaze model seed")->capture_default_str();

@@ -234,10 +234,7 @@ static Registered registerRender(CLI::App& app) {
                     "Extra lightmap brightening on top of the loader's overbright shift")
         ->check(CLI::Range(0.0, 16.0))
         ->capture_default_str();
-    cmd->add_option("--lod-px", opts->lod_px,
-                    "Level of detail: largest vertex move in each view's own pixels (0: off)")
-        ->check(CLI::Range(0.0, 16.0))
-        ->capture_default_str();
+    addLodOption(cmd, opts->lod_px);
     cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
         ->check(CLI::Range(1, 32))
         ->capture_default_str();

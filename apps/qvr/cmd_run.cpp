@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/frame_header.h"
 #include "qvr/codec/video_codec.h"
@@ -714,11 +715,7 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Server renders middle and outer in one geometry pass per eye (pays when "
                   "vertex-bound: no LOD, small displays)");
-    cmd->add_option("--lod-px", o->lod_px,
-                    "Level of detail on both sides: largest vertex move in each view's own pixels "
-                    "(0: full detail)")
-        ->check(CLI::Range(0.0, 16.0))
-        ->capture_default_str();
+    addLodOption(cmd, o->lod_px);
     cmd->add_option("--pipeline", o->pipeline_depth,
                     "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
                     "finishing n)")

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_parse.h"
 #include "commands.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/affinity.h"
@@ -154,11 +155,7 @@ static Registered registerServer(CLI::App& app) {
     cmd->add_option("--codec", o->codec, "x264 or raw")->capture_default_str();
     cmd->add_option("--core", o->core, "Pin the render thread to this core (-1: no)")
         ->capture_default_str();
-    cmd->add_option(
-           "--lod-px", o->lod_px,
-           "Level of detail: largest vertex move in the view's own pixels (0: full detail)")
-        ->check(CLI::Range(0.0, 16.0))
-        ->capture_default_str();
+    addLodOption(cmd, o->lod_px);
     cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit");
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
