@@ -153,6 +153,103 @@ HWY_INLINE VF lerp(VF w, VF a, VF b) {
     return hn::MulAdd(w, hn::Sub(b, a), a);
 }
 
+// The four taps of every lane: t00 at (flx, fly), t10 one texel right, t01 one below, t11 both.
+struct Taps {
+    VU t00, t10, t01, t11;
+};
+
+#if HWY_TARGET != HWY_SCALAR
+// Taps by gathers, for 0 ≤ flx ≤ width − 2 and 0 ≤ fly ≤ height − 2. The two taps of a row are
+// neighbours in memory: fetch them as one 64-bit element, half the gathered elements.
+HWY_INLINE Taps gatherTaps(const KernelLayer& l, VF flx, VF fly) {
+    const DF df;
+    const DU du;
+    // Texel index in float is exact: layers hold fewer than 2^24 texels (validateFrame).
+    const VI i00 = truncToInt(hn::MulAdd(fly, hn::Set(df, static_cast<float>(l.width)), flx));
+    VU r0_lo, r0_hi, r1_lo, r1_hi;
+#if HWY_TARGET <= HWY_AVX3
+    // 32-bit texel indices scaled by 4 bytes in the gather itself: no widening, no shifts.
+    const DI di;
+    const VI i01 = hn::Add(i00, hn::Set(di, l.width));
+    const __m256i i00_hi = _mm512_extracti64x4_epi64(i00.raw, 1);
+    const __m256i i01_hi = _mm512_extracti64x4_epi64(i01.raw, 1);
+    r0_lo = VU{_mm512_i32gather_epi64(_mm512_castsi512_si256(i00.raw), l.texels, 4)};
+    r0_hi = VU{_mm512_i32gather_epi64(i00_hi, l.texels, 4)};
+    r1_lo = VU{_mm512_i32gather_epi64(_mm512_castsi512_si256(i01.raw), l.texels, 4)};
+    r1_hi = VU{_mm512_i32gather_epi64(i01_hi, l.texels, 4)};
+#else
+    const hn::Half<DI> dh;
+    const hn::Repartition<uint64_t, DU> d64;
+    const hn::RebindToSigned<decltype(d64)> di64;
+    const auto* base64 = reinterpret_cast<const uint64_t*>(l.texels);
+    const auto lo = hn::ShiftLeft<2>(hn::PromoteTo(di64, hn::LowerHalf(dh, i00)));
+    const auto hi = hn::ShiftLeft<2>(hn::PromoteTo(di64, hn::UpperHalf(dh, i00)));
+    const auto row_bytes = hn::Set(di64, int64_t{4} * l.width);
+    r0_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, lo));
+    r0_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hi));
+    r1_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(lo, row_bytes)));
+    r1_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(hi, row_bytes)));
+#endif
+    return {hn::ConcatEven(du, r0_hi, r0_lo), hn::ConcatOdd(du, r0_hi, r0_lo),
+            hn::ConcatEven(du, r1_hi, r1_lo), hn::ConcatOdd(du, r1_hi, r1_lo)};
+}
+#endif
+
+#if HWY_TARGET <= HWY_AVX3
+// Taps by whole-row loads and two-table permutes where the lanes' footprint is small (docs/UCA.md,
+// "Row windows"); false leaves them to the gathers. Same texels, so the same result. Mesh tiles
+// only: their taps lie inside the layer, so every window starts and ends inside it.
+//  * Narrow: every left tap within 14 texels of lane 0's and every top tap in row y or y + 1,
+//    y = min(lane 0's row, lane 15's): rows y, y + 1, y + 2 as 16 texels each; bit 4 of a
+//    permute index picks the lower of two rows, so a lane's own row costs nothing.
+//  * Wide: every top tap in lane 0's row, left taps within 30 texels: two rows of 32 texels.
+HWY_INLINE bool permuteTaps(const KernelLayer& l, VF flx, VF fly, Taps& taps) {
+    const VI ix = truncToInt(flx);
+    const VI iy = truncToInt(fly);
+    const int x0 = _mm_cvtsi128_si32(_mm512_castsi512_si128(ix.raw));
+    const int y0 = _mm_cvtsi128_si32(_mm512_castsi512_si128(iy.raw));
+    const int y15 =
+        _mm_cvtsi128_si32(_mm512_castsi512_si128(_mm512_alignr_epi32(iy.raw, iy.raw, 15)));
+    const int y = y0 < y15 ? y0 : y15;
+    const __m512i rel = _mm512_sub_epi32(ix.raw, _mm512_set1_epi32(x0));
+    const __m512i dy = _mm512_sub_epi32(iy.raw, _mm512_set1_epi32(y));
+    const __m512i one = _mm512_set1_epi32(1);
+    const auto* base = reinterpret_cast<const uint32_t*>(l.texels);
+    const __mmask16 narrow =
+        _mm512_mask_cmple_epu32_mask(_mm512_cmple_epu32_mask(dy, one), rel, _mm512_set1_epi32(14));
+    if (narrow == 0xFFFF && x0 + 16 <= l.width && y + 2 < l.height) {
+        const uint32_t* row = base + static_cast<size_t>(y) * static_cast<size_t>(l.width) + x0;
+        const __m512i r0 = _mm512_loadu_si512(row);
+        const __m512i r1 = _mm512_loadu_si512(row + l.width);
+        const __m512i r2 = _mm512_loadu_si512(row + 2 * static_cast<size_t>(l.width));
+        const __m512i i0 = _mm512_or_si512(rel, _mm512_slli_epi32(dy, 4));
+        const __m512i i1 = _mm512_add_epi32(i0, one);
+        taps.t00 = VU{_mm512_permutex2var_epi32(r0, i0, r1)};
+        taps.t10 = VU{_mm512_permutex2var_epi32(r0, i1, r1)};
+        taps.t01 = VU{_mm512_permutex2var_epi32(r1, i0, r2)};
+        taps.t11 = VU{_mm512_permutex2var_epi32(r1, i1, r2)};
+        return true;
+    }
+    const __mmask16 wide = _mm512_mask_cmple_epu32_mask(
+        _mm512_cmpeq_epi32_mask(iy.raw, _mm512_set1_epi32(y0)), rel, _mm512_set1_epi32(30));
+    if (wide == 0xFFFF && x0 + 32 <= l.width) {
+        const uint32_t* row0 = base + static_cast<size_t>(y0) * static_cast<size_t>(l.width) + x0;
+        const uint32_t* row1 = row0 + l.width;
+        const __m512i a0 = _mm512_loadu_si512(row0);
+        const __m512i a1 = _mm512_loadu_si512(row0 + 16);
+        const __m512i b0 = _mm512_loadu_si512(row1);
+        const __m512i b1 = _mm512_loadu_si512(row1 + 16);
+        const __m512i rel1 = _mm512_add_epi32(rel, one);
+        taps.t00 = VU{_mm512_permutex2var_epi32(a0, rel, a1)};
+        taps.t10 = VU{_mm512_permutex2var_epi32(a0, rel1, a1)};
+        taps.t01 = VU{_mm512_permutex2var_epi32(b0, rel, b1)};
+        taps.t11 = VU{_mm512_permutex2var_epi32(b0, rel1, b1)};
+        return true;
+    }
+    return false;
+}
+#endif
+
 // Bilinear RGB of one layer at texel coordinates (lx, ly). kClamp: clamp to the edge. Without
 // it the caller guarantees 0 ≤ lx < width − 1 and 0 ≤ ly < height − 1 (mesh tiles), where the
 // clamps below change nothing.
@@ -170,54 +267,27 @@ HWY_INLINE Rgb sampleTexels(const KernelLayer& l, VF lx, VF ly) {
         lx = hn::Min(hn::Max(lx, zero), max_x);
         ly = hn::Min(hn::Max(ly, zero), max_y);
     }
-    const auto* base = reinterpret_cast<const uint32_t*>(l.texels);
-    VU t00, t10, t01, t11;
-    VF flx, fly;
+    VF flx = hn::Floor(lx);
+    VF fly = hn::Floor(ly);
+    Taps taps;
 #if HWY_TARGET != HWY_SCALAR
     if (l.width >= 2 && l.height >= 2) {
-        // The two taps of a row are neighbours in memory: fetch them as one 64-bit element, half
-        // the gathered elements. The left tap stops one short of the edge, where the weight of
-        // the right tap becomes exactly 1, so no fetch passes the end of a row.
-        flx = hn::Floor(lx);
-        fly = hn::Floor(ly);
+        // The left tap stops one short of the edge, where the weight of the right tap becomes
+        // exactly 1, so no fetch passes the end of a row.
         if (kClamp) {
             flx = hn::Min(flx, hn::Sub(max_x, hn::Set(df, 1.0f)));
             fly = hn::Min(fly, hn::Sub(max_y, hn::Set(df, 1.0f)));
         }
-        // Texel index in float is exact: layers hold fewer than 2^24 texels (validateFrame).
-        const VI i00 = truncToInt(hn::MulAdd(fly, hn::Set(df, static_cast<float>(l.width)), flx));
-        VU r0_lo, r0_hi, r1_lo, r1_hi;
 #if HWY_TARGET <= HWY_AVX3
-        // 32-bit texel indices scaled by 4 bytes in the gather itself: no widening, no shifts.
-        const VI i01 = hn::Add(i00, hn::Set(di, l.width));
-        const __m256i i00_hi = _mm512_extracti64x4_epi64(i00.raw, 1);
-        const __m256i i01_hi = _mm512_extracti64x4_epi64(i01.raw, 1);
-        r0_lo = VU{_mm512_i32gather_epi64(_mm512_castsi512_si256(i00.raw), l.texels, 4)};
-        r0_hi = VU{_mm512_i32gather_epi64(i00_hi, l.texels, 4)};
-        r1_lo = VU{_mm512_i32gather_epi64(_mm512_castsi512_si256(i01.raw), l.texels, 4)};
-        r1_hi = VU{_mm512_i32gather_epi64(i01_hi, l.texels, 4)};
+        if (kClamp || !permuteTaps(l, flx, fly, taps))
+            taps = gatherTaps(l, flx, fly);
 #else
-        const hn::Half<DI> dh;
-        const hn::Repartition<uint64_t, DU> d64;
-        const hn::RebindToSigned<decltype(d64)> di64;
-        const auto* base64 = reinterpret_cast<const uint64_t*>(l.texels);
-        const auto lo = hn::ShiftLeft<2>(hn::PromoteTo(di64, hn::LowerHalf(dh, i00)));
-        const auto hi = hn::ShiftLeft<2>(hn::PromoteTo(di64, hn::UpperHalf(dh, i00)));
-        const auto row_bytes = hn::Set(di64, int64_t{4} * l.width);
-        r0_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, lo));
-        r0_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hi));
-        r1_lo = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(lo, row_bytes)));
-        r1_hi = hn::BitCast(du, hn::GatherOffset(d64, base64, hn::Add(hi, row_bytes)));
+        taps = gatherTaps(l, flx, fly);
 #endif
-        t00 = hn::ConcatEven(du, r0_hi, r0_lo);
-        t10 = hn::ConcatOdd(du, r0_hi, r0_lo);
-        t01 = hn::ConcatEven(du, r1_hi, r1_lo);
-        t11 = hn::ConcatOdd(du, r1_hi, r1_lo);
     } else
 #endif
     {
-        flx = hn::Floor(lx);
-        fly = hn::Floor(ly);
+        const auto* base = reinterpret_cast<const uint32_t*>(l.texels);
         const VI i00 =
             hn::ConvertTo(di, hn::MulAdd(fly, hn::Set(df, static_cast<float>(l.width)), flx));
         const VI step_x =
@@ -225,20 +295,21 @@ HWY_INLINE Rgb sampleTexels(const KernelLayer& l, VF lx, VF ly) {
         const VI step_y =
             hn::IfThenElseZero(hn::RebindMask(di, hn::Lt(fly, max_y)), hn::Set(di, l.width));
         const VI i01 = hn::Add(i00, step_y);
-        t00 = hn::GatherIndex(du, base, i00);
-        t10 = hn::GatherIndex(du, base, hn::Add(i00, step_x));
-        t01 = hn::GatherIndex(du, base, i01);
-        t11 = hn::GatherIndex(du, base, hn::Add(i01, step_x));
+        taps.t00 = hn::GatherIndex(du, base, i00);
+        taps.t10 = hn::GatherIndex(du, base, hn::Add(i00, step_x));
+        taps.t01 = hn::GatherIndex(du, base, i01);
+        taps.t11 = hn::GatherIndex(du, base, hn::Add(i01, step_x));
     }
     const VF wx = hn::Sub(lx, flx);
     const VF wy = hn::Sub(ly, fly);
     Rgb out;
-    out.r = lerp(wy, lerp(wx, channel<0>(t00), channel<0>(t10)),
-                 lerp(wx, channel<0>(t01), channel<0>(t11)));
-    out.g = lerp(wy, lerp(wx, channel<1>(t00), channel<1>(t10)),
-                 lerp(wx, channel<1>(t01), channel<1>(t11)));
-    out.b = lerp(wy, lerp(wx, channel<2>(t00), channel<2>(t10)),
-                 lerp(wx, channel<2>(t01), channel<2>(t11)));
+    const Taps& t = taps;
+    out.r = lerp(wy, lerp(wx, channel<0>(t.t00), channel<0>(t.t10)),
+                 lerp(wx, channel<0>(t.t01), channel<0>(t.t11)));
+    out.g = lerp(wy, lerp(wx, channel<1>(t.t00), channel<1>(t.t10)),
+                 lerp(wx, channel<1>(t.t01), channel<1>(t.t11)));
+    out.b = lerp(wy, lerp(wx, channel<2>(t.t00), channel<2>(t.t10)),
+                 lerp(wx, channel<2>(t.t01), channel<2>(t.t11)));
     return out;
 }
 
