@@ -139,6 +139,13 @@ HWY_INLINE VF channel(VU texel) {
     const auto pick = hn::BitCast(d8, index);
 #if HWY_TARGET <= HWY_AVX3
     (void)d8;
+    if constexpr (kChannel == 1) {
+        // Green is already in bits 8–15: one bit select (any vector port) instead of a shuffle
+        // (port 5 only, which the permutes and shuffles already keep busy).
+        return hn::BitCast(df,
+                           VU{_mm512_ternarylogic_epi32(texel.raw, hn::Set(du, 0xFF00u).raw,
+                                                        hn::Set(du, kTexelBiasBits).raw, 0xEA)});
+    }
     return hn::BitCast(
         df, VU{_mm512_mask_shuffle_epi8(hn::Set(du, kTexelBiasBits).raw, 0x2222222222222222ull,
                                         texel.raw, pick.raw)});
