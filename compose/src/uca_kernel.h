@@ -88,20 +88,23 @@ struct TileJob {
     // once and read by someone else, so it need not displace the layers from the caches. The
     // caller fences them (ucaFenceStreams) before it reports the tile done.
     bool stream = false;
-    // Let a single-layer tile interpolate its map on the 8-pixel mesh where the mesh's error is
-    // within kMeshBoundTexels (MeshLattice); false maps every pixel exactly.
+    // Let a single-layer or border tile interpolate its map on the 8-pixel mesh where the
+    // mesh's error is within the bounds below (MeshLattice); false maps every pixel exactly.
     bool mesh = false;
 };
 
 // Mesh tiles (docs/UCA.md, "Mesh tiles"): the exact map at the nodes (x0 + 8i, y0 + 8j) of a
-// single-layer tile, converted to the layer's texel coordinates, and bilinear interpolation of
-// those in between. A tile qualifies per frame when
-//  * the exact map at every cell centre and edge midpoint (the 9×9 lattice at a 4-pixel step,
-//    nodes at even indices) is within kMeshBoundTexels of the interpolation, in texels;
+// tile and bilinear interpolation in between — of the layer's texel coordinates in a
+// single-layer tile, of the rendered-image point in a border tile (whose eccentricity is then
+// that of the interpolated point, meshEccentricityCos). A tile qualifies per frame when
+//  * at every cell centre and edge midpoint (the 9×9 lattice at a 4-pixel step, nodes at even
+//    indices) the exact map is within kMeshBoundTexels of the interpolation, in texels of the
+//    finest layer the tile samples;
 //  * every lattice point is at least kMeshMarginPx inside the rendered image (no pixel of the
-//    tile is invalid), and its texel coordinate lies in [kMeshTexelMargin, size − 1 −
-//    kMeshTexelMargin] (the interpolated coordinates then need no clamp).
-// Both kernels evaluate the lattice with the same float arithmetic and decide here.
+//    tile is invalid), and in a single-layer tile its texel coordinate lies in
+//    [kMeshTexelMargin, size − 1 − kMeshTexelMargin] (the interpolated coordinates need no
+//    clamp).
+// Both kernels evaluate the lattice with the same float arithmetic and decide alike.
 inline constexpr int kMeshStepPx = 8;
 static_assert(kTilePx % kMeshStepPx == 0);
 inline constexpr int kMeshCells = kTilePx / kMeshStepPx;
@@ -115,33 +118,62 @@ inline constexpr float kMeshTexelMargin = 1.0f / 64.0f;
 
 // The lattice of one tile, row-major (point (i, j) is display pixel (x0 + 4i, y0 + 4j)): the
 // exact rendered-image point — (0, 0) when invalid (off the image, behind the eye), which fails
-// the margin — and its texel coordinate lx = px·inv_scale + offset_x (one fused multiply-add).
+// the margin — its texel coordinate in a single-layer tile's layer, lx = px·inv_scale +
+// offset_x (one fused multiply-add).
 struct MeshLattice {
+    // The vector kernel reads neighbours up to a lattice row and one point before and after.
+    float head[16];
     float px[kMeshLatticeStorage];
     float py[kMeshLatticeStorage];
     float lx[kMeshLatticeStorage];
     float ly[kMeshLatticeStorage];
-    // The vector kernel reads neighbours up to a lattice row and one point past the end of ly.
     float tail[16];
 };
 
+// Which of a lattice's values a tile interpolates and how closely they must follow the map.
+struct MeshPlan {
+    bool border = false;  // interpolate px, py (else lx, ly of `layer`)
+    int layer = 0;        // the single-layer tile's slot
+    float bound_xy = 0;   // in the units of the interpolated coordinates
+};
+
+inline MeshPlan meshPlan(const KernelParams& p, uint8_t slot_mask) {
+    MeshPlan plan;
+    plan.border = (slot_mask & (slot_mask - 1)) != 0;
+    if (!plan.border) {
+        plan.layer = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
+        plan.bound_xy = kMeshBoundTexels;
+        return plan;
+    }
+    float inv = 0.0f;
+    for (int k = 0; k < p.slot_count; ++k) {
+        if ((slot_mask & (1u << k)) != 0)
+            inv = inv > p.slots[k].inv_scale ? inv : p.slots[k].inv_scale;
+    }
+    plan.bound_xy = kMeshBoundTexels / inv;
+    return plan;
+}
+
 // The scalar statement of the test; the vector kernel evaluates the same comparisons on the
-// same floats a vector of lattice points at a time (meshAcceptableV) and must agree.
-inline bool meshAcceptable(const MeshLattice& m, const KernelParams& p, const KernelLayer& l) {
+// same floats a vector of lattice points at a time and must agree.
+inline bool meshAcceptable(const MeshLattice& m, const KernelParams& p, const MeshPlan& plan) {
+    const KernelLayer& l = p.slots[plan.layer];
     const float max_lx = static_cast<float>(l.width - 1) - kMeshTexelMargin;
     const float max_ly = static_cast<float>(l.height - 1) - kMeshTexelMargin;
     for (int k = 0; k < kMeshLatticePoints; ++k) {
         // Written so that a NaN fails too.
         if (!(m.px[k] >= kMeshMarginPx && m.px[k] <= p.width - kMeshMarginPx &&
-              m.py[k] >= kMeshMarginPx && m.py[k] <= p.height - kMeshMarginPx &&
-              m.lx[k] >= kMeshTexelMargin && m.lx[k] <= max_lx && m.ly[k] >= kMeshTexelMargin &&
-              m.ly[k] <= max_ly)) {
+              m.py[k] >= kMeshMarginPx && m.py[k] <= p.height - kMeshMarginPx)) {
+            return false;
+        }
+        if (!plan.border && !(m.lx[k] >= kMeshTexelMargin && m.lx[k] <= max_lx &&
+                              m.ly[k] >= kMeshTexelMargin && m.ly[k] <= max_ly)) {
             return false;
         }
     }
     constexpr int n = kMeshLatticeSide;
     // Interpolation at a midpoint from the two (edge) or four (centre) nodes around it.
-    auto within = [&](const float* v, int j, int i) {
+    auto within = [&](const float* v, int j, int i, float bound) {
         float interp;
         if ((i & 1) != 0 && (j & 1) != 0) {
             interp = 0.25f * ((v[(j - 1) * n + i - 1] + v[(j - 1) * n + i + 1]) +
@@ -152,13 +184,15 @@ inline bool meshAcceptable(const MeshLattice& m, const KernelParams& p, const Ke
             interp = 0.5f * (v[(j - 1) * n + i] + v[(j + 1) * n + i]);
         }
         const float err = v[j * n + i] - interp;
-        return err <= kMeshBoundTexels && err >= -kMeshBoundTexels;
+        return err <= bound && err >= -bound;
     };
+    const float* x = plan.border ? m.px : m.lx;
+    const float* y = plan.border ? m.py : m.ly;
     for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
             if (((i | j) & 1) == 0)
                 continue;  // a node
-            if (!within(m.lx, j, i) || !within(m.ly, j, i))
+            if (!within(x, j, i, plan.bound_xy) || !within(y, j, i, plan.bound_xy))
                 return false;
         }
     }

@@ -333,10 +333,40 @@ HWY_INLINE Rgb unbias(const Rgb& c) {
     return {hn::Sub(c.r, bias), hn::Sub(c.g, bias), hn::Sub(c.b, bias)};
 }
 
+// Eq. 4's blend of the slots in slot_mask at rendered-image points with eccentricity cosines
+// cos_e (unbiased values).
+HWY_INLINE Rgb blendSlots(const KernelParams& p, uint8_t slot_mask, VF px, VF py, VF cos_e) {
+    const DF df;
+    const VF zero = hn::Zero(df);
+    const VF one = hn::Set(df, 1.0f);
+    const VF t1 = hn::Min(hn::Max(hn::Mul(hn::Sub(hn::Set(df, p.border_c_hi[0]), cos_e),
+                                          hn::Set(df, p.border_inv[0])),
+                                  zero),
+                          one);
+    const VF t2 = hn::Min(hn::Max(hn::Mul(hn::Sub(hn::Set(df, p.border_c_hi[1]), cos_e),
+                                          hn::Set(df, p.border_inv[1])),
+                                  zero),
+                          one);
+    const VF t12 = hn::Mul(t1, t2);
+    const VF w[3] = {hn::Sub(one, t1), hn::Sub(t1, t12), t12};
+    Rgb rgb = {zero, zero, zero};
+    for (int k = 0; k < p.slot_count; ++k) {
+        if ((slot_mask & (1u << k)) == 0)
+            continue;
+        // Lanes outside this layer's ramp have weight 0; skip the gathers when all do.
+        if (hn::AllFalse(df, hn::Gt(w[k], zero)))
+            continue;
+        const Rgb s = unbias(sampleLayer(p.slots[k], px, py));
+        rgb.r = hn::MulAdd(w[k], s.r, rgb.r);
+        rgb.g = hn::MulAdd(w[k], s.g, rgb.g);
+        rgb.b = hn::MulAdd(w[k], s.b, rgb.b);
+    }
+    return rgb;
+}
+
 // Eq. 4 for a vector of pixels; lanes off the rendered image come back in `valid`.
 HWY_INLINE Rgb shade(const KernelParams& p, const RowMap& r, VF u, VF v, float chroma,
                      uint8_t slot_mask, MF& valid) {
-    const DF df;
     const bool single = (slot_mask & (slot_mask - 1)) == 0;
     const MapV m = mapPixels(p, r, u, v, chroma, !single);
     Rgb rgb;
@@ -344,30 +374,7 @@ HWY_INLINE Rgb shade(const KernelParams& p, const RowMap& r, VF u, VF v, float c
         const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
         rgb = unbias(sampleLayer(p.slots[k], m.px, m.py));
     } else {
-        const VF zero = hn::Zero(df);
-        const VF one = hn::Set(df, 1.0f);
-        const VF t1 = hn::Min(hn::Max(hn::Mul(hn::Sub(hn::Set(df, p.border_c_hi[0]), m.cos_e),
-                                              hn::Set(df, p.border_inv[0])),
-                                      zero),
-                              one);
-        const VF t2 = hn::Min(hn::Max(hn::Mul(hn::Sub(hn::Set(df, p.border_c_hi[1]), m.cos_e),
-                                              hn::Set(df, p.border_inv[1])),
-                                      zero),
-                              one);
-        const VF t12 = hn::Mul(t1, t2);
-        const VF w[3] = {hn::Sub(one, t1), hn::Sub(t1, t12), t12};
-        rgb = {zero, zero, zero};
-        for (int k = 0; k < p.slot_count; ++k) {
-            if ((slot_mask & (1u << k)) == 0)
-                continue;
-            // Lanes outside this layer's ramp have weight 0; skip the gathers when all do.
-            if (hn::AllFalse(df, hn::Gt(w[k], zero)))
-                continue;
-            const Rgb s = unbias(sampleLayer(p.slots[k], m.px, m.py));
-            rgb.r = hn::MulAdd(w[k], s.r, rgb.r);
-            rgb.g = hn::MulAdd(w[k], s.g, rgb.g);
-            rgb.b = hn::MulAdd(w[k], s.b, rgb.b);
-        }
+        rgb = blendSlots(p, slot_mask, m.px, m.py, m.cos_e);
     }
     valid = m.valid;
     return rgb;
@@ -430,10 +437,11 @@ HWY_INLINE VU shadePacked(const KernelParams& p, const RowMap& r, VF u, VF v, ui
     return pack(rv, gv, bv);
 }
 
-// The exact map (steps 1–4, no eccentricity) at the tile's 9×9 lattice (docs/UCA.md, "Mesh
-// tiles"), a vector of lattice points at a time. Each lane has its own row, so the row
-// constants of rowMap() are formed per lane with the same float operations.
-HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const KernelLayer& layer,
+// The exact map (steps 1–4) at the tile's 9×9 lattice (docs/UCA.md, "Mesh tiles"), a vector
+// of lattice points at a time, with the texel coordinate in `layer` (single-layer plan). Each
+// lane has its own row, so the row constants of rowMap() are formed
+// per lane with the same float operations.
+HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const MeshPlan& plan,
                            MeshLattice& out) {
     const DF df;
     const int lanes = static_cast<int>(hn::Lanes(df));
@@ -449,12 +457,15 @@ HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const Kern
         }
         return o;
     }();
+    const KernelLayer& layer = p.slots[plan.layer];
     const RowMap r0 = rowMap(p, 0.0f);
     const VF x0 = hn::Set(df, static_cast<float>(job.x0));
     const VF y0 = hn::Set(df, static_cast<float>(job.y0));
     const VF zero = hn::Zero(df);
-    for (int k = 0; k < 16; k += lanes)
+    for (int k = 0; k < 16; k += lanes) {
+        hn::StoreU(zero, df, out.head + k);
         hn::StoreU(zero, df, out.tail + k);
+    }
     for (int k = 0; k < kMeshLatticeStorage; k += lanes) {
         const VF u = hn::Add(x0, hn::Load(df, offsets.u + k));
         const VF v = hn::Add(y0, hn::Load(df, offsets.v + k));
@@ -484,17 +495,31 @@ HWY_INLINE void mapLattice(const KernelParams& p, const TileJob& job, const Kern
         const VF vy = hn::IfThenElseZero(valid, py);
         hn::Store(vx, df, out.px + k);
         hn::Store(vy, df, out.py + k);
-        hn::Store(hn::MulAdd(vx, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_x)), df,
-                  out.lx + k);
-        hn::Store(hn::MulAdd(vy, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_y)), df,
-                  out.ly + k);
+        if (!plan.border) {
+            hn::Store(hn::MulAdd(vx, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_x)), df,
+                      out.lx + k);
+            hn::Store(hn::MulAdd(vy, hn::Set(df, layer.inv_scale), hn::Set(df, layer.offset_y)), df,
+                      out.ly + k);
+        }
     }
+}
+
+// cos e of rendered-image points: the direction ((px − cx)/fx, −(py − cy)/fy, −1) against the
+// gaze (border mesh tiles; the same operations as the twin's meshEccentricityCos).
+HWY_INLINE VF eccentricityCos(const KernelParams& p, VF px, VF py) {
+    const DF df;
+    const VF rx = hn::Mul(hn::Sub(px, hn::Set(df, p.cx)), hn::Set(df, 1.0f / p.fx));
+    const VF ry = hn::Mul(hn::Sub(hn::Set(df, p.cy), py), hn::Set(df, 1.0f / p.fy));
+    const VF n2 = hn::MulAdd(rx, rx, hn::MulAdd(ry, ry, hn::Set(df, 1.0f)));
+    const VF dot = hn::MulAdd(hn::Set(df, p.gaze[0]), rx,
+                              hn::MulAdd(hn::Set(df, p.gaze[1]), ry, hn::Set(df, -p.gaze[2])));
+    return hn::Div(dot, hn::Sqrt(n2));
 }
 
 // meshAcceptable() a vector of lattice points at a time: the same comparisons on the same
 // floats (each midpoint's interpolation is formed exactly as there), lanes selected by the
 // point's kind — node, horizontal or vertical edge midpoint, cell centre.
-HWY_INLINE bool meshAcceptableV(const MeshLattice& m, const KernelParams& p, const KernelLayer& l) {
+HWY_INLINE bool meshAcceptableV(const MeshLattice& m, const KernelParams& p, const MeshPlan& plan) {
     const DF df;
     const DU du;
     const int lanes = static_cast<int>(hn::Lanes(df));
@@ -513,19 +538,22 @@ HWY_INLINE bool meshAcceptableV(const MeshLattice& m, const KernelParams& p, con
         return t;
     }();
     constexpr int n = kMeshLatticeSide;
+    const KernelLayer& l = p.slots[plan.layer];
     const VF margin = hn::Set(df, kMeshMarginPx);
     const VF max_px = hn::Set(df, p.width - kMeshMarginPx);
     const VF max_py = hn::Set(df, p.height - kMeshMarginPx);
     const VF tmargin = hn::Set(df, kMeshTexelMargin);
     const VF max_lx = hn::Set(df, static_cast<float>(l.width - 1) - kMeshTexelMargin);
     const VF max_ly = hn::Set(df, static_cast<float>(l.height - 1) - kMeshTexelMargin);
-    const VF bound = hn::Set(df, kMeshBoundTexels);
-    const VF neg_bound = hn::Set(df, -kMeshBoundTexels);
     const VF half = hn::Set(df, 0.5f);
     const VF quarter = hn::Set(df, 0.25f);
-    auto within = [&](VF err) { return hn::And(hn::Le(err, bound), hn::Ge(err, neg_bound)); };
-    // Lanes of kind `kind` whose error is outside the bound, for one coordinate.
-    auto bad = [&](const float* v, int k, VU h, VU vert, VU c) {
+    const float* xs = plan.border ? m.px : m.lx;
+    const float* ys = plan.border ? m.py : m.ly;
+    // Lanes of each midpoint kind whose error exceeds the bound, for one coordinate.
+    auto bad = [&](const float* v, int k, float bound_f, VU h, VU vert, VU c) {
+        const VF bound = hn::Set(df, bound_f);
+        const VF neg_bound = hn::Set(df, -bound_f);
+        auto within = [&](VF err) { return hn::And(hn::Le(err, bound), hn::Ge(err, neg_bound)); };
         const VF x = hn::Load(df, v + k);
         const VF eh =
             hn::Sub(x, hn::Mul(half, hn::Add(hn::LoadU(df, v + k - 1), hn::LoadU(df, v + k + 1))));
@@ -543,16 +571,19 @@ HWY_INLINE bool meshAcceptableV(const MeshLattice& m, const KernelParams& p, con
     };
     for (int k = 0; k < kMeshLatticeStorage; k += lanes) {
         const VF px = hn::Load(df, m.px + k), py = hn::Load(df, m.py + k);
-        const VF lx = hn::Load(df, m.lx + k), ly = hn::Load(df, m.ly + k);
-        const auto inside = hn::And(hn::And(hn::And(hn::Ge(px, margin), hn::Le(px, max_px)),
-                                            hn::And(hn::Ge(py, margin), hn::Le(py, max_py))),
-                                    hn::And(hn::And(hn::Ge(lx, tmargin), hn::Le(lx, max_lx)),
-                                            hn::And(hn::Ge(ly, tmargin), hn::Le(ly, max_ly))));
+        auto inside = hn::And(hn::And(hn::Ge(px, margin), hn::Le(px, max_px)),
+                              hn::And(hn::Ge(py, margin), hn::Le(py, max_py)));
+        if (!plan.border) {
+            const VF lx = hn::Load(df, m.lx + k), ly = hn::Load(df, m.ly + k);
+            inside = hn::And(inside, hn::And(hn::And(hn::Ge(lx, tmargin), hn::Le(lx, max_lx)),
+                                             hn::And(hn::Ge(ly, tmargin), hn::Le(ly, max_ly))));
+        }
         const VU point = hn::Load(du, kinds.point + k);
         const VU h = hn::Load(du, kinds.h + k), vert = hn::Load(du, kinds.v + k),
                  c = hn::Load(du, kinds.c + k);
         auto fail = hn::AndNot(hn::RebindMask(du, inside), hn::MaskFromVec(point));
-        fail = hn::Or(fail, hn::Or(bad(m.lx, k, h, vert, c), bad(m.ly, k, h, vert, c)));
+        fail = hn::Or(fail, hn::Or(bad(xs, k, plan.bound_xy, h, vert, c),
+                                   bad(ys, k, plan.bound_xy, h, vert, c)));
         if (!hn::AllFalse(du, fail))
             return false;
     }
@@ -578,12 +609,17 @@ HWY_INLINE void storePixels(hn::Vec<hn::ScalableTag<uint32_t>> packed, const Til
     std::memcpy(row + x, tail, static_cast<size_t>(job.x1 - x) * sizeof(uint32_t));
 }
 
-// A mesh tile: the map of every pixel is the bilinear interpolation of the lattice's nodes,
-// first along x on the node rows (h), then along y between them; every pixel is valid.
-HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelLayer& layer) {
+// A mesh tile: the interpolated values of every pixel are the bilinear interpolation of the
+// lattice's nodes, first along x on the node rows (h), then along y between them; every pixel
+// is valid. Single-layer tiles interpolate texel coordinates and sample without clamps; border
+// tiles interpolate the rendered-image point and blend (Eq. 4) by its eccentricity.
+template <bool kBorder>
+HWY_INLINE void meshTile(const KernelParams& p, const TileJob& job, const MeshLattice& m,
+                         const MeshPlan& plan) {
     const DF df;
     const int lanes = static_cast<int>(hn::Lanes(df));
     constexpr int n = kMeshLatticeSide;
+    constexpr int kCoords = 2;
     HWY_ALIGN static const auto frac = [] {
         struct {
             float a[kTilePx];
@@ -592,8 +628,9 @@ HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelL
             f.a[c] = static_cast<float>(c % kMeshStepPx) * (1.0f / kMeshStepPx);
         return f;
     }();
-    HWY_ALIGN float hx[kMeshCells + 1][kTilePx], hy[kMeshCells + 1][kTilePx];
-    HWY_ALIGN float dx[kMeshCells][kTilePx], dy[kMeshCells][kTilePx];
+    const float* src[2] = {kBorder ? m.px : m.lx, kBorder ? m.py : m.ly};
+    HWY_ALIGN float h[kCoords][kMeshCells + 1][kTilePx];
+    HWY_ALIGN float d[kCoords][kMeshCells][kTilePx];
     const MF upper = hn::Ge(hn::Iota(df, 0.0f), hn::Set(df, static_cast<float>(kMeshStepPx)));
     // The node of column c's cell (offset 0) or the next (offset 1), per lane.
     auto node = [&](const float* lattice_row, int c, int offset) {
@@ -603,20 +640,20 @@ HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelL
             return here;
         return hn::IfThenElse(upper, hn::Set(df, lattice_row[2 * cell + 2]), here);
     };
-    for (int j = 0; j <= kMeshCells; ++j) {
-        const float* rx = m.lx + 2 * j * n;
-        const float* ry = m.ly + 2 * j * n;
-        for (int c = 0; c < kTilePx; c += lanes) {
-            const VF a = hn::Load(df, frac.a + c);
-            const VF lx = node(rx, c, 0), ly = node(ry, c, 0);
-            hn::Store(hn::MulAdd(hn::Sub(node(rx, c, 1), lx), a, lx), df, hx[j] + c);
-            hn::Store(hn::MulAdd(hn::Sub(node(ry, c, 1), ly), a, ly), df, hy[j] + c);
+    for (int q = 0; q < kCoords; ++q) {
+        for (int j = 0; j <= kMeshCells; ++j) {
+            const float* row = src[q] + 2 * j * n;
+            for (int c = 0; c < kTilePx; c += lanes) {
+                const VF a = hn::Load(df, frac.a + c);
+                const VF left = node(row, c, 0);
+                hn::Store(hn::MulAdd(hn::Sub(node(row, c, 1), left), a, left), df, h[q][j] + c);
+            }
         }
-    }
-    for (int j = 0; j < kMeshCells; ++j) {
-        for (int c = 0; c < kTilePx; c += lanes) {
-            hn::Store(hn::Sub(hn::Load(df, hx[j + 1] + c), hn::Load(df, hx[j] + c)), df, dx[j] + c);
-            hn::Store(hn::Sub(hn::Load(df, hy[j + 1] + c), hn::Load(df, hy[j] + c)), df, dy[j] + c);
+        for (int j = 0; j < kMeshCells; ++j) {
+            for (int c = 0; c < kTilePx; c += lanes) {
+                hn::Store(hn::Sub(hn::Load(df, h[q][j + 1] + c), hn::Load(df, h[q][j] + c)), df,
+                          d[q][j] + c);
+            }
         }
     }
     for (int y = job.y0; y < job.y1; ++y) {
@@ -627,9 +664,16 @@ HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelL
             hn::Set(df, static_cast<float>((y - job.y0) % kMeshStepPx) * (1.0f / kMeshStepPx));
         for (int x = job.x0; x < job.x1; x += lanes) {
             const int c = x - job.x0;
-            const VF lx = hn::MulAdd(hn::Load(df, dx[j] + c), b, hn::Load(df, hx[j] + c));
-            const VF ly = hn::MulAdd(hn::Load(df, dy[j] + c), b, hn::Load(df, hy[j] + c));
-            storePixels(packBiased(sampleTexels<false>(layer, lx, ly)), job, row, x);
+            const VF vx = hn::MulAdd(hn::Load(df, d[0][j] + c), b, hn::Load(df, h[0][j] + c));
+            const VF vy = hn::MulAdd(hn::Load(df, d[1][j] + c), b, hn::Load(df, h[1][j] + c));
+            VU packed;
+            if constexpr (kBorder) {
+                const Rgb rgb = blendSlots(p, job.slot_mask, vx, vy, eccentricityCos(p, vx, vy));
+                packed = pack(rgb.r, rgb.g, rgb.b);
+            } else {
+                packed = packBiased(sampleTexels<false>(p.slots[plan.layer], vx, vy));
+            }
+            storePixels(packed, job, row, x);
         }
     }
 }
@@ -637,14 +681,17 @@ HWY_INLINE void meshTile(const TileJob& job, const MeshLattice& m, const KernelL
 }  // namespace
 
 bool UcaTile(const KernelParams& p, const TileJob& job) {
-    const bool single = job.slot_mask != 0 && (job.slot_mask & (job.slot_mask - 1)) == 0;
-    if (job.mesh && single && !p.identity_map && !p.chroma && job.x1 - job.x0 <= kTilePx &&
-        job.y1 - job.y0 <= kTilePx) {
-        const int k = job.slot_mask == 1 ? 0 : (job.slot_mask == 2 ? 1 : 2);
+    if (job.mesh && job.slot_mask != 0 && !p.identity_map && !p.chroma &&
+        job.x1 - job.x0 <= kTilePx && job.y1 - job.y0 <= kTilePx) {
+        const MeshPlan plan = meshPlan(p, job.slot_mask);
         HWY_ALIGN MeshLattice lattice;
-        mapLattice(p, job, p.slots[k], lattice);
-        if (meshAcceptableV(lattice, p, p.slots[k])) {
-            meshTile(job, lattice, p.slots[k]);
+        mapLattice(p, job, plan, lattice);
+        if (meshAcceptableV(lattice, p, plan)) {
+            if (plan.border) {
+                meshTile<true>(p, job, lattice, plan);
+            } else {
+                meshTile<false>(p, job, lattice, plan);
+            }
             return true;
         }
     }

@@ -116,6 +116,23 @@ void sampleLayer(const KernelLayer& l, float px, float py, float rgb[3]) {
                  rgb);
 }
 
+// Eq. 4's blend of the slots in slot_mask at a rendered-image point (unbiased values).
+void blendSlots(const KernelParams& p, uint8_t slot_mask, float px, float py, float cos_e,
+                float rgb[3]) {
+    const float t1 = std::min(std::max((p.border_c_hi[0] - cos_e) * p.border_inv[0], 0.0f), 1.0f);
+    const float t2 = std::min(std::max((p.border_c_hi[1] - cos_e) * p.border_inv[1], 0.0f), 1.0f);
+    const float w[3] = {1.0f - t1, t1 - t1 * t2, t1 * t2};
+    rgb[0] = rgb[1] = rgb[2] = 0.0f;
+    for (int k = 0; k < p.slot_count; ++k) {
+        if ((slot_mask & (1u << k)) == 0 || w[k] == 0.0f)
+            continue;
+        float s[3];
+        sampleLayer(p.slots[k], px, py, s);
+        for (int c = 0; c < 3; ++c)
+            rgb[c] = std::fma(w[k], s[c] - kTexelBias, rgb[c]);
+    }
+}
+
 // Eq. 4 for one pixel: the slots the tile may touch, weighted by the blend ramps.
 bool shade(const KernelParams& p, const RowMap& r, float u, float v, float chroma,
            uint8_t slot_mask, float rgb[3]) {
@@ -130,17 +147,7 @@ bool shade(const KernelParams& p, const RowMap& r, float u, float v, float chrom
             rgb[c] -= kTexelBias;
         return true;
     }
-    const float t1 = std::min(std::max((p.border_c_hi[0] - m.cos_e) * p.border_inv[0], 0.0f), 1.0f);
-    const float t2 = std::min(std::max((p.border_c_hi[1] - m.cos_e) * p.border_inv[1], 0.0f), 1.0f);
-    const float w[3] = {1.0f - t1, t1 - t1 * t2, t1 * t2};
-    for (int k = 0; k < p.slot_count; ++k) {
-        if ((slot_mask & (1u << k)) == 0 || w[k] == 0.0f)
-            continue;
-        float s[3];
-        sampleLayer(p.slots[k], m.px, m.py, s);
-        for (int c = 0; c < 3; ++c)
-            rgb[c] = std::fma(w[k], s[c] - kTexelBias, rgb[c]);
-    }
+    blendSlots(p, slot_mask, m.px, m.py, m.cos_e, rgb);
     return true;
 }
 
@@ -162,8 +169,8 @@ uint32_t packBiased(const float rgb[3]) {
 }
 
 // The tile's 9×9 lattice of exact maps (docs/UCA.md, "Mesh tiles"), point by point.
-void mapLattice(const KernelParams& p, const TileJob& job, const KernelLayer& layer,
-                MeshLattice& out) {
+void mapLattice(const KernelParams& p, const TileJob& job, const MeshPlan& plan, MeshLattice& out) {
+    const KernelLayer& layer = p.slots[plan.layer];
     for (int k = 0; k < kMeshLatticePoints; ++k) {
         const float u = static_cast<float>(job.x0 + (k % kMeshLatticeSide) * (kMeshStepPx / 2));
         const float v = static_cast<float>(job.y0 + (k / kMeshLatticeSide) * (kMeshStepPx / 2));
@@ -175,42 +182,57 @@ void mapLattice(const KernelParams& p, const TileJob& job, const KernelLayer& la
     }
 }
 
-// A pixel of a mesh tile: the nodes of its cell interpolated along x on both node rows, then
-// along y, in the vector kernel's order.
-void meshPoint(const MeshLattice& m, int c, int r, float& lx, float& ly) {
+// cos e of a rendered-image point (border mesh tiles), as the vector kernel forms it.
+float meshEccentricityCos(const KernelParams& p, float px, float py) {
+    const float rx = (px - p.cx) * (1.0f / p.fx);
+    const float ry = (p.cy - py) * (1.0f / p.fy);
+    const float n2 = std::fma(rx, rx, std::fma(ry, ry, 1.0f));
+    const float dot = std::fma(p.gaze[0], rx, std::fma(p.gaze[1], ry, -p.gaze[2]));
+    return dot / std::sqrt(n2);
+}
+
+// A value of a mesh tile's pixel (c, r): the nodes of its cell interpolated along x on both
+// node rows, then along y, in the vector kernel's order.
+float meshValue(const float* v, int c, int r) {
     constexpr int n = kMeshLatticeSide;
     const int i = 2 * (c / kMeshStepPx);
     const int j = 2 * (r / kMeshStepPx);
     const float a = static_cast<float>(c % kMeshStepPx) * (1.0f / kMeshStepPx);
     const float b = static_cast<float>(r % kMeshStepPx) * (1.0f / kMeshStepPx);
-    auto lerp2 = [&](const float* v) {
-        const float* top = v + j * n + i;
-        const float* bottom = v + (j + 2) * n + i;
-        const float h0 = std::fma(top[2] - top[0], a, top[0]);
-        const float h1 = std::fma(bottom[2] - bottom[0], a, bottom[0]);
-        return std::fma(h1 - h0, b, h0);
-    };
-    lx = lerp2(m.lx);
-    ly = lerp2(m.ly);
+    const float* top = v + j * n + i;
+    const float* bottom = v + (j + 2) * n + i;
+    const float h0 = std::fma(top[2] - top[0], a, top[0]);
+    const float h1 = std::fma(bottom[2] - bottom[0], a, bottom[0]);
+    return std::fma(h1 - h0, b, h0);
 }
 
 }  // namespace
 
 bool ucaTileScalar(const KernelParams& p, const TileJob& job) {
     const bool single = job.slot_mask != 0 && (job.slot_mask & (job.slot_mask - 1)) == 0;
-    if (job.mesh && single && !p.identity_map && !p.chroma && job.x1 - job.x0 <= kTilePx &&
-        job.y1 - job.y0 <= kTilePx) {
-        const KernelLayer& layer = p.slots[job.slot_mask == 1 ? 0 : (job.slot_mask == 2 ? 1 : 2)];
+    if (job.mesh && job.slot_mask != 0 && !p.identity_map && !p.chroma &&
+        job.x1 - job.x0 <= kTilePx && job.y1 - job.y0 <= kTilePx) {
+        const MeshPlan plan = meshPlan(p, job.slot_mask);
         MeshLattice lattice;
-        mapLattice(p, job, layer, lattice);
-        if (meshAcceptable(lattice, p, layer)) {
+        mapLattice(p, job, plan, lattice);
+        if (meshAcceptable(lattice, p, plan)) {
             for (int y = job.y0; y < job.y1; ++y) {
                 uint8_t* row = job.out + static_cast<size_t>(y) * job.out_stride_px * 4;
                 for (int x = job.x0; x < job.x1; ++x) {
-                    float lx, ly, rgb[3];
-                    meshPoint(lattice, x - job.x0, y - job.y0, lx, ly);
-                    sampleTexels(layer, lx, ly, rgb);
-                    const uint32_t packed = packBiased(rgb);
+                    const int c = x - job.x0, r = y - job.y0;
+                    float rgb[3];
+                    uint32_t packed;
+                    if (plan.border) {
+                        const float px = meshValue(lattice.px, c, r);
+                        const float py = meshValue(lattice.py, c, r);
+                        blendSlots(p, job.slot_mask, px, py, meshEccentricityCos(p, px, py), rgb);
+                        packed = kOpaqueBlack | quantize(rgb[0]) | (quantize(rgb[1]) << 8) |
+                                 (quantize(rgb[2]) << 16);
+                    } else {
+                        sampleTexels(p.slots[plan.layer], meshValue(lattice.lx, c, r),
+                                     meshValue(lattice.ly, c, r), rgb);
+                        packed = packBiased(rgb);
+                    }
                     std::memcpy(row + static_cast<size_t>(x) * 4, &packed, sizeof packed);
                 }
             }
