@@ -135,6 +135,9 @@ struct MeshPlan {
     bool border = false;  // interpolate px, py (else lx, ly of `layer`)
     int layer = 0;        // the single-layer tile's slot
     float bound_xy = 0;   // in the units of the interpolated coordinates
+    // False for a border with a full-resolution layer (the fovea's edge): there the exact map
+    // keeps the sharp layer's positions exact (docs/UCA.md, "Mesh tiles").
+    bool usable = true;
 };
 
 inline MeshPlan meshPlan(const KernelParams& p, uint8_t slot_mask) {
@@ -151,6 +154,7 @@ inline MeshPlan meshPlan(const KernelParams& p, uint8_t slot_mask) {
             inv = inv > p.slots[k].inv_scale ? inv : p.slots[k].inv_scale;
     }
     plan.bound_xy = kMeshBoundTexels / inv;
+    plan.usable = inv < 1.0f;
     return plan;
 }
 

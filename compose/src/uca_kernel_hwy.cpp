@@ -685,14 +685,16 @@ bool UcaTile(const KernelParams& p, const TileJob& job) {
         job.x1 - job.x0 <= kTilePx && job.y1 - job.y0 <= kTilePx) {
         const MeshPlan plan = meshPlan(p, job.slot_mask);
         HWY_ALIGN MeshLattice lattice;
-        mapLattice(p, job, plan, lattice);
-        if (meshAcceptableV(lattice, p, plan)) {
-            if (plan.border) {
-                meshTile<true>(p, job, lattice, plan);
-            } else {
-                meshTile<false>(p, job, lattice, plan);
+        if (plan.usable) {
+            mapLattice(p, job, plan, lattice);
+            if (meshAcceptableV(lattice, p, plan)) {
+                if (plan.border) {
+                    meshTile<true>(p, job, lattice, plan);
+                } else {
+                    meshTile<false>(p, job, lattice, plan);
+                }
+                return true;
             }
-            return true;
         }
     }
     const DF df;

@@ -214,8 +214,12 @@ bool ucaTileScalar(const KernelParams& p, const TileJob& job) {
         job.x1 - job.x0 <= kTilePx && job.y1 - job.y0 <= kTilePx) {
         const MeshPlan plan = meshPlan(p, job.slot_mask);
         MeshLattice lattice;
-        mapLattice(p, job, plan, lattice);
-        if (meshAcceptable(lattice, p, plan)) {
+        bool meshed = plan.usable;
+        if (meshed) {
+            mapLattice(p, job, plan, lattice);
+            meshed = meshAcceptable(lattice, p, plan);
+        }
+        if (meshed) {
             for (int y = job.y0; y < job.y1; ++y) {
                 uint8_t* row = job.out + static_cast<size_t>(y) * job.out_stride_px * 4;
                 for (int x = job.x0; x < job.x1; ++x) {
