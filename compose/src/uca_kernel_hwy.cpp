@@ -416,6 +416,9 @@ HWY_INLINE VU shadePacked(const KernelParams& p, const RowMap& r, VF u, VF v, ui
     if (!p.chroma && (slot_mask & (slot_mask - 1)) == 0) {
         // One layer: its biased channels go straight to bytes.
         const MapV m = mapPixels(p, r, u, v, 1.0f, false);
+        // Tiles at the rendered image's edge have whole vectors off it: no samples there.
+        if (hn::AllFalse(hn::DFromV<VF>(), m.valid))
+            return hn::Set(du, kOpaqueBlack);
         const int k = slot_mask == 1 ? 0 : (slot_mask == 2 ? 1 : 2);
         return hn::IfThenElse(hn::RebindMask(du, m.valid),
                               packBiased(sampleLayer(p.slots[k], m.px, m.py)),
