@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "qvr/compose/uca.h"
 #include "qvr/foveation/hmd_profile.h"
@@ -236,6 +237,11 @@ SlotInfo slotBands(const HmdProfile& profile, const LayerPlan& plan, int eye,
 // Which plan layer (0 fovea, 1 middle, 2 outer) each kernel slot holds.
 void slotLayers(const LayerPlan& plan, int eye, int layer_of_slot[3], int& slot_count);
 bool ucaTileSimd(const KernelParams& p, const TileJob& job);
+// For tests: the kernel's compiled targets this CPU supports, their names, and restricting the
+// dispatch to some of them (0: back to everything the CPU supports).
+std::vector<int64_t> ucaAvailableTargets();
+const char* ucaTargetName(int64_t target);
+void ucaSetTargetsForTest(int64_t targets);
 // Orders the calling thread's streaming stores before its later stores (sfence).
 void ucaFenceStreams();
 

@@ -405,8 +405,12 @@ HWY_INLINE VU packBiased(const Rgb& c) {
     const VU b = hn::BitCast(du, c.b);
     // (r >> 8) holds the red byte in bits 0–7; g its green byte in bits 8–15; (b << 8) its blue
     // byte in bits 16–23 and zeros above.
-    const VU rg = hn::IfVecThenElse(hn::Set(du, 0xFFu), hn::ShiftRight<8>(r), g);
-    const VU rgb = hn::IfVecThenElse(hn::Set(du, 0xFFFFu), rg, hn::ShiftLeft<8>(b));
+    // Bit selects written out: Highway's IfVecThenElse wants whole-lane masks (its SCALAR target
+    // selects whole lanes); on x86 each of these becomes one vpternlogd.
+    const VU low8 = hn::Set(du, 0xFFu);
+    const VU low16 = hn::Set(du, 0xFFFFu);
+    const VU rg = hn::Or(hn::And(low8, hn::ShiftRight<8>(r)), hn::AndNot(low8, g));
+    const VU rgb = hn::Or(hn::And(low16, rg), hn::AndNot(low16, hn::ShiftLeft<8>(b)));
     return hn::Or(rgb, hn::Set(du, kOpaqueBlack));
 }
 
@@ -746,6 +750,18 @@ void ucaFenceStreams() {
 
 bool ucaTileSimd(const KernelParams& p, const TileJob& job) {
     return HWY_DYNAMIC_DISPATCH(UcaTile)(p, job);
+}
+
+std::vector<int64_t> ucaAvailableTargets() {
+    return hwy::SupportedAndGeneratedTargets();
+}
+
+const char* ucaTargetName(int64_t target) {
+    return hwy::TargetName(target);
+}
+
+void ucaSetTargetsForTest(int64_t targets) {
+    hwy::SetSupportedTargetsForTest(targets);
 }
 }  // namespace qvr::detail
 #endif

@@ -7,6 +7,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -83,20 +84,21 @@ Diff compare(const ImageRgba8& a, const ImageRgba8& b) {
     return d;
 }
 
-TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
+// The vector kernel on the target Highway dispatches to now against the scalar twin, on random
+// layers, lenses, gazes and poses.
+void expectFastPathMatchesTwin(std::mt19937& rng, int trials) {
     // Highway's AVX2 and AVX-512 targets fuse MulAdd like the twin's std::fma.
     const std::string target = detail::ucaSimdTarget();
     const bool fma_target = target.rfind("AVX", 0) == 0;
     std::printf("SIMD target %s: %s\n", target.c_str(),
                 fma_target ? "bit-exact comparison" : "one-level tolerance");
-    std::mt19937 rng(std::random_device{}());
     std::uniform_real_distribution<double> angle(-3.0, 3.0);
     std::uniform_real_distribution<double> gaze(-15.0, 15.0);
     std::uniform_real_distribution<double> e1(3.0, 40.0);
     std::uniform_real_distribution<double> k(0.0, 0.3);
     std::uniform_int_distribution<int> size(100, 420);
     int64_t mesh_tiles = 0;
-    for (int trial = 0; trial < 8; ++trial) {
+    for (int trial = 0; trial < trials; ++trial) {
         HmdProfile profile = smallProfile(size(rng), size(rng));
         profile.lens.k1 = k(rng);
         profile.lens.k2 = k(rng);
@@ -148,6 +150,26 @@ TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
         }
     }
     std::printf("mesh tiles over all trials: %lld\n", static_cast<long long>(mesh_tiles));
+}
+
+TEST(ComposeUca, FastPathMatchesScalarTwinOnRandomInputs) {
+    std::mt19937 rng(std::random_device{}());
+    expectFastPathMatchesTwin(rng, 8);
+}
+
+// Every target compiled into the kernel, not only the one this CPU picks: the AVX-512 row windows
+// and the AVX2/SSE gathers are different code (SSE targets keep the one-level tolerance).
+TEST(ComposeUca, FastPathMatchesScalarTwinOnEveryCompiledTarget) {
+    std::mt19937 rng(std::random_device{}());
+    const std::vector<int64_t> targets = detail::ucaAvailableTargets();
+    EXPECT_FALSE(targets.empty());
+    for (int64_t t : targets) {
+        SCOPED_TRACE(detail::ucaTargetName(t));
+        detail::ucaSetTargetsForTest(t);
+        EXPECT_EQ(std::string(detail::ucaSimdTarget()), detail::ucaTargetName(t));
+        expectFastPathMatchesTwin(rng, 2);
+    }
+    detail::ucaSetTargetsForTest(0);  // back to what the CPU has
 }
 
 TEST(ComposeUca, TileClassificationNeverChangesAPixel) {
