@@ -210,6 +210,17 @@ HWY_INLINE Taps gatherTaps(const KernelLayer& l, VF flx, VF fly) {
 //    y = min(lane 0's row, lane 15's): rows y, y + 1, y + 2 as 16 texels each; bit 4 of a
 //    permute index picks the lower of two rows, so a lane's own row costs nothing.
 //  * Wide: every top tap in lane 0's row, left taps within 30 texels: two rows of 32 texels.
+// The four taps from two 32-texel tables, top = (top_lo, top_hi) and bottom = (bot_lo, bot_hi):
+// left taps at index i, right taps at i + 1.
+HWY_INLINE Taps permuteFour(__m512i top_lo, __m512i top_hi, __m512i bot_lo, __m512i bot_hi,
+                            __m512i i) {
+    const __m512i i1 = _mm512_add_epi32(i, _mm512_set1_epi32(1));
+    return {VU{_mm512_permutex2var_epi32(top_lo, i, top_hi)},
+            VU{_mm512_permutex2var_epi32(top_lo, i1, top_hi)},
+            VU{_mm512_permutex2var_epi32(bot_lo, i, bot_hi)},
+            VU{_mm512_permutex2var_epi32(bot_lo, i1, bot_hi)}};
+}
+
 HWY_INLINE bool permuteTaps(const KernelLayer& l, VF flx, VF fly, Taps& taps) {
     const VI ix = truncToInt(flx);
     const VI iy = truncToInt(fly);
@@ -229,12 +240,8 @@ HWY_INLINE bool permuteTaps(const KernelLayer& l, VF flx, VF fly, Taps& taps) {
         const __m512i r0 = _mm512_loadu_si512(row);
         const __m512i r1 = _mm512_loadu_si512(row + l.width);
         const __m512i r2 = _mm512_loadu_si512(row + 2 * static_cast<size_t>(l.width));
-        const __m512i i0 = _mm512_or_si512(rel, _mm512_slli_epi32(dy, 4));
-        const __m512i i1 = _mm512_add_epi32(i0, one);
-        taps.t00 = VU{_mm512_permutex2var_epi32(r0, i0, r1)};
-        taps.t10 = VU{_mm512_permutex2var_epi32(r0, i1, r1)};
-        taps.t01 = VU{_mm512_permutex2var_epi32(r1, i0, r2)};
-        taps.t11 = VU{_mm512_permutex2var_epi32(r1, i1, r2)};
+        // Top taps from rows y / y + 1, bottom taps from y + 1 / y + 2, the row by index bit 4.
+        taps = permuteFour(r0, r1, r1, r2, _mm512_or_si512(rel, _mm512_slli_epi32(dy, 4)));
         return true;
     }
     const __mmask16 wide = _mm512_mask_cmple_epu32_mask(
@@ -242,15 +249,8 @@ HWY_INLINE bool permuteTaps(const KernelLayer& l, VF flx, VF fly, Taps& taps) {
     if (wide == 0xFFFF && x0 + 32 <= l.width) {
         const uint32_t* row0 = base + static_cast<size_t>(y0) * static_cast<size_t>(l.width) + x0;
         const uint32_t* row1 = row0 + l.width;
-        const __m512i a0 = _mm512_loadu_si512(row0);
-        const __m512i a1 = _mm512_loadu_si512(row0 + 16);
-        const __m512i b0 = _mm512_loadu_si512(row1);
-        const __m512i b1 = _mm512_loadu_si512(row1 + 16);
-        const __m512i rel1 = _mm512_add_epi32(rel, one);
-        taps.t00 = VU{_mm512_permutex2var_epi32(a0, rel, a1)};
-        taps.t10 = VU{_mm512_permutex2var_epi32(a0, rel1, a1)};
-        taps.t01 = VU{_mm512_permutex2var_epi32(b0, rel, b1)};
-        taps.t11 = VU{_mm512_permutex2var_epi32(b0, rel1, b1)};
+        taps = permuteFour(_mm512_loadu_si512(row0), _mm512_loadu_si512(row0 + 16),
+                           _mm512_loadu_si512(row1), _mm512_loadu_si512(row1 + 16), rel);
         return true;
     }
     return false;
