@@ -42,20 +42,26 @@ ImageRgba8 randomImage(int w, int h, std::mt19937& rng) {
     return img;
 }
 
-LayerFrame randomFrame(const HmdProfile& profile, const LayerPlan& plan, std::mt19937& rng) {
+// A frame of the plan whose present layers are image(eye, width, height).
+template <typename MakeImage>
+LayerFrame frameOf(const LayerPlan& plan, MakeImage image) {
     LayerFrame f;
     f.plan = plan;
     for (size_t eye = 0; eye < 2; ++eye) {
         const EyeLayers& l = plan.eyes[eye];
         if (!l.fovea.empty())
-            f.eyes[eye].fovea = randomImage(l.fovea.width_px, l.fovea.height_px, rng);
+            f.eyes[eye].fovea = image(eye, l.fovea.width_px, l.fovea.height_px);
         if (!l.middle.empty())
-            f.eyes[eye].middle = randomImage(l.middle.width_px, l.middle.height_px, rng);
+            f.eyes[eye].middle = image(eye, l.middle.width_px, l.middle.height_px);
         if (!l.outer.empty())
-            f.eyes[eye].outer = randomImage(l.outer.width_px, l.outer.height_px, rng);
+            f.eyes[eye].outer = image(eye, l.outer.width_px, l.outer.height_px);
     }
-    (void)profile;
     return f;
+}
+
+LayerFrame randomFrame(const HmdProfile& profile, const LayerPlan& plan, std::mt19937& rng) {
+    (void)profile;
+    return frameOf(plan, [&](size_t, int w, int h) { return randomImage(w, h, rng); });
 }
 
 Pose poseDeg(double yaw, double pitch, double roll) {
@@ -238,18 +244,10 @@ TEST(ComposeUca, MeshTilesStayWithinTheirBoundOfTheExactMap) {
         profile.lens.k2 = k(rng);
         const LayerPlan plan =
             LayerPlanner(profile).plan({gaze(rng), gaze(rng)}, 8.0 + 5.0 * trial);
-        LayerFrame frame;
-        frame.plan = plan;
-        for (size_t eye = 0; eye < 2; ++eye) {
-            const EyeLayers& l = plan.eyes[eye];
-            const int phase = static_cast<int>(rng() % 255);
-            if (!l.fovea.empty())
-                frame.eyes[eye].fovea = rampImage(l.fovea.width_px, l.fovea.height_px, phase);
-            if (!l.middle.empty())
-                frame.eyes[eye].middle = rampImage(l.middle.width_px, l.middle.height_px, phase);
-            if (!l.outer.empty())
-                frame.eyes[eye].outer = rampImage(l.outer.width_px, l.outer.height_px, phase);
-        }
+        // One phase per eye, shared by its layers.
+        const int phases[2] = {static_cast<int>(rng() % 255), static_cast<int>(rng() % 255)};
+        const LayerFrame frame =
+            frameOf(plan, [&](size_t eye, int w, int h) { return rampImage(w, h, phases[eye]); });
         const Pose display = poseDeg(angle(rng), angle(rng), angle(rng));
         std::array<std::array<ImageRgba8, 2>, 2> meshed;  // [simd][eye]
         for (bool simd : {true, false}) {
