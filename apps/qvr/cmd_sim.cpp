@@ -3,14 +3,17 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "qvr/sim/benches.h"
 #include "qvr/sim/evaluation.h"
+#include "qvr/sim/runtime_model.h"
 #include "qvr/sim/simulator.h"
 #include "qvr/workload/trace_io.h"
 
@@ -28,7 +31,85 @@ struct SimOptions {
     std::string out;
     uint64_t seed = 1;
     std::string hardware;
+    std::string pipeline;  // "", "paper" or "runtime"
+    int depth = 2;
+    double wait_limit_ms = 250.0;
 };
+
+// The runtime pipeline model (sim/runtime_model.h): frames.csv and summary.json of its own.
+int runRuntimeSim(const SimOptions& o, Design design, const HardwareConfig& hw,
+                  const WorkloadTrace& trace) {
+    if (design == Design::Static) {
+        std::fprintf(stderr, "qvr sim: the runtime pipeline has no static design\n");
+        return 2;
+    }
+    RuntimeSimConfig cfg;
+    cfg.design = design;
+    cfg.costs = hw.runtime;
+    cfg.pipeline_depth = o.depth;
+    cfg.wait_limit_ms = o.wait_limit_ms;
+    cfg.frames = o.frames;
+    double delay_ms = 0.0;
+    auto link = makeRuntimeLink(o.net, &delay_ms);
+    if (!link) {
+        std::fprintf(stderr, "qvr sim: --net: %s\n", link.error().c_str());
+        return 2;
+    }
+    cfg.costs.link_delay_ms += delay_ms;
+    const RuntimeRunResult run = simulateRuntime(trace, cfg, **link);
+    std::error_code ec;
+    std::filesystem::create_directories(o.out, ec);
+    if (ec) {
+        std::fprintf(stderr, "qvr sim: cannot create '%s': %s\n", o.out.c_str(),
+                     ec.message().c_str());
+        return 1;
+    }
+    const std::filesystem::path out(o.out);
+    std::ofstream csv(out / "frames.csv");
+    csv << "frame,e1_deg,pose_ms,decision_ms,request_ms,local_start_ms,local_end_ms,"
+           "remote_done_ms,uca_start_ms,uca_end_ms,display_ms,bytes,t_local_ms,t_remote_ms,"
+           "headset_busy_ms,mtp_ms,served,reused\n";
+    for (const RuntimeFrame& f : run.frames)
+        csv << fmt::format(
+            "{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.0f},"
+            "{:.3f},{:.3f},{:.3f},{:.3f},{},{}\n",
+            f.index, f.e1_deg, f.pose_ms, f.decision_ms, f.request_ms, f.local_start_ms,
+            f.local_end_ms, f.remote_done_ms, f.uca_start_ms, f.uca_end_ms, f.display_ms, f.bytes,
+            f.t_local_ms, f.t_remote_ms, f.headset_busy_ms, f.mtp_ms, int(f.served), int(f.reused));
+    const RuntimeSummary& s = run.summary;
+    nlohmann::json j = {{"pipeline", "runtime"},
+                        {"design", s.design},
+                        {"net", o.net},
+                        {"pipeline_depth", o.depth},
+                        {"frames", s.frames},
+                        {"fps_mean", s.fps_mean},
+                        {"mtp_ms_mean", s.mtp_ms_mean},
+                        {"mtp_ms_p99", s.mtp_ms_p99},
+                        {"bytes_per_frame_mean", s.bytes_per_frame_mean},
+                        {"e1_deg_mean", s.e1_deg_mean},
+                        {"frames_reused", s.frames_reused},
+                        {"requests_dropped", s.requests_dropped},
+                        {"t_local_ms_mean", s.t_local_ms_mean},
+                        {"t_remote_ms_mean", s.t_remote_ms_mean},
+                        {"headset_busy_ms_mean", s.headset_busy_ms_mean},
+                        {"server_busy_ms_mean", s.server_busy_ms_mean}};
+    std::ofstream(out / "summary.json") << j.dump(2) << "\n";
+    if (!csv) {
+        std::fprintf(stderr, "qvr sim: error writing %s/frames.csv\n", o.out.c_str());
+        return 1;
+    }
+    fmt::print("{} on {} | runtime pipeline, {} in flight | {} | {} frames\n", s.design,
+               trace.header.name, o.depth, o.net, s.frames);
+    fmt::print("  FPS {:.1f}  MTP {:.1f} ms mean ({:.1f} p99)  {:.0f} B/frame  e1 {:.1f} deg\n",
+               s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean, s.e1_deg_mean);
+    fmt::print(
+        "  headset busy {:.1f} ms/frame  server {:.1f} ms/frame  T_remote {:.1f} ms  reused {}  "
+        "dropped requests {}\n",
+        s.headset_busy_ms_mean, s.server_busy_ms_mean, s.t_remote_ms_mean, s.frames_reused,
+        s.requests_dropped);
+    fmt::print("  wrote {}/frames.csv and {}/summary.json\n", o.out, o.out);
+    return 0;
+}
 
 int runSim(const SimOptions& o) {
     if (o.bench.empty() == o.trace.empty()) {
@@ -48,7 +129,8 @@ int runSim(const SimOptions& o) {
         std::fprintf(stderr, "qvr sim: %s\n", design.error().c_str());
         return 2;
     }
-    auto net = networkSpecByName(o.net);
+    const bool runtime_flag = o.pipeline == "runtime";
+    auto net = networkSpecByName(runtime_flag ? std::string("wifi") : o.net);
     if (!net) {
         std::fprintf(stderr, "qvr sim: %s\n", net.error().c_str());
         return 2;
@@ -77,6 +159,8 @@ int runSim(const SimOptions& o) {
         }
         hardware = *hw;
     }
+    if (o.pipeline == "runtime" || (o.pipeline.empty() && hardware.runtime_pipeline))
+        return runRuntimeSim(o, *design, hardware, *trace);
     SimConfig cfg;
     cfg.bench = trace->header.name;
     cfg.design = *design;
@@ -145,6 +229,17 @@ static Registered registerSim(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--hardware", o->hardware,
                     "TOML file overriding the modelled hardware's constants (docs/MODEL.md)");
+    cmd->add_option("--pipeline", o->pipeline,
+                    "Pipeline model: paper (Fig. 4, the default) or runtime (qvr run's, with the "
+                    "hardware file's calibrated costs; the default when that file says so)")
+        ->check(CLI::IsMember({"paper", "runtime"}));
+    cmd->add_option("--depth", o->depth, "Runtime pipeline: frames in flight (1 or 2)")
+        ->check(CLI::Range(1, 2))
+        ->capture_default_str();
+    cmd->add_option("--wait-limit-ms", o->wait_limit_ms,
+                    "Runtime pipeline: remote layers later than this are late (frame reuse)")
+        ->check(CLI::Range(1.0, 10000.0))
+        ->capture_default_str();
     cmd->add_option("--seed", o->seed, "Seed of the network noise")->capture_default_str();
     cmd->add_option("--out", o->out, "Output folder for frames.csv and summary.json")->required();
     return {cmd, [o]() { return runSim(*o); }};

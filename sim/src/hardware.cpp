@@ -2,6 +2,8 @@
 // sources: docs/MODEL.md.
 #include "qvr/sim/hardware.h"
 
+#include <fmt/format.h>
+
 #include "qvr/core/config.h"
 
 namespace qvr {
@@ -83,6 +85,36 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
         r.number("cpu.software_control_ms", hw.cpu.software_control_ms, 0.0, 1000.0);
     hw.fixed.sensor_ms = r.number("latency.sensor_ms", hw.fixed.sensor_ms, 0.0, 1000.0);
     hw.fixed.display_ms = r.number("latency.display_ms", hw.fixed.display_ms, 0.0, 1000.0);
+    const std::string pipeline = r.string("runtime.pipeline", "paper");
+    if (pipeline != "paper" && pipeline != "runtime")
+        return makeError(std::string(source_name) + ": runtime.pipeline must be \"paper\" or " +
+                         "\"runtime\", got \"" + pipeline + "\"");
+    hw.runtime_pipeline = pipeline == "runtime";
+    RuntimeCosts& rc = hw.runtime;
+    auto cost = [&](const char* key, double& v) {
+        v = r.number(std::string("runtime.") + key, v, 0.0, 10000.0);
+    };
+    cost("decision_base_ms", rc.decision.base_ms);
+    cost("decision_ms_per_ktri", rc.decision.ms_per_ktri);
+    cost("fovea_base_ms", rc.fovea.base_ms);
+    cost("fovea_ms_per_mpx", rc.fovea.ms_per_mpx);
+    cost("fovea_ms_per_ktri", rc.fovea.ms_per_ktri);
+    cost("decode_base_ms", rc.decode.base_ms);
+    cost("decode_ms_per_mpx", rc.decode.ms_per_mpx);
+    cost("uca_base_ms", rc.uca.base_ms);
+    cost("uca_ms_per_mpx", rc.uca.ms_per_mpx);
+    cost("frame_overhead_ms", rc.frame_overhead_ms);
+    cost("server_render_base_ms", rc.server_render.base_ms);
+    cost("server_render_ms_per_mpx", rc.server_render.ms_per_mpx);
+    cost("server_render_ms_per_ktri", rc.server_render.ms_per_ktri);
+    cost("encode_base_ms", rc.encode.base_ms);
+    cost("encode_ms_per_mpx", rc.encode.ms_per_mpx);
+    cost("server_frame_ms", rc.server_frame_ms);
+    cost("link_delay_ms", rc.link_delay_ms);
+    rc.packet_payload_bytes =
+        r.number("runtime.packet_payload_bytes", rc.packet_payload_bytes, 1.0, 65536.0);
+    rc.packet_overhead_bytes =
+        r.number("runtime.packet_overhead_bytes", rc.packet_overhead_bytes, 0.0, 65536.0);
     if (auto st = r.finish(); !st)
         return makeError(st.error());
     return hw;
@@ -93,6 +125,35 @@ Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_
     if (!text)
         return makeError(text.error());
     return parseHardwareConfig(*text, path, gpu_mhz);
+}
+
+}  // namespace qvr
+
+namespace qvr {
+
+std::string runtimeCostsToml(const RuntimeCosts& c) {
+    std::string s = "[runtime]\npipeline = \"runtime\"\n";
+    auto put = [&](const char* key, double v) { s += fmt::format("{} = {:.6g}\n", key, v); };
+    put("decision_base_ms", c.decision.base_ms);
+    put("decision_ms_per_ktri", c.decision.ms_per_ktri);
+    put("fovea_base_ms", c.fovea.base_ms);
+    put("fovea_ms_per_mpx", c.fovea.ms_per_mpx);
+    put("fovea_ms_per_ktri", c.fovea.ms_per_ktri);
+    put("decode_base_ms", c.decode.base_ms);
+    put("decode_ms_per_mpx", c.decode.ms_per_mpx);
+    put("uca_base_ms", c.uca.base_ms);
+    put("uca_ms_per_mpx", c.uca.ms_per_mpx);
+    put("frame_overhead_ms", c.frame_overhead_ms);
+    put("server_render_base_ms", c.server_render.base_ms);
+    put("server_render_ms_per_mpx", c.server_render.ms_per_mpx);
+    put("server_render_ms_per_ktri", c.server_render.ms_per_ktri);
+    put("encode_base_ms", c.encode.base_ms);
+    put("encode_ms_per_mpx", c.encode.ms_per_mpx);
+    put("server_frame_ms", c.server_frame_ms);
+    put("link_delay_ms", c.link_delay_ms);
+    put("packet_payload_bytes", c.packet_payload_bytes);
+    put("packet_overhead_bytes", c.packet_overhead_bytes);
+    return s;
 }
 
 }  // namespace qvr

@@ -40,3 +40,39 @@ TEST(HardwareConfig, RejectsUnknownKeysBadValuesAndBadToml) {
 
 }  // namespace
 }  // namespace qvr
+
+namespace qvr {
+namespace {
+
+TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
+    RuntimeCosts c;
+    c.fovea = {3.5, 41.0, 0.125};
+    c.decode = {0.25, 6.0, 0.0};
+    c.server_frame_ms = 1.5;
+    c.packet_overhead_bytes = 60.0;
+    auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
+    ASSERT_TRUE(hw.ok()) << hw.error();
+    EXPECT_TRUE(hw->runtime_pipeline);
+    EXPECT_EQ(hw->runtime.fovea.base_ms, 3.5);
+    EXPECT_EQ(hw->runtime.fovea.ms_per_mpx, 41.0);
+    EXPECT_EQ(hw->runtime.fovea.ms_per_ktri, 0.125);
+    EXPECT_EQ(hw->runtime.decode.ms_per_mpx, 6.0);
+    EXPECT_EQ(hw->runtime.server_frame_ms, 1.5);
+    EXPECT_EQ(hw->runtime.packet_overhead_bytes, 60.0);
+    EXPECT_FALSE(defaultHardware(500.0).runtime_pipeline);
+    auto paper = parseHardwareConfig("[runtime]\npipeline = \"paper\"\n", "p.toml", 500.0);
+    ASSERT_TRUE(paper.ok()) << paper.error();
+    EXPECT_FALSE(paper->runtime_pipeline);
+    for (const char* bad : {"[runtime]\npipeline = \"fast\"\n", "[runtime]\nfovea_base_ms = -1\n",
+                            "[runtime]\nuca_per_mpx = 1\n", "[runtime]\npacket_payload_bytes = 0\n",
+                            "[runtime]\ndecode_ms_per_mpx = \"x\"\n"}) {
+        auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
+        EXPECT_FALSE(r.ok()) << bad;
+        if (!r.ok()) {
+            EXPECT_NE(r.error().find("bad.toml"), std::string::npos) << r.error();
+        }
+    }
+}
+
+}  // namespace
+}  // namespace qvr

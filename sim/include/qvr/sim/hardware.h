@@ -81,6 +81,41 @@ struct FixedLatencies {
     double display_ms = 5.0;
 };
 
+// ---- The runtime pipeline model (runtime_model.h): this machine's costs, from `qvr calibrate`.
+
+// A linear cost a + b·x + c·y in ms; what `qvr calibrate` fits by least squares.
+struct LinearCost {
+    double base_ms = 0.0;
+    double ms_per_mpx = 0.0;   // per million pixels
+    double ms_per_ktri = 0.0;  // per thousand triangles (as the scene's BVH counts them)
+    double at(double pixels, double triangles) const {
+        return base_ms + ms_per_mpx * pixels * 1e-6 + ms_per_ktri * triangles * 1e-3;
+    }
+};
+
+// This machine's costs of the runtime's parts. The defaults are placeholders of the right order
+// for llvmpipe on one core of a 2-core Xeon (so tests and an uncalibrated `qvr sim --model
+// runtime` run); a calibration replaces every one of them.
+struct RuntimeCosts {
+    // Headset, one core.
+    LinearCost decision{0.5, 0.0, 0.04};  // BVH ring counts to e1 + 6°: triangles counted
+    LinearCost fovea{2.0, 50.0, 0.02};    // one eye's fovea (or full frame) render pass
+    LinearCost decode{0.3, 4.0, 0.0};     // one stream, per decoded layer pixel
+    LinearCost uca{1.0, 1.3, 0.0};        // one frame, per display pixel (both eyes)
+    double frame_overhead_ms = 0.5;       // per frame: pumps, telemetry, bookkeeping
+    // Server, one core (render thread): per layer render and encode, and per request.
+    LinearCost server_render{2.0, 60.0, 0.01};
+    LinearCost encode{0.5, 12.0, 0.0};
+    double server_frame_ms = 0.0;
+    // Link: media packets carry this much payload and this much header on the wire.
+    double packet_payload_bytes = 1200.0;
+    double packet_overhead_bytes = 48.0;
+    double link_delay_ms = 0.0;  // one way
+    double payloadShare() const {
+        return packet_payload_bytes / (packet_payload_bytes + packet_overhead_bytes);
+    }
+};
+
 struct HardwareConfig {
     MobileGpuConfig gpu;
     UcaConfig uca;
@@ -88,6 +123,10 @@ struct HardwareConfig {
     RemoteConfig remote;
     CpuConfig cpu;
     FixedLatencies fixed;
+    // Which pipeline `qvr sim` times frames on: the paper's (false, the default) or the
+    // runtime's as built, with `runtime`'s costs (a calibration file sets it).
+    bool runtime_pipeline = false;
+    RuntimeCosts runtime;
 };
 
 // The defaults of docs/MODEL.md at a given GPU clock.
@@ -108,8 +147,18 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             decode_overhead_ms (0…100)
 //   [cpu]     control_logic_ms, local_setup_ms, software_control_ms (0…1000)
 //   [latency] sensor_ms, display_ms (0…1000)
+//   [runtime] pipeline ("paper" or "runtime"); every cost in ms, 0…10000:
+//             decision_base_ms, decision_ms_per_ktri, fovea_base_ms, fovea_ms_per_mpx,
+//             fovea_ms_per_ktri, decode_base_ms, decode_ms_per_mpx, uca_base_ms, uca_ms_per_mpx,
+//             frame_overhead_ms, server_render_base_ms, server_render_ms_per_mpx,
+//             server_render_ms_per_ktri, encode_base_ms, encode_ms_per_mpx, server_frame_ms,
+//             link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536)
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);
+
+// The [runtime] section for these costs (pipeline = "runtime"), in the grammar above; what
+// `qvr calibrate` writes.
+std::string runtimeCostsToml(const RuntimeCosts& costs);
 
 }  // namespace qvr

@@ -1,0 +1,58 @@
+// `qvr calibrate`: this machine's costs of the runtime's parts, measured by micro-benchmarks that
+// run none of `qvr run`'s pipeline — each part alone, on the headset's core, over a spread of
+// sizes — and fitted to the runtime pipeline model's linear costs (sim/hardware.h RuntimeCosts).
+// Shared by `qvr calibrate` and `qvr run` (which calibrates first when given no file).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "qvr/core/expected.h"
+#include "qvr/sim/hardware.h"
+
+namespace qvr::cli {
+
+struct CalibrateOptions {
+    std::string scene = "builtin:room";
+    std::string profile = "default";
+    std::string codec = "x264";
+    float lod_px = 1.0f;
+    int core = 0;        // pinned like the headset (-1: unpinned)
+    bool quick = false;  // fewer samples (qvr run's pass before a run)
+    bool verbose = true;
+};
+
+// One fitted part: its cost, the samples it was fitted on and how far they scatter around it.
+struct CalibratedPart {
+    std::string name;
+    std::string what;  // what one sample is
+    int samples = 0;
+    LinearCost cost;
+    double median_ms = 0.0, min_ms = 0.0, max_ms = 0.0;  // of the samples
+    double residual_rms_pct = 0.0;                       // RMS of (measured − fit) / measured
+};
+
+struct Calibration {
+    RuntimeCosts costs;
+    std::vector<CalibratedPart> parts;
+    std::string machine;
+    std::string date;
+    std::string command;
+    double seconds = 0.0;
+    double load_avg_before = 0.0;
+    nlohmann::json links;  // the emulator's profiles
+    nlohmann::json toJson() const;
+    std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included
+};
+
+Expected<Calibration> runCalibration(const CalibrateOptions& options);
+
+// A key for this machine and these options (CPU model, cores, profile, scene, codec, LOD); the
+// cached calibration of `qvr run` is stored under it.
+std::string calibrationCacheKey(const CalibrateOptions& options);
+std::string calibrationCachePath(const CalibrateOptions& options);
+std::string machineDescriptionLine();
+
+}  // namespace qvr::cli

@@ -1,0 +1,551 @@
+// Micro-benchmarks of the runtime's parts (calibration.h), each alone on one pinned core: the
+// headset's fovea (and full-frame) render against pixels and the BVH's triangle count, the
+// decision's ring counts, the server's layer render and encode, a stream's decode, UCA per
+// frame, the plan; fitted by least squares to RuntimeCosts.
+#include "calibration.h"
+
+#include "cli_parse.h"
+#include "commands.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "qvr/codec/video_codec.h"
+#include "qvr/compose/uca.h"
+#include "qvr/foveation/layer_plan.h"
+#include "qvr/net/link_emulator.h"
+#include "qvr/net/protocol.h"
+#include "qvr/render/gl_renderer.h"
+#include "qvr/render/renderer.h"
+#include "qvr/runtime/affinity.h"
+#include "qvr/runtime/headset_client.h"
+#include "qvr/runtime/session.h"
+#include "qvr/runtime/workload_probe.h"
+
+namespace qvr::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct Sample {
+    double ms = 0.0;
+    double pixels = 0.0;
+    double triangles = 0.0;
+};
+
+// Weighted least squares of ms on [1, Mpx, ktri] over the features `use` selects; a negative slope
+// is dropped and the rest refitted (a cost cannot fall with size).
+LinearCost fit(const std::vector<Sample>& s, bool use_px, bool use_tri) {
+    for (;;) {
+        std::vector<std::function<double(const Sample&)>> f = {[](const Sample&) { return 1.0; }};
+        if (use_px)
+            f.push_back([](const Sample& x) { return x.pixels * 1e-6; });
+        if (use_tri)
+            f.push_back([](const Sample& x) { return x.triangles * 1e-3; });
+        const size_t k = f.size();
+        std::vector<std::vector<double>> a(k, std::vector<double>(k + 1, 0.0));
+        // Weighted by 1/ms²: relative errors count, so a 1 ms fovea weighs as much as a 200 ms
+        // full frame (the model must predict both).
+        for (const Sample& x : s) {
+            const double w = 1.0 / std::max(x.ms * x.ms, 0.01);
+            for (size_t i = 0; i < k; ++i) {
+                for (size_t j = 0; j < k; ++j)
+                    a[i][j] += w * f[i](x) * f[j](x);
+                a[i][k] += w * f[i](x) * x.ms;
+            }
+        }
+        // Ridge-free Gaussian elimination with partial pivoting; a singular column gets 0.
+        std::vector<double> beta(k, 0.0);
+        for (size_t c = 0; c < k; ++c) {
+            size_t p = c;
+            for (size_t r = c + 1; r < k; ++r)
+                if (std::fabs(a[r][c]) > std::fabs(a[p][c]))
+                    p = r;
+            std::swap(a[c], a[p]);
+            if (std::fabs(a[c][c]) < 1e-12)
+                continue;
+            for (size_t r = 0; r < k; ++r) {
+                if (r == c)
+                    continue;
+                const double m = a[r][c] / a[c][c];
+                for (size_t j = c; j <= k; ++j)
+                    a[r][j] -= m * a[c][j];
+            }
+        }
+        for (size_t c = 0; c < k; ++c)
+            beta[c] = std::fabs(a[c][c]) < 1e-12 ? 0.0 : a[c][k] / a[c][c];
+        LinearCost cost;
+        cost.base_ms = beta[0];
+        size_t idx = 1;
+        if (use_px)
+            cost.ms_per_mpx = beta[idx++];
+        if (use_tri)
+            cost.ms_per_ktri = beta[idx++];
+        if (use_tri && cost.ms_per_ktri < 0) {
+            use_tri = false;
+            continue;
+        }
+        if (use_px && cost.ms_per_mpx < 0) {
+            use_px = false;
+            continue;
+        }
+        if (cost.base_ms < 0) {
+            // Through the origin is the closest a cost can come.
+            cost.base_ms = 0.0;
+        }
+        return cost;
+    }
+}
+
+CalibratedPart summarise(const std::string& name, const std::string& what,
+                         const std::vector<Sample>& s, const LinearCost& cost) {
+    CalibratedPart p;
+    p.name = name;
+    p.what = what;
+    p.samples = static_cast<int>(s.size());
+    p.cost = cost;
+    if (s.empty())
+        return p;
+    std::vector<double> ms;
+    double sq = 0.0;
+    for (const Sample& x : s) {
+        ms.push_back(x.ms);
+        const double r = x.ms > 0 ? (x.ms - cost.at(x.pixels, x.triangles)) / x.ms : 0.0;
+        sq += r * r;
+    }
+    std::sort(ms.begin(), ms.end());
+    p.median_ms = ms[ms.size() / 2];
+    p.min_ms = ms.front();
+    p.max_ms = ms.back();
+    p.residual_rms_pct = 100.0 * std::sqrt(sq / double(s.size()));
+    return p;
+}
+
+double loadAvg1() {
+    std::ifstream in("/proc/loadavg");
+    double l = 0.0;
+    in >> l;
+    return l;
+}
+
+std::string cpuModel() {
+    std::ifstream cpu("/proc/cpuinfo");
+    for (std::string line; std::getline(cpu, line);)
+        if (line.rfind("model name", 0) == 0)
+            return line.substr(line.find(':') + 2);
+    return "unknown CPU";
+}
+
+std::string utcNow() {
+    const std::time_t t = std::time(nullptr);
+    char buf[64];
+    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
+    return buf;
+}
+
+}  // namespace
+
+std::string machineDescriptionLine() {
+    return fmt::format("{} × {}", runtime::onlineCores(), cpuModel());
+}
+
+std::string calibrationCacheKey(const CalibrateOptions& o) {
+    const std::string text = fmt::format("{}|{}|{}|{}|{}|{}", machineDescriptionLine(), o.profile,
+                                         o.scene, o.codec, o.lod_px, o.core);
+    uint64_t h = 1469598103934665603ull;  // FNV-1a
+    for (unsigned char c : text) {
+        h ^= c;
+        h *= 1099511628211ull;
+    }
+    return fmt::format("{:016x}", h);
+}
+
+std::string calibrationCachePath(const CalibrateOptions& o) {
+    const char* xdg = std::getenv("XDG_CACHE_HOME");
+    const char* home = std::getenv("HOME");
+    const std::string base = xdg && *xdg     ? std::string(xdg)
+                             : home && *home ? std::string(home) + "/.cache"
+                                             : std::string("/tmp");
+    return base + "/qvr/calibration-" + calibrationCacheKey(o) + ".toml";
+}
+
+nlohmann::json Calibration::toJson() const {
+    nlohmann::json parts_json = nlohmann::json::array();
+    for (const CalibratedPart& p : parts)
+        parts_json.push_back({{"name", p.name},
+                              {"sample", p.what},
+                              {"samples", p.samples},
+                              {"base_ms", p.cost.base_ms},
+                              {"ms_per_mpx", p.cost.ms_per_mpx},
+                              {"ms_per_ktri", p.cost.ms_per_ktri},
+                              {"median_ms", p.median_ms},
+                              {"min_ms", p.min_ms},
+                              {"max_ms", p.max_ms},
+                              {"residual_rms_pct", p.residual_rms_pct}});
+    return {{"machine", machine},
+            {"date", date},
+            {"command", command},
+            {"seconds", seconds},
+            {"load_avg_before", load_avg_before},
+            {"parts", parts_json},
+            {"links", links},
+            {"frame_overhead_ms", costs.frame_overhead_ms},
+            {"packet_payload_bytes", costs.packet_payload_bytes},
+            {"packet_overhead_bytes", costs.packet_overhead_bytes}};
+}
+
+std::string Calibration::toToml() const {
+    std::string s = fmt::format(
+        "# qvr calibrate: this machine's runtime costs (docs/MODEL.md §8).\n# {}\n# {}, {:.0f} s, "
+        "load average {:.2f} before\n",
+        command, date, seconds, load_avg_before);
+    s += "# machine: " + machine + "\n";
+    for (const CalibratedPart& p : parts)
+        s += fmt::format(
+            "# {:14} {:3} samples ({}): median {:.2f} ms [{:.2f}, {:.2f}], fit residual "
+            "{:.0f}% RMS\n",
+            p.name, p.samples, p.what, p.median_ms, p.min_ms, p.max_ms, p.residual_rms_pct);
+    return s + runtimeCostsToml(costs);
+}
+
+Expected<Calibration> runCalibration(const CalibrateOptions& o) {
+    using namespace qvr::runtime;
+    const auto t_start = Clock::now();
+    Calibration cal;
+    cal.load_avg_before = loadAvg1();
+    cal.machine = machineDescriptionLine();
+    cal.date = utcNow();
+    auto profile = runtimeProfileByName(o.profile);
+    if (!profile)
+        return makeError("--profile: " + profile.error());
+    if (o.core >= 0) {
+        if (auto st = pinCurrentThread(o.core); !st)
+            std::fprintf(stderr, "qvr calibrate: %s (running unpinned)\n", st.error().c_str());
+    }
+    // The poses: the default motion's first seconds, the seeded gaze model. These are not a
+    // run's frames: no pipeline, no network, each part timed alone.
+    const int n_poses = o.quick ? 3 : 6;
+    auto inputs = loadHeadsetInputs(o.scene, "default", "model", profile->refresh_hz, 400, 7);
+    if (!inputs)
+        return makeError(inputs.error());
+    GlRendererOptions gl;
+    gl.lod_error_px = o.lod_px;
+    auto renderer = glRendererFactory(gl)();
+    if (!renderer)
+        return makeError(renderer.error());
+    if (auto st = (*renderer)->upload(*inputs->scene); !st)
+        return makeError(st.error());
+    Renderer& r = **renderer;
+    const LayerPlanner planner(*profile);
+    WorkloadProbe probe(*profile, inputs->bvh);
+    const double ring = probe.header().ring_deg;
+    CodecConfig codec;
+    codec.backend = o.codec;
+    const double eye_px = double(profile->width_px) * profile->height_px;
+
+    struct PoseSample {
+        Pose head;
+        Gaze gaze;
+        WorkloadFrame wf;  // every ring counted
+    };
+    std::vector<PoseSample> poses;
+    for (int k = 0; k < n_poses; ++k) {
+        const double t_ms = 250.0 + 700.0 * k;  // spread over the first seconds
+        PoseSample p;
+        p.head = poseAt(inputs->traces.motion, t_ms);
+        p.gaze = gazeAt(inputs->traces.gaze, t_ms);
+        p.wf = probe.frame(k, t_ms, p.head, p.gaze, 180.0);
+        poses.push_back(std::move(p));
+    }
+    auto log = [&](const std::string& line) {
+        if (o.verbose) {
+            std::fputs(line.c_str(), stdout);
+            std::fflush(stdout);
+        }
+    };
+
+    // 1. The decision: BVH ring counts to e1 + 6° (and the pixel rings).
+    std::vector<Sample> decision;
+    for (const PoseSample& p : poses)
+        for (double e1 : {1.0, 5.0, 10.0, 20.0, 35.0}) {
+            const auto t0 = Clock::now();
+            const WorkloadFrame wf = probe.frame(0, 0.0, p.head, p.gaze, e1 + 6.0);
+            const double ms = msSince(t0);
+            decision.push_back(
+                {ms, 0.0, sumWithinDeg(p.wf.triangles_per_ring, ring, e1 + 6.0 + ring)});
+            (void)wf;
+        }
+    cal.costs.decision = fit(decision, false, true);
+    cal.parts.push_back(
+        summarise("decision", "ring counts to e1+6°, both eyes", decision, cal.costs.decision));
+    log(fmt::format("  decision: {} samples\n", decision.size()));
+
+    // 2. The plan and bookkeeping of a frame.
+    {
+        std::vector<double> ms;
+        for (const PoseSample& p : poses)
+            for (double e1 : {3.0, 8.0, 15.0}) {
+                const auto t0 = Clock::now();
+                const LayerPlan plan = planner.plan(p.gaze, e1);
+                ms.push_back(msSince(t0));
+                (void)plan;
+            }
+        std::sort(ms.begin(), ms.end());
+        cal.costs.frame_overhead_ms = ms[ms.size() / 2];
+    }
+
+    // 3. Headset render: fovea passes at several e1, and the full frame (local).
+    std::vector<Sample> fovea;
+    std::vector<Sample> server;
+    std::vector<Sample> encode;
+    std::vector<Sample> decode;
+    std::vector<Sample> uca;
+    const std::vector<double> e1s = o.quick ? std::vector<double>{3, 8, 15, 30}
+                                            : std::vector<double>{2, 4, 6, 9, 13, 18, 25, 35};
+    ImageRgba8 image;
+    Compositor compositor(*profile, [] {
+        ComposeOptions c;
+        c.threads = 1;
+        return c;
+    }());
+    std::array<ImageRgba8, 2> display;
+    // Per layer size class, an encoder and a decoder that see successive frames (P-frames).
+    struct Chain {
+        std::unique_ptr<VideoEncoder> enc;
+        std::unique_ptr<VideoDecoder> dec;
+        int frames = 0;
+    };
+    std::array<Chain, 4> chains;  // stream ids: eye × {middle, outer}
+    for (size_t pi = 0; pi < poses.size(); ++pi) {
+        const PoseSample& p = poses[pi];
+        for (double e1 : e1s) {
+            const LayerPlan plan = planner.plan(p.gaze, e1);
+            const double fovea_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e1_deg);
+            const double mid_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e2_deg);
+            const double all_tris = sumTotal(p.wf.triangles_per_ring);
+            auto frame = std::make_shared<LayerFrame>();
+            frame->plan = plan;
+            frame->render_pose = p.head;
+            for (int eye = 0; eye < 2; ++eye) {
+                const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+                EyeLayerImages& imgs = frame->eyes[static_cast<size_t>(eye)];
+                if (!layers.fovea.empty()) {
+                    const auto t0 = Clock::now();
+                    auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
+                                          LayerKind::kFovea, imgs.fovea);
+                    if (!st)
+                        return makeError("fovea render: " + st.error());
+                    fovea.push_back({msSince(t0), double(layers.fovea.pixels()), fovea_tris / 2});
+                }
+                for (int li = 0; li < 2; ++li) {
+                    const bool middle = li == 0;
+                    const LayerRect& rect = middle ? layers.middle : layers.outer;
+                    if (rect.empty())
+                        continue;
+                    ImageRgba8& img = middle ? imgs.middle : imgs.outer;
+                    const auto t0 = Clock::now();
+                    auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
+                                          middle ? LayerKind::kMiddle : LayerKind::kOuter, img);
+                    if (!st)
+                        return makeError("layer render: " + st.error());
+                    server.push_back(
+                        {msSince(t0), double(rect.pixels()), (middle ? mid_tris : all_tris) / 2});
+                    Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
+                    if (!ch.enc) {
+                        auto e = makeVideoEncoder(codec);
+                        auto d = makeVideoDecoder(codec);
+                        if (!e || !d)
+                            return makeError("codec: " + (e ? d.error() : e.error()));
+                        ch.enc = std::move(*e);
+                        ch.dec = std::move(*d);
+                    }
+                    auto enc = ch.enc->encode(img);
+                    if (!enc)
+                        return makeError("encode: " + enc.error());
+                    const auto t1 = Clock::now();
+                    auto dec = ch.dec->decode(enc->bytes);
+                    const double dec_ms = msSince(t1);
+                    if (!dec)
+                        return makeError("decode: " + dec.error());
+                    // Key frames are the exception in a run (one every 120 frames): P-frames only.
+                    if (!enc->is_keyframe) {
+                        encode.push_back({enc->encode_ms, double(rect.pixels()), 0});
+                        decode.push_back({dec_ms, double(rect.pixels()), 0});
+                    }
+                }
+            }
+            // UCA over the frame just rendered, with a slightly moved pose.
+            const auto t0 = Clock::now();
+            auto rep = compositor.present(frame, p.head, display);
+            const double uca_ms = msSince(t0);
+            if (!rep)
+                return makeError("UCA: " + rep.error());
+            uca.push_back({uca_ms, 2.0 * eye_px, 0});
+        }
+        log(fmt::format("  pose {}/{}: fovea, periphery layers, codec, UCA\n", pi + 1,
+                        poses.size()));
+    }
+    // The full frame: local's render and remote's server layer (1 or 2 poses: ~0.2 s a view).
+    for (size_t pi = 0; pi < (o.quick ? 1u : 2u); ++pi) {
+        const PoseSample& p = poses[pi];
+        const LayerPlan full = planner.plan(p.gaze, 180.0);
+        const double all_tris = sumTotal(p.wf.triangles_per_ring);
+        for (int eye = 0; eye < 2; ++eye) {
+            const auto t0 = Clock::now();
+            auto st = renderLayer(r, *profile, full, p.head, static_cast<Eye>(eye),
+                                  LayerKind::kFovea, image);
+            if (!st)
+                return makeError("full render: " + st.error());
+            const double ms = msSince(t0);
+            fovea.push_back({ms, eye_px, all_tris / 2});
+            // The server's whole-frame layer is the same view at scale 1.
+            server.push_back({ms, eye_px, all_tris / 2});
+        }
+        log(fmt::format("  full frame {}/{}\n", pi + 1, o.quick ? 1 : 2));
+    }
+    cal.costs.fovea = fit(fovea, true, true);
+    cal.costs.server_render = fit(server, true, true);
+    cal.costs.encode = fit(encode, true, false);
+    cal.costs.decode = fit(decode, true, false);
+    cal.costs.uca = fit(uca, true, false);
+    // UCA was timed at one display size only: all of it is per pixel.
+    if (!uca.empty()) {
+        double sum = 0.0;
+        std::vector<double> ms;
+        for (const Sample& s : uca)
+            ms.push_back(s.ms);
+        std::sort(ms.begin(), ms.end());
+        sum = ms[ms.size() / 2];
+        cal.costs.uca = {0.0, sum / (2.0 * eye_px * 1e-6), 0.0};
+    }
+    cal.parts.push_back(
+        summarise("fovea/local", "one eye's fovea or full-frame pass", fovea, cal.costs.fovea));
+    cal.parts.push_back(summarise("server render", "one periphery or whole-frame layer", server,
+                                  cal.costs.server_render));
+    cal.parts.push_back(summarise("encode", "one layer, P-frame", encode, cal.costs.encode));
+    cal.parts.push_back(summarise("decode", "one stream, P-frame", decode, cal.costs.decode));
+    cal.parts.push_back(summarise("uca", "one frame, both eyes", uca, cal.costs.uca));
+
+    // 4. The link: net's profiles and its packets' header.
+    cal.costs.packet_payload_bytes = double(net::kMediaChunkBytes);
+    cal.costs.packet_overhead_bytes = double(net::kMediaHeaderBytes);
+    cal.links = nlohmann::json::object();
+    for (const std::string& name : net::linkProfileNames()) {
+        auto lc = net::parseLinkSpec(name);
+        if (lc)
+            cal.links[name] = {{"rate_bps", lc->rate_bps}, {"delay_ms", lc->delay_ms}};
+    }
+    cal.seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
+    return cal;
+}
+
+}  // namespace qvr::cli
+
+namespace qvr::cli {
+
+namespace {
+
+struct CalibrateCmdOptions {
+    CalibrateOptions cal;
+    std::string out;
+    std::string json;
+    std::string command_line;
+};
+
+int runCalibrate(CalibrateCmdOptions& o) {
+    if (o.out.empty()) {
+        std::fprintf(stderr, "qvr calibrate: --out FILE is required\n");
+        return 2;
+    }
+    o.cal.verbose = true;
+    fmt::print("qvr calibrate: {} on {}, profile {}, codec {}, LOD {} px, core {}{}\n",
+               machineDescriptionLine(), o.cal.scene, o.cal.profile, o.cal.codec, o.cal.lod_px,
+               o.cal.core, o.cal.quick ? ", quick" : "");
+    auto cal = runCalibration(o.cal);
+    if (!cal) {
+        std::fprintf(stderr, "qvr calibrate: %s\n", cal.error().c_str());
+        return 2;
+    }
+    cal->command = o.command_line;
+    fmt::print("  {:14} {:>7} {:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>9}\n", "part", "samples",
+               "median", "min", "max", "base ms", "ms/Mpx", "ms/ktri", "fit RMS");
+    for (const CalibratedPart& p : cal->parts)
+        fmt::print(
+            "  {:14} {:>7} {:>9.2f} {:>9.2f} {:>9.2f} {:>10.3f} {:>10.3f} {:>10.4f} {:>8.0f}%\n",
+            p.name, p.samples, p.median_ms, p.min_ms, p.max_ms, p.cost.base_ms, p.cost.ms_per_mpx,
+            p.cost.ms_per_ktri, p.residual_rms_pct);
+    fmt::print(
+        "  frame overhead (plan) {:.3f} ms; packets {} + {} bytes; took {:.0f} s, load "
+        "average {:.2f} before\n",
+        cal->costs.frame_overhead_ms, cal->costs.packet_payload_bytes,
+        cal->costs.packet_overhead_bytes, cal->seconds, cal->load_avg_before);
+    {
+        std::ofstream f(o.out);
+        f << cal->toToml();
+        if (!f) {
+            std::fprintf(stderr, "qvr calibrate: cannot write %s\n", o.out.c_str());
+            return 1;
+        }
+    }
+    const std::string json = o.json.empty() ? o.out + ".json" : o.json;
+    {
+        std::ofstream f(json);
+        f << cal->toJson().dump(2) << "\n";
+        if (!f) {
+            std::fprintf(stderr, "qvr calibrate: cannot write %s\n", json.c_str());
+            return 1;
+        }
+    }
+    fmt::print("  wrote {} (qvr sim --hardware / qvr run --hardware) and {}\n", o.out, json);
+    return 0;
+}
+
+}  // namespace
+
+static Registered registerCalibrate(CLI::App& app) {
+    auto o = std::make_shared<CalibrateCmdOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "calibrate",
+        "Measure this machine's runtime costs (render, encode, decode, UCA, ring counts) and "
+        "write a hardware file for the runtime pipeline model");
+    cmd->add_option("--out", o->out, "Hardware file to write (TOML)")->required();
+    cmd->add_option("--json", o->json, "JSON copy (default: OUT.json)");
+    cmd->add_option("--scene", o->cal.scene, "Scene the render costs are measured on")
+        ->capture_default_str();
+    cmd->add_option("--profile", o->cal.profile, "Display profile (as qvr run's)")
+        ->capture_default_str();
+    cmd->add_option("--codec", o->cal.codec, "Codec backend: x264 or raw")
+        ->check(CLI::IsMember({"x264", "raw"}))
+        ->capture_default_str();
+    cmd->add_option("--core", o->cal.core, "Core to pin to (-1: none)")
+        ->check(CLI::Range(-1, 4096))
+        ->capture_default_str();
+    addLodOption(cmd, o->cal.lod_px);
+    cmd->add_flag("--quick", o->cal.quick, "Fewer samples (what qvr run does before a run)");
+    return {cmd, [o] {
+                o->command_line = fmt::format(
+                    "qvr calibrate --out {} --scene {} --profile {} --codec {} --lod-px {} "
+                    "--core {}{}",
+                    o->out, o->cal.scene, o->cal.profile, o->cal.codec, o->cal.lod_px, o->cal.core,
+                    o->cal.quick ? " --quick" : "");
+                return runCalibrate(*o);
+            }};
+}
+
+QVR_REGISTER_COMMAND(91, registerCalibrate);
+
+}  // namespace qvr::cli

@@ -1,0 +1,94 @@
+// The runtime's pipeline as built (docs/RUNTIME.md), as a model beside the paper's (simulator.h):
+// one headset core that runs the decision, the fovea render, every stream's decode and UCA in
+// turn, frames in flight (1 or 2), a server with one render thread and a request queue of depth
+// 2 where the newest request wins, a link that serialises the streams, vsync slots at the
+// display rate, and the wait limit after which the display re-warps older layers (frame reuse).
+// Its costs are this machine's, measured by `qvr calibrate` (RuntimeCosts); its metrics are the
+// runtime's (telemetry.h): FPS of scan-out, MTP from pose sample to UCA end. docs/MODEL.md §8.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "qvr/sim/design.h"
+#include "qvr/sim/hardware.h"
+#include "qvr/sim/network.h"
+#include "qvr/workload/workload.h"
+
+namespace qvr {
+
+// The runtime model's settings: which pipeline `qvr sim` uses and the runtime's knobs.
+struct RuntimeSimConfig {
+    Design design = Design::Qvr;  // local, remote, ffr (fixed e1), sw, qvr/dfr (LIWC)
+    double fixed_e1_deg = 5.0;    // ffr's e1
+    RuntimeCosts costs;
+    int pipeline_depth = 2;        // frames in flight (1 or 2); local always runs 1
+    int server_queue = 2;          // the server's request queue; the newest request wins
+    double wait_limit_ms = 250.0;  // remote layers later than this are late: the frame is reused
+    int frames = 300;              // clamped to the trace's length
+    // LIWC learns the server's render + encode time (LiwcConfig::learn_remote_base), as in the
+    // runtime.
+    bool liwc_learn_remote_base = true;
+};
+
+// One frame, ms from the run's start, as the runtime's telemetry records it.
+struct RuntimeFrame {
+    int64_t index = 0;
+    double e1_deg = 0.0;
+    double pose_ms = 0.0;
+    double request_ms = -1.0;
+    double local_start_ms = 0.0, local_end_ms = 0.0;
+    double remote_done_ms = -1.0;  // every stream decoded (−1: never, or not requested)
+    double uca_start_ms = 0.0, uca_end_ms = 0.0;
+    double display_ms = 0.0;
+    double bytes = 0.0;
+    double t_local_ms = 0.0;
+    double t_remote_ms = 0.0;
+    double headset_busy_ms = 0.0;
+    double decision_ms = 0.0;
+    double mtp_ms = 0.0;
+    bool requested = false;
+    bool served = false;  // the server rendered it (not pushed out of its queue)
+    bool reused = false;
+};
+
+struct RuntimeSummary {
+    std::string design;
+    int frames = 0;
+    int frames_reused = 0;
+    int requests_dropped = 0;
+    double fps_mean = 0.0;  // scan-outs per second between the first and the last
+    double mtp_ms_mean = 0.0;
+    double mtp_ms_p99 = 0.0;
+    double bytes_per_frame_mean = 0.0;
+    double e1_deg_mean = 0.0;
+    double t_local_ms_mean = 0.0;
+    double t_remote_ms_mean = 0.0;  // frames that requested remote layers
+    double headset_busy_ms_mean = 0.0;
+    double server_busy_ms_mean = 0.0;  // render + encode per served frame
+};
+
+struct RuntimeRunResult {
+    std::vector<RuntimeFrame> frames;
+    RuntimeSummary summary;
+};
+
+// Replays `trace` through the runtime's pipeline on `link` (a constant rate or a trace; the
+// caller gives it the link emulator's rate and no noise, efficiency 1: the payload share of a
+// packet is applied here). Deterministic.
+RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
+                                 Link& link);
+
+// The link net's emulator (net/link_emulator.h) makes of a `qvr run --net` spec, for this model:
+// "wifi" (200 Mbit/s), "lte" (100), "5g" (500), "rate:MBPS", "trace:PATH[@MBPS]" (a Mahimahi
+// trace at its recorded mean unless MBPS is given), each with optional ",key=value" options of
+// which delay_ms is used (one way; *delay_ms) and the rest (loss, jitter, queue) are not
+// modelled. No noise: the emulator has none; packet headers are charged by the model.
+Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double* delay_ms);
+
+// The runtime design names (`qvr run --designs`) on the simulator's designs.
+Expected<Design> runtimeDesignByName(const std::string& name);
+
+}  // namespace qvr

@@ -1,0 +1,449 @@
+// The runtime's pipeline (runtime/src/headset_client.cpp, render_server.cpp) as events on three
+// timelines: the headset's one core, the server's render thread and the link. The headset runs
+// the runtime's loop literally — prepare frames up to the pipeline depth ahead (pose, decision,
+// request), then finish the oldest (fovea render, wait for its streams while decoding whatever
+// arrives, UCA, vsync) — and the server is advanced lazily up to the headset's clock, which is
+// exact because only the headset adds requests. docs/MODEL.md §8.
+#include "qvr/sim/runtime_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <numeric>
+
+#include "qvr/controller/liwc.h"
+#include "qvr/controller/policy.h"
+#include "qvr/foveation/layer_plan.h"
+
+namespace qvr {
+
+namespace {
+
+struct Stream {
+    int64_t frame = 0;
+    double rx_ms = 0.0;  // last packet arrived
+    double payload_bytes = 0.0;
+    double pixels = 0.0;  // decoded layer pixels
+    double goodput_bps = 0.0;
+    bool decoded = false;
+};
+
+struct FrameState {
+    LayerPlan plan;
+    int expected = 0;  // streams
+    int decoded = 0;
+    double last_rx_ms = 0.0;
+    double received_bytes = 0.0;
+    double middle_bytes = 0.0, outer_bytes = 0.0;
+    bool served = false;
+};
+
+// A layer the server renders and sends: its pixels, the triangles in its view, its bytes.
+struct LayerJob {
+    double pixels = 0.0;
+    double triangles = 0.0;
+    double bytes = 0.0;
+    bool middle = true;
+};
+
+double nearestRankP99(std::vector<double> v) {
+    if (v.empty())
+        return 0.0;
+    std::sort(v.begin(), v.end());
+    const double rank = std::ceil(0.99 * static_cast<double>(v.size()));
+    const size_t idx = static_cast<size_t>(std::clamp(rank, 1.0, double(v.size()))) - 1;
+    return v[idx];
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double* delay_ms) {
+    const size_t comma = spec.find(',');
+    const std::string profile = spec.substr(0, comma);
+    if (delay_ms)
+        *delay_ms = 0.0;
+    for (size_t pos = comma; pos != std::string::npos;) {
+        const size_t end = spec.find(',', pos + 1);
+        const std::string opt =
+            spec.substr(pos + 1, end == std::string::npos ? end : end - pos - 1);
+        pos = end;
+        if (opt.rfind("delay_ms=", 0) == 0) {
+            char* stop = nullptr;
+            const double v = std::strtod(opt.c_str() + 9, &stop);
+            if (stop == opt.c_str() + 9 || *stop != '\0' || !std::isfinite(v) || v < 0 || v > 10000)
+                return makeError("link '" + spec + "': bad delay_ms");
+            if (delay_ms)
+                *delay_ms = v;
+        }
+    }
+    auto rate = [&](double bps) -> Expected<std::unique_ptr<Link>> {
+        return std::unique_ptr<Link>(std::make_unique<NoisyLink>(
+            profile, bps, 1.0, std::numeric_limits<double>::infinity(), RadioPower{}, 1));
+    };
+    if (profile == "wifi")
+        return rate(200e6);
+    if (profile == "lte")
+        return rate(100e6);
+    if (profile == "5g")
+        return rate(500e6);
+    if (profile.rfind("rate:", 0) == 0) {
+        char* stop = nullptr;
+        const double mbps = std::strtod(profile.c_str() + 5, &stop);
+        if (stop == profile.c_str() + 5 || *stop != '\0' || !(mbps > 0) || mbps > 1e6)
+            return makeError("link '" + spec + "': rate:MBPS needs a rate in (0, 1e6]");
+        return rate(mbps * 1e6);
+    }
+    if (profile.rfind("trace:", 0) == 0) {
+        std::string path = profile.substr(6);
+        double target_bps = 0.0;
+        if (const size_t at = path.rfind('@'); at != std::string::npos) {
+            char* stop = nullptr;
+            const double mbps = std::strtod(path.c_str() + at + 1, &stop);
+            if (stop == path.c_str() + at + 1 || *stop != '\0' || !(mbps > 0) || mbps > 1e6)
+                return makeError("link '" + spec + "': trace:PATH@MBPS needs a mean in (0, 1e6]");
+            target_bps = mbps * 1e6;
+            path.resize(at);
+        }
+        auto trace = loadMahimahiTrace(path);
+        if (!trace)
+            return makeError(trace.error());
+        if (target_bps <= 0)
+            target_bps = trace->meanBps();
+        return std::unique_ptr<Link>(
+            std::make_unique<TraceLink>(profile, std::move(*trace), target_bps, 1.0, RadioPower{}));
+    }
+    return makeError("link '" + spec +
+                     "': the runtime model knows wifi, lte, 5g, rate:MBPS and trace:PATH[@MBPS]");
+}
+
+Expected<Design> runtimeDesignByName(const std::string& name) {
+    if (name == "local")
+        return Design::Local;
+    if (name == "remote")
+        return Design::Remote;
+    if (name == "ffr")
+        return Design::Ffr;
+    if (name == "sw")
+        return Design::Sw;
+    if (name == "qvr")
+        return Design::Qvr;
+    return makeError("runtime model: unknown design '" + name + "' (local, remote, ffr, sw, qvr)");
+}
+
+RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
+                                 Link& link) {
+    const WorkloadHeader& header = trace.header;
+    const RuntimeCosts& c = config.costs;
+    const DesignTraits& traits = traitsOf(config.design);
+    const bool local_only = traits.split == Split::LocalOnly;
+    const bool whole_frame = traits.split == Split::RemoteOnly;
+    const bool liwc = traits.policy == "liwc";
+    const LayerPlanner planner(header.profile);
+    const double eye_px = double(header.profile.width_px) * double(header.profile.height_px);
+    const double period_ms = 1000.0 / std::max(1.0, header.profile.refresh_hz);
+    const int n_frames = std::clamp<int>(config.frames, 0, static_cast<int>(trace.frames.size()));
+    const size_t depth =
+        local_only ? 1 : static_cast<size_t>(std::clamp(config.pipeline_depth, 1, 4));
+    const size_t queue_cap = static_cast<size_t>(std::max(config.server_queue, 1));
+
+    std::unique_ptr<FoveaPolicy> policy;
+    if (liwc) {
+        LiwcConfig lc;
+        lc.learn_remote_base = config.liwc_learn_remote_base;
+        policy = std::make_unique<LiwcPolicy>(header, lc);
+    } else if (traits.policy == "sw") {
+        policy = makeSoftwareReactivePolicy(header);
+    } else if (traits.policy == "fixed") {
+        policy = std::make_unique<FixedPolicy>(config.fixed_e1_deg);
+    }
+
+    RuntimeRunResult result;
+    result.frames.resize(static_cast<size_t>(n_frames));
+    std::vector<FrameState> state(static_cast<size_t>(n_frames));
+    std::vector<Stream> streams;  // every stream sent, in rx order (the link keeps order)
+
+    // Headset core.
+    double hs = 0.0;
+    double busy = 0.0;  // busy time since the previous frame finished
+    double last_e1_deg = 5.0;
+    double last_complete_rx_ms = 0.0;
+    double last_scanout_ms = -1.0;
+    double ack_goodput_bps = 0.0;
+    // Server and link.
+    struct Request {
+        int64_t frame;
+        double arrive_ms;
+    };
+    std::deque<Request> queue;
+    double server_free = 0.0, link_free = 0.0, server_busy_total = 0.0;
+    int served_frames = 0;
+    size_t next_undecoded = 0;
+
+    auto work = [&](double ms) {
+        hs += ms;
+        busy += ms;
+    };
+
+    // Renders, encodes and sends frame j's layers from `start`.
+    auto serve = [&](int64_t j, double start) {
+        FrameState& fs = state[static_cast<size_t>(j)];
+        const WorkloadFrame& wf = trace.frames[static_cast<size_t>(j)];
+        fs.served = true;
+        ++served_frames;
+        double t = start + c.server_frame_ms;
+        const double total_tris = sumTotal(wf.triangles_per_ring);
+        std::vector<LayerJob> jobs;
+        if (whole_frame) {
+            const double bytes = bitsPerPixelAt(header, wf, 1.0) * eye_px / 8.0;
+            for (int eye = 0; eye < 2; ++eye)
+                jobs.push_back({eye_px, total_tris / 2.0, bytes, true});
+        } else {
+            const PeripheryBytes pb = peripheryBytes(header, wf, fs.plan);
+            const double mid_tris =
+                sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e2_deg);
+            for (int eye = 0; eye < 2; ++eye) {
+                const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
+                if (!e.middle.empty())
+                    jobs.push_back(
+                        {double(e.middle.pixels()), mid_tris / 2.0, pb.middle / 2.0, true});
+                if (!e.outer.empty())
+                    jobs.push_back(
+                        {double(e.outer.pixels()), total_tris / 2.0, pb.outer / 2.0, false});
+            }
+        }
+        for (const LayerJob& job : jobs) {
+            const double render = c.server_render.at(job.pixels, job.triangles);
+            const double encode = c.encode.at(job.pixels, 0.0);
+            t += render + encode;
+            server_busy_total += render + encode;
+            const double send = std::max(link_free, t);
+            const LinkTransfer tr = link.transfer(send, job.bytes / c.payloadShare());
+            link_free = send + tr.duration_ms;
+            Stream s;
+            s.frame = j;
+            s.rx_ms = link_free + c.link_delay_ms;
+            s.payload_bytes = job.bytes;
+            s.pixels = job.pixels;
+            s.goodput_bps = tr.duration_ms > 0 ? job.bytes * 8.0 / (tr.duration_ms * 1e-3) : 0.0;
+            streams.push_back(s);
+            if (job.middle)
+                fs.middle_bytes += job.bytes;
+            else
+                fs.outer_bytes += job.bytes;
+        }
+        server_free = t;
+    };
+
+    // Starts every queued request the server would have started by `until`.
+    auto advanceServer = [&](double until) {
+        while (!queue.empty()) {
+            const double start = std::max(server_free, queue.front().arrive_ms);
+            if (start > until)
+                break;
+            const int64_t j = queue.front().frame;
+            queue.pop_front();
+            serve(j, start);
+        }
+    };
+
+    // Decodes the next received stream (the transport hands them over in arrival order).
+    auto decodeNext = [&]() {
+        Stream& s = streams[next_undecoded++];
+        hs = std::max(hs, s.rx_ms);
+        work(c.decode.at(s.pixels, 0.0));
+        s.decoded = true;
+        ack_goodput_bps = s.goodput_bps;
+        FrameState& fs = state[static_cast<size_t>(s.frame)];
+        RuntimeFrame& rf = result.frames[static_cast<size_t>(s.frame)];
+        fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
+        fs.received_bytes += s.payload_bytes;
+        rf.bytes += s.payload_bytes;
+        if (++fs.decoded == fs.expected) {
+            rf.remote_done_ms = hs;
+            last_complete_rx_ms = std::max(last_complete_rx_ms, fs.last_rx_ms);
+        }
+    };
+
+    // Takes what has arrived by now (pumpNetwork(0)).
+    auto pump = [&]() {
+        for (;;) {
+            advanceServer(hs);
+            if (next_undecoded >= streams.size() || streams[next_undecoded].rx_ms > hs)
+                break;
+            decodeNext();
+        }
+    };
+
+    // Steps 1–3.
+    auto prepare = [&](int64_t i) {
+        RuntimeFrame& rf = result.frames[static_cast<size_t>(i)];
+        FrameState& fs = state[static_cast<size_t>(i)];
+        const WorkloadFrame& wf = trace.frames[static_cast<size_t>(i)];
+        rf.index = wf.index;
+        rf.pose_ms = hs;
+        if (!local_only)
+            pump();
+        const double decision_start = hs;
+        if (liwc) {
+            // The BVH ring counts reach e1 + 6° (one ring more than the candidates need).
+            const double counted = sumWithinDeg(wf.triangles_per_ring, header.ring_deg,
+                                                last_e1_deg + 6.0 + header.ring_deg);
+            work(c.decision.at(0.0, counted));
+        }
+        if (local_only) {
+            fs.plan = planner.plan(wf.gaze, 180.0);
+            rf.e1_deg = fs.plan.cover_deg;
+        } else if (whole_frame) {
+            fs.plan = planner.plan(wf.gaze, 180.0);
+            fs.expected = 2;
+            rf.e1_deg = 0.0;
+        } else {
+            const Decision d = policy->decide(wf);
+            last_e1_deg = d.e1_deg;
+            fs.plan = planner.plan(wf.gaze, d.e1_deg);
+            rf.e1_deg = fs.plan.e1_deg;
+            for (const EyeLayers& e : fs.plan.eyes)
+                fs.expected += (e.middle.empty() ? 0 : 1) + (e.outer.empty() ? 0 : 1);
+        }
+        rf.decision_ms = hs - decision_start;
+        if (fs.expected > 0) {
+            rf.requested = true;
+            rf.request_ms = hs;
+            advanceServer(hs);
+            queue.push_back({i, hs});
+            while (queue.size() > queue_cap) {
+                queue.pop_front();
+                ++result.summary.requests_dropped;
+            }
+        }
+    };
+
+    // Steps 4–8.
+    auto finish = [&](int64_t i) {
+        RuntimeFrame& rf = result.frames[static_cast<size_t>(i)];
+        FrameState& fs = state[static_cast<size_t>(i)];
+        const WorkloadFrame& wf = trace.frames[static_cast<size_t>(i)];
+        // 4. The fovea (the whole frame for local), one pass per eye.
+        rf.local_start_ms = hs;
+        if (!whole_frame) {
+            const double tris =
+                local_only ? sumTotal(wf.triangles_per_ring)
+                           : sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e1_deg);
+            for (const EyeLayers& e : fs.plan.eyes)
+                if (!e.fovea.empty())
+                    work(c.fovea.at(double(e.fovea.pixels()), tris / 2.0));
+        }
+        rf.local_end_ms = hs;
+        rf.t_local_ms = rf.local_end_ms - rf.local_start_ms;
+
+        // 5. Wait for this frame's streams, decoding whatever arrives.
+        bool have_current = fs.expected == 0;
+        if (fs.expected > 0) {
+            const double service_start = std::max(rf.request_ms, last_complete_rx_ms);
+            const double deadline =
+                std::max({rf.local_end_ms, rf.pose_ms, service_start}) + config.wait_limit_ms;
+            for (;;) {
+                advanceServer(deadline);  // no request is sent while the headset waits
+                if (fs.decoded == fs.expected || hs >= deadline)
+                    break;
+                if (next_undecoded >= streams.size() || streams[next_undecoded].rx_ms >= deadline) {
+                    hs = std::max(hs, deadline);
+                    break;
+                }
+                decodeNext();
+            }
+            have_current = fs.decoded == fs.expected;
+            const double end = have_current ? rf.remote_done_ms : hs;
+            rf.t_remote_ms = std::max(0.0, end - service_start);
+        }
+        // 6. UCA with the newest pose; a late frame re-warps older layers.
+        rf.reused = !have_current;
+        rf.uca_start_ms = hs;
+        work(c.uca.at(2.0 * eye_px, 0.0) + c.frame_overhead_ms);
+        rf.uca_end_ms = hs;
+        rf.mtp_ms = rf.uca_end_ms - rf.pose_ms;
+        // 7. Scan-out at the next free vsync slot.
+        double slot = std::ceil(rf.uca_end_ms / period_ms - 1e-9) * period_ms;
+        if (slot <= last_scanout_ms)
+            slot = last_scanout_ms + period_ms;
+        last_scanout_ms = slot;
+        rf.display_ms = slot;
+        hs = slot;
+        rf.headset_busy_ms = i > 0 ? busy : 0.0;
+        busy = 0.0;
+        rf.served = fs.served;
+        // 8. The policy learns what the frame measured.
+        if (policy && !local_only && !whole_frame) {
+            FrameMeasurement m;
+            m.index = wf.index;
+            m.e1_deg = fs.plan.e1_deg;
+            m.t_local_ms =
+                depth > 1 && rf.headset_busy_ms > 0.0 ? rf.headset_busy_ms : rf.t_local_ms;
+            m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
+            m.triangles_local =
+                sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e1_deg);
+            m.pixels_local = sumWithinDeg(wf.pixels_per_ring, header.ring_deg, fs.plan.e1_deg);
+            m.middle_bytes = fs.middle_bytes > 0 && fs.received_bytes > 0 ? fs.middle_bytes : 0;
+            m.outer_bytes = fs.outer_bytes > 0 && fs.received_bytes > 0 ? fs.outer_bytes : 0;
+            m.middle_pixels = 2.0 * double(fs.plan.middle_pixels);
+            m.outer_pixels = 2.0 * double(fs.plan.outer_pixels);
+            m.s1 = fs.plan.s1;
+            m.s2 = fs.plan.s2;
+            m.throughput_bps = ack_goodput_bps;
+            policy->observe(m);
+        }
+    };
+
+    std::deque<int64_t> ahead;
+    int64_t next = 0;
+    for (int64_t i = 0; i < n_frames; ++i) {
+        while (ahead.size() < depth && next < n_frames) {
+            prepare(next);
+            ahead.push_back(next++);
+        }
+        finish(ahead.front());
+        ahead.pop_front();
+    }
+
+    // Summary, as summarizeRun (runtime/telemetry.cpp) computes it.
+    RuntimeSummary& s = result.summary;
+    s.design = std::string(traits.name);
+    s.frames = n_frames;
+    if (n_frames == 0)
+        return result;
+    const double n = double(n_frames);
+    std::vector<double> mtp;
+    int remote_frames = 0, busy_frames = 0;
+    for (const RuntimeFrame& f : result.frames) {
+        mtp.push_back(f.mtp_ms);
+        s.mtp_ms_mean += f.mtp_ms / n;
+        s.bytes_per_frame_mean += f.bytes / n;
+        s.e1_deg_mean += f.e1_deg / n;
+        s.t_local_ms_mean += f.t_local_ms / n;
+        s.frames_reused += f.reused ? 1 : 0;
+        if (f.requested) {
+            s.t_remote_ms_mean += f.t_remote_ms;
+            ++remote_frames;
+        }
+        if (f.headset_busy_ms > 0) {
+            s.headset_busy_ms_mean += f.headset_busy_ms;
+            ++busy_frames;
+        }
+    }
+    s.mtp_ms_p99 = nearestRankP99(mtp);
+    if (remote_frames > 0)
+        s.t_remote_ms_mean /= remote_frames;
+    if (busy_frames > 0)
+        s.headset_busy_ms_mean /= busy_frames;
+    if (served_frames > 0)
+        s.server_busy_ms_mean = server_busy_total / served_frames;
+    const double span = result.frames.back().display_ms - result.frames.front().display_ms;
+    if (n_frames > 1 && span > 0)
+        s.fps_mean = (n - 1.0) * 1000.0 / span;
+    return result;
+}
+
+}  // namespace qvr

@@ -1,0 +1,191 @@
+// The runtime pipeline model (sim/runtime_model.h) against closed forms: with costs that do not
+// depend on the frame, a design with one bottleneck stage runs at that stage's rate (rounded to
+// vsync slots where the headset waits for them), two frames in flight overlap the headset's and
+// the server's work exactly as far as the shorter stage allows, and a frame whose layers arrive
+// later than the wait limit is reused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "qvr/foveation/layer_plan.h"
+#include "qvr/sim/network.h"
+#include "qvr/sim/runtime_model.h"
+
+namespace qvr {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+WorkloadTrace flatTrace(int frames) {
+    WorkloadTrace t;
+    t.header.name = "flat";
+    t.header.profile = defaultHmdProfile();
+    t.header.profile.width_px = 320;
+    t.header.profile.height_px = 360;
+    t.header.ring_deg = 1.0;
+    t.header.rings = 120;
+    t.header.scales = {1, 2, 4, 8, 16, 32};
+    for (int i = 0; i < frames; ++i) {
+        WorkloadFrame f;
+        f.index = i;
+        f.time_ms = 1000.0 * i / 90.0;
+        f.triangles_per_ring.assign(120, 100.0);
+        f.pixels_per_ring.assign(120, 1000.0);
+        f.bits_per_pixel.assign(6, 0.1);
+        t.frames.push_back(f);
+    }
+    return t;
+}
+
+// Costs that are the same for every frame: only the base terms.
+RuntimeCosts flatCosts(double fovea_pass_ms, double uca_ms, double server_layer_ms) {
+    RuntimeCosts c;
+    c.decision = {0, 0, 0};
+    c.fovea = {fovea_pass_ms, 0, 0};
+    c.decode = {0, 0, 0};
+    c.uca = {uca_ms, 0, 0};
+    c.frame_overhead_ms = 0.0;
+    c.server_render = {server_layer_ms, 0, 0};
+    c.encode = {0, 0, 0};
+    c.server_frame_ms = 0.0;
+    c.link_delay_ms = 0.0;
+    return c;
+}
+
+// A link so fast its transfers take no measurable time.
+NoisyLink fastLink() {
+    return NoisyLink("fast", 1e15, 1.0, kInf, {0, 0}, 1);
+}
+
+const double kSlotMs = 1000.0 / 90.0;
+
+double slots(double ms) {
+    return std::ceil(ms / kSlotMs - 1e-9) * kSlotMs;
+}
+
+RuntimeRunResult run(Design d, const RuntimeCosts& costs, int depth, int frames = 60,
+                     double wait_limit_ms = 250.0) {
+    const WorkloadTrace trace = flatTrace(frames);
+    RuntimeSimConfig cfg;
+    cfg.design = d;
+    cfg.costs = costs;
+    cfg.pipeline_depth = depth;
+    cfg.frames = frames;
+    cfg.wait_limit_ms = wait_limit_ms;
+    NoisyLink link = fastLink();
+    return simulateRuntime(trace, cfg, link);
+}
+
+TEST(RuntimeModel, LocalRunsAtItsRenderPlusUcaRoundedToVsync) {
+    // Two full-frame passes of 30 ms and 5 ms of UCA: 65 ms a frame on the headset's core, then
+    // the next vsync slot.
+    const RuntimeRunResult r = run(Design::Local, flatCosts(30.0, 5.0, 0.0), 2);
+    EXPECT_NEAR(r.summary.fps_mean, 1000.0 / slots(65.0), 1e-6);
+    EXPECT_NEAR(r.summary.mtp_ms_mean, 65.0, 1e-6);
+    EXPECT_EQ(r.summary.frames_reused, 0);
+    EXPECT_EQ(r.summary.bytes_per_frame_mean, 0.0);
+    for (const RuntimeFrame& f : r.frames)
+        EXPECT_NEAR(std::fmod(f.display_ms + 1e-9, kSlotMs), 0.0, 1e-6);
+}
+
+TEST(RuntimeModel, ServerBoundRemoteRunsAtTheServersRate) {
+    // Two full-frame layers of 100 ms on the server: 200 ms a frame. With two frames in flight
+    // the server never idles, so scan-outs follow it exactly; with one it idles while the headset
+    // composes and waits for vsync.
+    const RuntimeRunResult two = run(Design::Remote, flatCosts(0.0, 1.0, 100.0), 2);
+    EXPECT_NEAR(two.summary.fps_mean, 1000.0 / 200.0, 1e-6);
+    EXPECT_EQ(two.summary.frames_reused, 0);
+    EXPECT_GT(two.summary.bytes_per_frame_mean, 0.0);
+    const RuntimeRunResult one = run(Design::Remote, flatCosts(0.0, 1.0, 100.0), 1);
+    EXPECT_NEAR(one.summary.fps_mean, 1000.0 / slots(201.0), 1e-6);
+    EXPECT_NEAR(one.summary.mtp_ms_mean, 201.0, 1e-6);
+}
+
+TEST(RuntimeModel, TwoFramesInFlightOverlapAsFarAsTheShorterStageAllows) {
+    // Foveated: the headset renders two 20 ms fovea passes and 5 ms of UCA (45 ms), the server
+    // four 15 ms layers (60 ms). One frame in flight overlaps only the fovea with the server:
+    // max(40, 60) + 5 ms, then vsync. Two frames overlap everything: the longer stage sets the
+    // pace.
+    const RuntimeCosts server_bound = flatCosts(20.0, 5.0, 15.0);
+    const RuntimeRunResult one = run(Design::Ffr, server_bound, 1);
+    EXPECT_NEAR(one.summary.fps_mean, 1000.0 / slots(60.0 + 5.0), 1e-6);
+    const RuntimeRunResult two = run(Design::Ffr, server_bound, 2, 120);
+    // After the first frames (the server starts with both requests queued), every scan-out
+    // follows the server by its 60 ms (each rounded up to a vsync slot, which the mean over n
+    // intervals sees as at most one slot / n).
+    const double intervals = double(two.frames.size() - 21);
+    const double span = two.frames.back().display_ms - two.frames[20].display_ms;
+    EXPECT_NEAR(span / intervals, 60.0, kSlotMs / intervals);
+    for (size_t k = 21; k < two.frames.size(); ++k)
+        EXPECT_NEAR(two.frames[k].remote_done_ms - two.frames[k - 1].remote_done_ms, 60.0, 1e-6);
+    EXPECT_EQ(two.summary.frames_reused, 0);
+
+    // Headset-bound (two 40 ms passes + 5 ms UCA = 85 ms against the server's 60 ms): the
+    // headset's own time, rounded to its vsync slot, sets the pace; depth 1 pays both in turn.
+    const RuntimeCosts headset_bound = flatCosts(40.0, 5.0, 15.0);
+    const RuntimeRunResult hb2 = run(Design::Ffr, headset_bound, 2);
+    EXPECT_NEAR(hb2.summary.fps_mean, 1000.0 / slots(85.0), 1e-6);
+    const RuntimeRunResult hb1 = run(Design::Ffr, headset_bound, 1);
+    EXPECT_NEAR(hb1.summary.fps_mean, 1000.0 / slots(85.0), 1e-6);
+    EXPECT_NEAR(hb1.summary.headset_busy_ms_mean, 85.0, 1e-6);
+}
+
+TEST(RuntimeModel, AFrameLaterThanTheWaitLimitIsReused) {
+    // One frame in flight, server 2 × 120 ms = 240 ms: in time for a 250 ms limit...
+    const RuntimeRunResult in_time = run(Design::Remote, flatCosts(0.0, 1.0, 120.0), 1, 30);
+    EXPECT_EQ(in_time.summary.frames_reused, 0);
+    // ...and every frame late for a 230 ms one: each is shown 230 ms after its request.
+    const RuntimeRunResult late =
+        run(Design::Remote, flatCosts(0.0, 1.0, 120.0), 1, 30, /*wait_limit_ms=*/230.0);
+    EXPECT_EQ(late.summary.frames_reused, 30);
+    EXPECT_NEAR(late.frames[0].uca_start_ms - late.frames[0].request_ms, 230.0, 1e-6);
+}
+
+TEST(RuntimeModel, TheServersQueueKeepsTheNewestRequests) {
+    // A server far slower than the wait limit with two frames in flight: the headset moves on
+    // with reused frames and its requests pile up; the queue (2) drops the oldest.
+    const RuntimeRunResult r = run(Design::Remote, flatCosts(0.0, 1.0, 400.0), 2, 40);
+    EXPECT_GT(r.summary.requests_dropped, 0);
+    int served = 0;
+    for (const RuntimeFrame& f : r.frames)
+        served += f.served ? 1 : 0;
+    EXPECT_EQ(served + r.summary.requests_dropped, 40 - 2 /* still queued at the end */);
+    EXPECT_GT(r.summary.frames_reused, 0);
+}
+
+TEST(RuntimeModel, CostsScaleWithPixelsAndTriangles) {
+    // The same design with a per-pixel fovea cost: a larger fixed fovea costs more.
+    RuntimeCosts c = flatCosts(1.0, 1.0, 1.0);
+    c.fovea.ms_per_mpx = 100.0;
+    const WorkloadTrace trace = flatTrace(20);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Ffr;
+    cfg.costs = c;
+    cfg.frames = 20;
+    NoisyLink link = fastLink();
+    cfg.fixed_e1_deg = 5.0;
+    const RuntimeRunResult small = simulateRuntime(trace, cfg, link);
+    cfg.fixed_e1_deg = 20.0;
+    const RuntimeRunResult large = simulateRuntime(trace, cfg, link);
+    EXPECT_NEAR(small.summary.e1_deg_mean, 5.0, 1e-9);
+    EXPECT_NEAR(large.summary.e1_deg_mean, 20.0, 1e-9);
+    // Closed form: two passes of 1 ms + 100 ms per Mpx of the plan's fovea.
+    const LayerPlanner planner(trace.header.profile);
+    for (const RuntimeRunResult* r : {&small, &large}) {
+        const LayerPlan plan = planner.plan(trace.frames[0].gaze, r->summary.e1_deg_mean);
+        const double px = double(plan.eyes[0].fovea.pixels() + plan.eyes[1].fovea.pixels());
+        EXPECT_NEAR(r->frames[0].t_local_ms, 2.0 + 100.0 * px * 1e-6, 1e-9);
+    }
+    EXPECT_GT(large.summary.t_local_ms_mean, small.summary.t_local_ms_mean);
+}
+
+TEST(RuntimeModel, DesignNames) {
+    EXPECT_EQ(*runtimeDesignByName("qvr"), Design::Qvr);
+    EXPECT_EQ(*runtimeDesignByName("local"), Design::Local);
+    EXPECT_FALSE(runtimeDesignByName("dfr").ok());
+    EXPECT_FALSE(runtimeDesignByName("").ok());
+}
+
+}  // namespace
+}  // namespace qvr
