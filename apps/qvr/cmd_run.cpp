@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "calibration.h"
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/frame_header.h"
@@ -34,7 +35,9 @@
 #include "qvr/runtime/server_process.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
+#include "qvr/sim/hardware.h"
 #include "qvr/sim/network.h"
+#include "qvr/sim/runtime_model.h"
 #include "qvr/sim/simulator.h"
 #include "qvr/workload/trace_io.h"
 
@@ -63,6 +66,8 @@ struct RunOptions {
     bool one_pass_periphery = false;
     int pipeline_depth = 2;
     float lod_px = 1.0f;
+    std::string hardware;      // a calibration (qvr calibrate --out); none: cached or measured
+    bool recalibrate = false;  // measure even when a cached calibration exists
     std::string command_line;
 };
 
@@ -298,6 +303,174 @@ std::string limitsHtml(const std::vector<DesignRun>& runs) {
     return html;
 }
 
+// The calibration the prediction uses: the file given, this machine's cached one, or a fresh
+// measurement (written to the cache). Always measured before the run: no constant is fitted to
+// the run it predicts.
+struct CalibrationChoice {
+    HardwareConfig hardware;
+    std::string source;  // "file", "cached" or "measured"
+    std::string path;
+    double seconds = 0.0;
+    std::string note;  // one sentence for the console and the report
+};
+
+Expected<CalibrationChoice> chooseCalibration(const RunOptions& o) {
+    CalibrationChoice c;
+    if (!o.hardware.empty()) {
+        auto hw = loadHardwareConfig(o.hardware, 500.0);
+        if (!hw)
+            return makeError("--hardware: " + hw.error());
+        if (!hw->runtime_pipeline)
+            return makeError("--hardware: " + o.hardware +
+                             " is not a calibration (no [runtime] pipeline = \"runtime\"; "
+                             "qvr calibrate --out FILE writes one)");
+        c.hardware = *hw;
+        c.source = "file";
+        c.path = o.hardware;
+        c.note = "calibration from " + o.hardware;
+        return c;
+    }
+    CalibrateOptions co;
+    co.scene = "builtin:room";
+    co.profile = o.profile;
+    co.codec = o.codec;
+    co.lod_px = o.lod_px;
+    co.core = 0;
+    co.verbose = false;
+    const std::string cache = calibrationCachePath(co);
+    if (!o.recalibrate && fs::exists(cache)) {
+        auto hw = loadHardwareConfig(cache, 500.0);
+        if (hw) {
+            c.hardware = *hw;
+            c.source = "cached";
+            c.path = cache;
+            c.note = "this machine's cached calibration " + cache +
+                     " (qvr run --recalibrate to measure again)";
+            return c;
+        }
+        std::fprintf(stderr, "qvr run: ignoring the cached calibration: %s\n", hw.error().c_str());
+    }
+    // In its own thread pinned to the headset's core, so this thread's mask (inherited by the
+    // server process) stays whole.
+    Expected<Calibration> cal = makeError("not run");
+    std::thread t([&] { cal = runCalibration(co); });
+    t.join();
+    if (!cal)
+        return makeError("calibration: " + cal.error());
+    cal->command = "qvr run (calibrating first: qvr calibrate --scene builtin:room --profile " +
+                   o.profile + ")";
+    std::error_code ec;
+    fs::create_directories(fs::path(cache).parent_path(), ec);
+    if (std::ofstream f(cache); f)
+        f << cal->toToml();
+    auto hw = parseHardwareConfig(cal->toToml(), "calibration", 500.0);
+    if (!hw)
+        return makeError("calibration: " + hw.error());
+    c.hardware = *hw;
+    c.source = "measured";
+    c.path = cache;
+    c.seconds = cal->seconds;
+    c.note = fmt::format("calibrated now, before the run, in {:.1f} s (saved as {})", cal->seconds,
+                         cache);
+    return c;
+}
+
+// The runtime designs on the simulator's: fixed:E is FFR at E degrees.
+bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg) {
+    if (name.rfind("fixed:", 0) == 0) {
+        char* end = nullptr;
+        const double e = std::strtod(name.c_str() + 6, &end);
+        if (end == name.c_str() + 6 || *end != '\0' || !(e > 0))
+            return false;
+        design = Design::Ffr;
+        fixed_e1_deg = e;
+        return true;
+    }
+    auto d = qvr::runtimeDesignByName(name);
+    if (!d)
+        return false;
+    design = *d;
+    return true;
+}
+
+nlohmann::json predictionJson(double fps, double mtp, double mtp_p99, double bytes, double e1) {
+    return {{"fps_mean", fps},
+            {"mtp_ms_mean", mtp},
+            {"mtp_ms_p99", mtp_p99},
+            {"bytes_per_frame_mean", bytes},
+            {"e1_deg_mean", e1}};
+}
+
+// Signed error of the prediction, percent of the measurement (null where it is 0).
+nlohmann::json errorPctJson(const nlohmann::json& predicted, const nlohmann::json& measured) {
+    nlohmann::json e = nlohmann::json::object();
+    for (const char* k :
+         {"fps_mean", "mtp_ms_mean", "mtp_ms_p99", "bytes_per_frame_mean", "e1_deg_mean"}) {
+        const double m = measured.value(k, 0.0);
+        const double p = predicted.value(k, 0.0);
+        e[k] = m != 0.0 ? nlohmann::json(100.0 * (p - m) / std::fabs(m)) : nlohmann::json();
+    }
+    return e;
+}
+
+std::string fmtCell(const nlohmann::json& v, const char* fmt_spec) {
+    if (!v.is_number())
+        return "—";
+    return fmt::format(fmt::runtime(fmt_spec), v.get<double>());
+}
+
+// Measured against the calibrated runtime model and the paper-hardware model, per design.
+std::string validationHtml(const nlohmann::json& designs, const std::string& calibration_note,
+                           const std::string& sim_note) {
+    std::string h =
+        "<h2>Measured against the simulator</h2>\n<p>Prediction on this run's own recorded "
+        "workload (<code>workload.jsonl</code>). <b>calibrated</b>: the runtime pipeline model "
+        "(docs/MODEL.md §8) with this machine's costs, " +
+        htmlEscape(calibration_note) +
+        ". <b>paper hardware</b>: the paper's pipeline on its modelled mobile GPU and server "
+        "(the default of <code>qvr eval</code>), for reference, not this machine. Error = "
+        "(predicted − measured) / measured.</p>\n<table><tr><th>design</th><th>metric</th>"
+        "<th>measured</th><th>calibrated</th><th>error</th><th>paper hardware</th></tr>\n";
+    struct Metric {
+        const char* key;
+        const char* label;
+        const char* f;
+    };
+    const Metric metrics[] = {{"fps_mean", "FPS", "{:.1f}"},
+                              {"mtp_ms_mean", "MTP mean ms", "{:.1f}"},
+                              {"mtp_ms_p99", "MTP p99 ms", "{:.1f}"},
+                              {"bytes_per_frame_mean", "bytes/frame", "{:.0f}"},
+                              {"e1_deg_mean", "e1 mean °", "{:.1f}"}};
+    for (auto it = designs.begin(); it != designs.end(); ++it) {
+        const nlohmann::json& d = it.value();
+        if (!d.contains("predicted"))
+            continue;
+        bool first = true;
+        for (const Metric& m : metrics) {
+            const nlohmann::json& err = d["prediction_error_pct"][m.key];
+            std::string err_cell = fmtCell(err, "{:+.1f}%");
+            if (std::string(m.key) == "e1_deg_mean")
+                err_cell = fmtCell(d["prediction_error_abs"]["e1_deg_mean"], "{:+.1f}°");
+            const nlohmann::json paper =
+                d.contains("predicted_paper_hardware")
+                    ? d["predicted_paper_hardware"].value(m.key, nlohmann::json())
+                    : nlohmann::json();
+            h += fmt::format(
+                "<tr>{}<td style='text-align:left'>{}</td><td>{}</td><td>{}</td><td>{}</td>"
+                "<td>{}</td></tr>\n",
+                first ? fmt::format("<td rowspan='5'>{}</td>", htmlEscape(it.key())) : "", m.label,
+                fmtCell(d.value(m.key, nlohmann::json()), m.f),
+                fmtCell(d["predicted"].value(m.key, nlohmann::json()), m.f), err_cell,
+                fmtCell(paper, m.f));
+            first = false;
+        }
+    }
+    h += "</table>\n";
+    if (!sim_note.empty())
+        h += "<p>" + htmlEscape(sim_note) + "</p>\n";
+    return h;
+}
+
 int runRun(const RunOptions& o) {
     auto designs = parseDesignList(o.designs);
     if (!designs) {
@@ -333,6 +506,12 @@ int runRun(const RunOptions& o) {
         std::fprintf(stderr, "qvr run: %s\n", inputs.error().c_str());
         return 2;
     }
+    auto calibration = chooseCalibration(o);
+    if (!calibration) {
+        std::fprintf(stderr, "qvr run: %s\n", calibration.error().c_str());
+        return 2;
+    }
+    fmt::print("qvr run: prediction uses {}\n", calibration->note);
     const std::shared_ptr<const Scene>& scene = inputs->scene;
     const std::shared_ptr<const TriangleBvh>& bvh = inputs->bvh;
     const HeadsetTraces& traces = inputs->traces;
@@ -465,37 +644,74 @@ int runRun(const RunOptions& o) {
     const double run_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
-    // What the simulator predicts for the recorded workload.
+    // What the simulators predict for the recorded workload: the runtime model with this
+    // machine's calibration, and the paper's model on its modelled hardware.
+    nlohmann::json predicted = nlohmann::json::object();        // design → runtime model
+    nlohmann::json predicted_paper = nlohmann::json::object();  // design → paper model
     nlohmann::json sim_json = nlohmann::json::object();
     std::string sim_note;
     if (recorded_workload) {
         auto trace = loadWorkloadTrace(workload_path.string());
+        double delay_ms = 0.0;
+        auto rt_link_check = makeRuntimeLink(o.net, &delay_ms);
         const std::string net_name = o.net.substr(0, o.net.find(','));
         auto spec = networkSpecByName(net_name);
         if (!spec) {
-            sim_note =
-                fmt::format("--net '{}' has no simulator profile; predicted on wifi", net_name);
+            sim_note = fmt::format(
+                "--net '{}' has no paper-model profile; the paper-hardware column uses wifi",
+                net_name);
             spec = networkSpecByName("wifi");
         }
-        if (trace && spec && !trace->frames.empty()) {
-            for (Design sd : {Design::Qvr, Design::Local, Design::Remote}) {
-                auto sim_link = makeLink(*spec, o.seed);
-                if (!sim_link)
-                    break;
-                SimConfig cfg;
-                cfg.bench = "qvr-run";
-                cfg.design = sd;
-                cfg.frames = static_cast<int>(trace->frames.size());
-                const RunResult r = simulate(*trace, cfg, **sim_link);
-                sim_json[std::string(traitsOf(sd).name)] = {
-                    {"fps_mean", r.summary.fps_mean},
-                    {"mtp_ms_mean", r.summary.mtp_ms_mean},
-                    {"bytes_per_frame_mean", r.summary.bytes_per_frame_mean},
-                    {"e1_deg_mean", r.summary.e1_deg_mean}};
+        if (!rt_link_check)
+            sim_note += (sim_note.empty() ? "" : "; ") +
+                        ("no calibrated prediction: " + rt_link_check.error());
+        if (trace && !trace->frames.empty()) {
+            for (const DesignRun& r : runs) {
+                const std::string name = designName(r.design);
+                Design sd = Design::Qvr;
+                double fixed_e1 = 5.0;
+                if (!simDesignOf(name, sd, fixed_e1))
+                    continue;
+                if (rt_link_check) {
+                    auto rt_link = makeRuntimeLink(o.net, &delay_ms);
+                    RuntimeSimConfig rc;
+                    rc.design = sd;
+                    rc.fixed_e1_deg = fixed_e1;
+                    rc.costs = calibration->hardware.runtime;
+                    rc.costs.link_delay_ms += delay_ms;
+                    rc.pipeline_depth = o.pipeline_depth;
+                    rc.wait_limit_ms = o.remote_timeout_ms;
+                    rc.frames = static_cast<int>(trace->frames.size());
+                    const RuntimeSummary ps = simulateRuntime(*trace, rc, **rt_link).summary;
+                    predicted[name] = predictionJson(ps.fps_mean, ps.mtp_ms_mean, ps.mtp_ms_p99,
+                                                     ps.bytes_per_frame_mean, ps.e1_deg_mean);
+                    predicted[name]["headset_busy_ms_mean"] = ps.headset_busy_ms_mean;
+                    predicted[name]["server_busy_ms_mean"] = ps.server_busy_ms_mean;
+                    predicted[name]["t_remote_ms_mean"] = ps.t_remote_ms_mean;
+                    predicted[name]["frames_reused"] = ps.frames_reused;
+                }
+                if (spec) {
+                    auto sim_link = makeLink(*spec, o.seed);
+                    if (!sim_link)
+                        continue;
+                    SimConfig cfg;
+                    cfg.bench = "qvr-run";
+                    cfg.design = sd;
+                    cfg.frames = static_cast<int>(trace->frames.size());
+                    const RunResult pr = simulate(*trace, cfg, **sim_link);
+                    predicted_paper[name] = predictionJson(
+                        pr.summary.fps_mean, pr.summary.mtp_ms_mean, pr.summary.mtp_ms_p99,
+                        pr.summary.bytes_per_frame_mean, pr.summary.e1_deg_mean);
+                    sim_json[name] = predicted_paper[name];
+                }
             }
         } else if (!trace) {
             sim_note = "workload trace unreadable: " + trace.error();
         }
+    } else {
+        sim_note =
+            "no prediction: the workload is recorded during the qvr design's run, and "
+            "--designs has no qvr";
     }
 
     // summary.json
@@ -524,7 +740,17 @@ int runRun(const RunOptions& o) {
     const DesignSummary* remote = nullptr;
     const DesignSummary* qvr = nullptr;
     for (const DesignRun& r : runs) {
-        dj[designName(r.design)] = summaryJson(r.result.summary, r.result.stats);
+        const std::string name = designName(r.design);
+        dj[name] = summaryJson(r.result.summary, r.result.stats);
+        if (predicted.contains(name)) {
+            dj[name]["predicted"] = predicted[name];
+            dj[name]["prediction_error_pct"] = errorPctJson(predicted[name], dj[name]);
+            dj[name]["prediction_error_abs"] = {
+                {"e1_deg_mean",
+                 predicted[name].value("e1_deg_mean", 0.0) - dj[name].value("e1_deg_mean", 0.0)}};
+        }
+        if (predicted_paper.contains(name))
+            dj[name]["predicted_paper_hardware"] = predicted_paper[name];
         if (r.design == RuntimeDesign::kLocal)
             local = &r.result.summary;
         if (r.design == RuntimeDesign::kRemote)
@@ -551,7 +777,12 @@ int runRun(const RunOptions& o) {
             1.0 - sim_json["qvr"]["bytes_per_frame_mean"].get<double>() /
                       sim_json["remote"]["bytes_per_frame_mean"].get<double>();
     j["ratios"] = ratios;
-    j["sim_prediction"] = sim_json;
+    j["sim_prediction"] = sim_json;  // the paper-hardware model, as before
+    j["calibration"] = {{"source", calibration->source},
+                        {"path", calibration->path},
+                        {"seconds", calibration->seconds},
+                        {"note", calibration->note},
+                        {"pipeline_depth", o.pipeline_depth}};
     if (!sim_note.empty())
         j["sim_note"] = sim_note;
     // The server's own counters (all designs together), as its process wrote them on exit.
@@ -654,14 +885,8 @@ int runRun(const RunOptions& o) {
     }
     html += "</table>\n";
     html += limitsHtml(runs);
-    html += "<h2>Against the paper and the simulator</h2>\n<pre>" +
-            htmlEscape(j["ratios"].dump(2)) + "\n" + htmlEscape(sim_json.dump(2)) + "</pre>\n";
-    if (!sim_note.empty())
-        html += "<p>" + htmlEscape(sim_note) + "</p>\n";
-    html +=
-        "<p>The simulator replays <code>workload.jsonl</code> (recorded during the qvr run) on "
-        "its modelled mobile GPU and link (docs/MODEL.md), not on llvmpipe: the gap to the "
-        "measured FPS is the gap between that model and this machine.</p>\n";
+    html += validationHtml(dj, calibration->note, sim_note);
+    html += "<h2>Against the paper</h2>\n<pre>" + htmlEscape(j["ratios"].dump(2)) + "</pre>\n";
     for (const std::string& f : figures)
         html += "<h3>" + f + "</h3><img src='" + f + ".png' width='1000'>\n";
     if (!have_gnuplot)
@@ -674,8 +899,21 @@ int runRun(const RunOptions& o) {
     std::ofstream(out / "report.html") << html;
 
     fmt::print("  ratios: {}\n", ratios.dump());
-    if (!sim_json.empty())
-        fmt::print("  sim prediction: {}\n", sim_json.dump());
+    if (!predicted.empty()) {
+        fmt::print("  calibrated prediction ({}): error of FPS, MTP mean, bytes/frame; e1\n",
+                   calibration->source);
+        for (auto it = dj.begin(); it != dj.end(); ++it) {
+            if (!it.value().contains("prediction_error_pct"))
+                continue;
+            const nlohmann::json& e = it.value()["prediction_error_pct"];
+            fmt::print("    {:8} fps {:>8}  mtp {:>8}  bytes {:>8}  e1 {:>7}\n", it.key(),
+                       fmtCell(e["fps_mean"], "{:+.1f}%"), fmtCell(e["mtp_ms_mean"], "{:+.1f}%"),
+                       fmtCell(e["bytes_per_frame_mean"], "{:+.1f}%"),
+                       fmtCell(it.value()["prediction_error_abs"]["e1_deg_mean"], "{:+.1f}°"));
+        }
+    }
+    if (!sim_note.empty())
+        fmt::print("  {}\n", sim_note);
     fmt::print(
         "  {}\n  wrote {}/summary.json, telemetry.csv, frames_*.csv, report.html in {:.0f} s\n",
         video_note, o.out, run_s);
@@ -721,6 +959,11 @@ static Registered registerRun(CLI::App& app) {
                     "finishing n)")
         ->check(CLI::Range(1, 2))
         ->capture_default_str();
+    cmd->add_option("--hardware", o->hardware,
+                    "Calibration for the prediction (qvr calibrate --out FILE); without it the "
+                    "cached calibration of this machine, or a fresh one measured first");
+    cmd->add_flag("--recalibrate", o->recalibrate,
+                  "Measure the calibration again even when a cached one exists");
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
     cmd->add_flag("!--no-fovea-border", o->fovea_border,
                   "Do not draw the e1 circle (the fovea layer's edge) in the video");

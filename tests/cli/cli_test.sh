@@ -218,5 +218,33 @@ expect_error "control --bench nope" control --bench nope --frames 5
 expect_error "control --net dialup" control --net dialup --frames 5
 expect_error "control --trace and --bench together" control --trace "$tmp/empty.jsonl" --bench synthetic-grid
 
+
+# The runtime pipeline model (qvr sim --pipeline runtime) on the hand-written trace, and the
+# calibration file grammar.
+if run_ok "sim --pipeline runtime runs" sim --trace "$tmp/good.jsonl" --pipeline runtime --design qvr --out "$tmp/simrt"; then
+    python3 - "$tmp/simrt/summary.json" <<'PY' && pass "sim --pipeline runtime writes its summary" || fail "sim --pipeline runtime writes its summary"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["pipeline"] == "runtime" and d["frames"] == 12, d
+assert d["fps_mean"] > 0 and d["mtp_ms_mean"] > 0 and d["bytes_per_frame_mean"] > 0, d
+PY
+fi
+printf '[runtime]\npipeline = "runtime"\nfovea_base_ms = 1\n' >"$tmp/rt.toml"
+run_ok "sim --hardware <runtime pipeline file> selects the runtime model" sim --trace "$tmp/good.jsonl" --hardware "$tmp/rt.toml" --design ffr --out "$tmp/simrt2" &&
+    grep -q '"pipeline": "runtime"' "$tmp/simrt2/summary.json" && pass "the hardware file chose the runtime model"
+printf '[runtime]\npipeline = "fast"\n' >"$tmp/rt_bad.toml"
+printf '[runtime]\nfovea_base_ms = -3\n' >"$tmp/rt_neg.toml"
+expect_error "sim --hardware <bad runtime.pipeline>" sim --trace "$tmp/good.jsonl" --hardware "$tmp/rt_bad.toml" --out "$tmp/x"
+expect_error "sim --hardware <negative runtime cost>" sim --trace "$tmp/good.jsonl" --hardware "$tmp/rt_neg.toml" --out "$tmp/x"
+expect_error "sim --pipeline bogus" sim --trace "$tmp/good.jsonl" --pipeline bogus --out "$tmp/x"
+expect_error "sim --pipeline runtime --depth 3" sim --trace "$tmp/good.jsonl" --pipeline runtime --depth 3 --out "$tmp/x"
+expect_error "sim --pipeline runtime --net dialup" sim --trace "$tmp/good.jsonl" --pipeline runtime --net dialup --out "$tmp/x"
+expect_error "sim --pipeline runtime --design static" sim --trace "$tmp/good.jsonl" --pipeline runtime --design static --out "$tmp/x"
+expect_error "calibrate without --out" calibrate
+expect_error "calibrate --profile /nonexistent.toml" calibrate --profile /nonexistent.toml --out "$tmp/cal.toml"
+expect_error "calibrate --codec bogus" calibrate --codec bogus --out "$tmp/cal.toml"
+expect_error "run --hardware /nonexistent" run --hardware /nonexistent.toml --frames 2 --out "$tmp/run"
+expect_error "run --hardware <bad runtime.pipeline>" run --hardware "$tmp/rt_bad.toml" --frames 2 --out "$tmp/run"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
