@@ -4,6 +4,7 @@
 // Shared by `qvr calibrate` and `qvr run` (which calibrates first when given no file).
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -30,8 +31,9 @@ struct CalibratedPart {
     std::string what;  // what one sample is
     int samples = 0;
     LinearCost cost;
-    double median_ms = 0.0, min_ms = 0.0, max_ms = 0.0;  // of the samples
-    double residual_rms_pct = 0.0;                       // RMS of (measured − fit) / measured
+    double median_ms = 0.0, min_ms = 0.0, max_ms = 0.0;    // of the samples
+    double residual_rms_pct = 0.0;                         // RMS of (measured − fit) / measured
+    std::vector<std::array<double, 3>> samples_ms_px_tri;  // every sample, in the JSON
 };
 
 struct Calibration {
@@ -42,6 +44,7 @@ struct Calibration {
     std::string command;
     double seconds = 0.0;
     double load_avg_before = 0.0;
+    int bits_samples = 0;  // P-frames the bits-per-pixel law was fitted on
     nlohmann::json links;  // the emulator's profiles
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included

@@ -132,6 +132,8 @@ CalibratedPart summarise(const std::string& name, const std::string& what,
     p.min_ms = ms.front();
     p.max_ms = ms.back();
     p.residual_rms_pct = 100.0 * std::sqrt(sq / double(s.size()));
+    for (const Sample& x : s)
+        p.samples_ms_px_tri.push_back({x.ms, x.pixels, x.triangles});
     return p;
 }
 
@@ -195,7 +197,8 @@ nlohmann::json Calibration::toJson() const {
                               {"median_ms", p.median_ms},
                               {"min_ms", p.min_ms},
                               {"max_ms", p.max_ms},
-                              {"residual_rms_pct", p.residual_rms_pct}});
+                              {"residual_rms_pct", p.residual_rms_pct},
+                              {"samples_ms_px_tri", p.samples_ms_px_tri}});
     return {{"machine", machine},
             {"date", date},
             {"command", command},
@@ -204,6 +207,9 @@ nlohmann::json Calibration::toJson() const {
             {"parts", parts_json},
             {"links", links},
             {"frame_overhead_ms", costs.frame_overhead_ms},
+            {"bits_per_px_at_1", costs.bits_per_px_at_1},
+            {"bits_scale_exponent", costs.bits_scale_exponent},
+            {"bits_samples", bits_samples},
             {"packet_payload_bytes", costs.packet_payload_bytes},
             {"packet_overhead_bytes", costs.packet_overhead_bytes}};
 }
@@ -219,6 +225,8 @@ std::string Calibration::toToml() const {
             "# {:14} {:3} samples ({}): median {:.2f} ms [{:.2f}, {:.2f}], fit residual "
             "{:.0f}% RMS\n",
             p.name, p.samples, p.what, p.median_ms, p.min_ms, p.max_ms, p.residual_rms_pct);
+    s += fmt::format("# bits per layer pixel {:.4f}·s^{:.3f} over {} P-frames\n",
+                     costs.bits_per_px_at_1, costs.bits_scale_exponent, bits_samples);
     return s + runtimeCostsToml(costs);
 }
 
@@ -330,84 +338,123 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         int frames = 0;
     };
     std::array<Chain, 4> chains;  // stream ids: eye × {middle, outer}
+    struct BitsSample {
+        double log_scale, log_bits_per_px;
+    };
+    std::vector<BitsSample> bits;
+    // Warm-up: llvmpipe compiles its shaders on first use.
+    {
+        const LayerPlan plan = planner.plan(poses[0].gaze, 10.0);
+        for (LayerKind kind : {LayerKind::kFovea, LayerKind::kMiddle, LayerKind::kOuter})
+            if (auto st = renderLayer(r, *profile, plan, poses[0].head, Eye::kLeft, kind, image);
+                !st)
+                return makeError("render: " + st.error());
+    }
+    // Consecutive frames (1/refresh apart, as a run's content advances) so the codec sees the
+    // motion of a run: the first of each short sequence follows a jump and is not sampled.
+    const int sequence = 3;
+    const double frame_ms = 1000.0 / profile->refresh_hz;
     for (size_t pi = 0; pi < poses.size(); ++pi) {
-        const PoseSample& p = poses[pi];
+        const PoseSample& p0 = poses[pi];
         for (double e1 : e1s) {
-            const LayerPlan plan = planner.plan(p.gaze, e1);
-            const double fovea_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e1_deg);
-            const double mid_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e2_deg);
-            const double all_tris = sumTotal(p.wf.triangles_per_ring);
-            auto frame = std::make_shared<LayerFrame>();
-            frame->plan = plan;
-            frame->render_pose = p.head;
-            for (int eye = 0; eye < 2; ++eye) {
-                const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
-                EyeLayerImages& imgs = frame->eyes[static_cast<size_t>(eye)];
-                if (!layers.fovea.empty()) {
-                    const auto t0 = Clock::now();
-                    auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
-                                          LayerKind::kFovea, imgs.fovea);
-                    if (!st)
-                        return makeError("fovea render: " + st.error());
-                    fovea.push_back({msSince(t0), double(layers.fovea.pixels()), fovea_tris / 2});
-                }
-                for (int li = 0; li < 2; ++li) {
-                    const bool middle = li == 0;
-                    const LayerRect& rect = middle ? layers.middle : layers.outer;
-                    if (rect.empty())
-                        continue;
-                    ImageRgba8& img = middle ? imgs.middle : imgs.outer;
-                    const auto t0 = Clock::now();
-                    auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
-                                          middle ? LayerKind::kMiddle : LayerKind::kOuter, img);
-                    if (!st)
-                        return makeError("layer render: " + st.error());
-                    server.push_back(
-                        {msSince(t0), double(rect.pixels()), (middle ? mid_tris : all_tris) / 2});
-                    Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
-                    if (!ch.enc) {
-                        auto e = makeVideoEncoder(codec);
-                        auto d = makeVideoDecoder(codec);
-                        if (!e || !d)
-                            return makeError("codec: " + (e ? d.error() : e.error()));
-                        ch.enc = std::move(*e);
-                        ch.dec = std::move(*d);
+            for (int step = 0; step < sequence; ++step) {
+                const double t_ms = 250.0 + 700.0 * double(pi) + frame_ms * step;
+                PoseSample p = p0;
+                p.head = poseAt(inputs->traces.motion, t_ms);
+                p.gaze = gazeAt(inputs->traces.gaze, t_ms);
+                const bool sampled = step > 0;
+                const LayerPlan plan = planner.plan(p.gaze, e1);
+                const double fovea_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e1_deg);
+                const double mid_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e2_deg);
+                const double all_tris = sumTotal(p.wf.triangles_per_ring);
+                auto frame = std::make_shared<LayerFrame>();
+                frame->plan = plan;
+                frame->render_pose = p.head;
+                double layer_px = 0.0;
+                for (int eye = 0; eye < 2; ++eye) {
+                    const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+                    EyeLayerImages& imgs = frame->eyes[static_cast<size_t>(eye)];
+                    layer_px += double(layers.fovea.pixels() + layers.middle.pixels() +
+                                       layers.outer.pixels());
+                    if (!layers.fovea.empty()) {
+                        const auto t0 = Clock::now();
+                        auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
+                                              LayerKind::kFovea, imgs.fovea);
+                        if (!st)
+                            return makeError("fovea render: " + st.error());
+                        if (step == 0)
+                            fovea.push_back(
+                                {msSince(t0), double(layers.fovea.pixels()), fovea_tris / 2});
                     }
-                    auto enc = ch.enc->encode(img);
-                    if (!enc)
-                        return makeError("encode: " + enc.error());
-                    const auto t1 = Clock::now();
-                    auto dec = ch.dec->decode(enc->bytes);
-                    const double dec_ms = msSince(t1);
-                    if (!dec)
-                        return makeError("decode: " + dec.error());
-                    // Key frames are the exception in a run (one every 120 frames): P-frames only.
-                    if (!enc->is_keyframe) {
-                        encode.push_back({enc->encode_ms, double(rect.pixels()), 0});
-                        decode.push_back({dec_ms, double(rect.pixels()), 0});
+                    for (int li = 0; li < 2; ++li) {
+                        const bool middle = li == 0;
+                        const LayerRect& rect = middle ? layers.middle : layers.outer;
+                        if (rect.empty())
+                            continue;
+                        ImageRgba8& img = middle ? imgs.middle : imgs.outer;
+                        const auto t0 = Clock::now();
+                        auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
+                                              middle ? LayerKind::kMiddle : LayerKind::kOuter, img);
+                        if (!st)
+                            return makeError("layer render: " + st.error());
+                        server.push_back({msSince(t0), double(rect.pixels()),
+                                          (middle ? mid_tris : all_tris) / 2});
+                        Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
+                        if (!ch.enc) {
+                            auto e = makeVideoEncoder(codec);
+                            auto d = makeVideoDecoder(codec);
+                            if (!e || !d)
+                                return makeError("codec: " + (e ? d.error() : e.error()));
+                            ch.enc = std::move(*e);
+                            ch.dec = std::move(*d);
+                        }
+                        auto enc = ch.enc->encode(img);
+                        if (!enc)
+                            return makeError("encode: " + enc.error());
+                        const auto t1 = Clock::now();
+                        auto dec = ch.dec->decode(enc->bytes);
+                        const double dec_ms = msSince(t1);
+                        if (!dec)
+                            return makeError("decode: " + dec.error());
+                        // Key frames are the exception in a run (one every 120 frames): P-frames
+                        // only.
+                        if (sampled && !enc->is_keyframe) {
+                            encode.push_back({enc->encode_ms, double(rect.pixels()), 0});
+                            decode.push_back({dec_ms, double(rect.pixels()), 0});
+                            if (!enc->bytes.empty())
+                                bits.push_back({std::log(std::max(rect.scale, 1.0)),
+                                                std::log(8.0 * double(enc->bytes.size()) /
+                                                         double(rect.pixels()))});
+                        }
                     }
                 }
+                // UCA over the frame just rendered.
+                const auto t0 = Clock::now();
+                auto rep = compositor.present(frame, p.head, display);
+                const double uca_ms = msSince(t0);
+                if (!rep)
+                    return makeError("UCA: " + rep.error());
+                if (sampled)
+                    uca.push_back({uca_ms, layer_px, 0});
             }
-            // UCA over the frame just rendered, with a slightly moved pose.
-            const auto t0 = Clock::now();
-            auto rep = compositor.present(frame, p.head, display);
-            const double uca_ms = msSince(t0);
-            if (!rep)
-                return makeError("UCA: " + rep.error());
-            uca.push_back({uca_ms, 2.0 * eye_px, 0});
         }
         log(fmt::format("  pose {}/{}: fovea, periphery layers, codec, UCA\n", pi + 1,
                         poses.size()));
     }
-    // The full frame: local's render and remote's server layer (1 or 2 poses: ~0.2 s a view).
+    // The full frame: local's render and remote's server layer (1 or 2 poses: ~0.2 s a view),
+    // and UCA over a full-resolution layer (local's fovea, remote's whole frame).
     for (size_t pi = 0; pi < (o.quick ? 1u : 2u); ++pi) {
         const PoseSample& p = poses[pi];
         const LayerPlan full = planner.plan(p.gaze, 180.0);
         const double all_tris = sumTotal(p.wf.triangles_per_ring);
+        auto frame = std::make_shared<LayerFrame>();
+        frame->plan = full;
+        frame->render_pose = p.head;
         for (int eye = 0; eye < 2; ++eye) {
+            ImageRgba8& img = frame->eyes[static_cast<size_t>(eye)].fovea;
             const auto t0 = Clock::now();
             auto st = renderLayer(r, *profile, full, p.head, static_cast<Eye>(eye),
-                                  LayerKind::kFovea, image);
+                                  LayerKind::kFovea, img);
             if (!st)
                 return makeError("full render: " + st.error());
             const double ms = msSince(t0);
@@ -415,30 +462,45 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             // The server's whole-frame layer is the same view at scale 1.
             server.push_back({ms, eye_px, all_tris / 2});
         }
+        for (int rep_i = 0; rep_i < 2; ++rep_i) {
+            const auto t0 = Clock::now();
+            auto rep = compositor.present(frame, p.head, display);
+            if (!rep)
+                return makeError("UCA: " + rep.error());
+            uca.push_back({msSince(t0), 2.0 * eye_px, 0});
+        }
         log(fmt::format("  full frame {}/{}\n", pi + 1, o.quick ? 1 : 2));
+    }
+    // Bits per pixel: log-linear least squares, b·s^γ.
+    if (bits.size() >= 2) {
+        double sx = 0, sy = 0, sxx = 0, sxy = 0;
+        for (const BitsSample& b : bits) {
+            sx += b.log_scale;
+            sy += b.log_bits_per_px;
+            sxx += b.log_scale * b.log_scale;
+            sxy += b.log_scale * b.log_bits_per_px;
+        }
+        const double n = double(bits.size());
+        const double den = n * sxx - sx * sx;
+        const double gamma = std::fabs(den) > 1e-12 ? (n * sxy - sx * sy) / den : 0.0;
+        cal.costs.bits_scale_exponent = std::clamp(gamma, -4.0, 4.0);
+        cal.costs.bits_per_px_at_1 =
+            std::clamp(std::exp((sy - cal.costs.bits_scale_exponent * sx) / n), 1e-6, 100.0);
+        cal.bits_samples = static_cast<int>(bits.size());
     }
     cal.costs.fovea = fit(fovea, true, true);
     cal.costs.server_render = fit(server, true, true);
     cal.costs.encode = fit(encode, true, false);
     cal.costs.decode = fit(decode, true, false);
     cal.costs.uca = fit(uca, true, false);
-    // UCA was timed at one display size only: all of it is per pixel.
-    if (!uca.empty()) {
-        double sum = 0.0;
-        std::vector<double> ms;
-        for (const Sample& s : uca)
-            ms.push_back(s.ms);
-        std::sort(ms.begin(), ms.end());
-        sum = ms[ms.size() / 2];
-        cal.costs.uca = {0.0, sum / (2.0 * eye_px * 1e-6), 0.0};
-    }
     cal.parts.push_back(
         summarise("fovea/local", "one eye's fovea or full-frame pass", fovea, cal.costs.fovea));
     cal.parts.push_back(summarise("server render", "one periphery or whole-frame layer", server,
                                   cal.costs.server_render));
     cal.parts.push_back(summarise("encode", "one layer, P-frame", encode, cal.costs.encode));
     cal.parts.push_back(summarise("decode", "one stream, P-frame", decode, cal.costs.decode));
-    cal.parts.push_back(summarise("uca", "one frame, both eyes", uca, cal.costs.uca));
+    cal.parts.push_back(
+        summarise("uca", "one frame, both eyes, per layer pixel read", uca, cal.costs.uca));
 
     // 4. The link: net's profiles and its packets' header.
     cal.costs.packet_payload_bytes = double(net::kMediaChunkBytes);

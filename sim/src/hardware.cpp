@@ -104,6 +104,9 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     cost("uca_base_ms", rc.uca.base_ms);
     cost("uca_ms_per_mpx", rc.uca.ms_per_mpx);
     cost("frame_overhead_ms", rc.frame_overhead_ms);
+    rc.bits_per_px_at_1 = r.number("runtime.bits_per_px_at_1", rc.bits_per_px_at_1, 0.0, 100.0);
+    rc.bits_scale_exponent =
+        r.number("runtime.bits_scale_exponent", rc.bits_scale_exponent, -4.0, 4.0);
     cost("server_render_base_ms", rc.server_render.base_ms);
     cost("server_render_ms_per_mpx", rc.server_render.ms_per_mpx);
     cost("server_render_ms_per_ktri", rc.server_render.ms_per_ktri);
@@ -144,6 +147,8 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("uca_base_ms", c.uca.base_ms);
     put("uca_ms_per_mpx", c.uca.ms_per_mpx);
     put("frame_overhead_ms", c.frame_overhead_ms);
+    put("bits_per_px_at_1", c.bits_per_px_at_1);
+    put("bits_scale_exponent", c.bits_scale_exponent);
     put("server_render_base_ms", c.server_render.base_ms);
     put("server_render_ms_per_mpx", c.server_render.ms_per_mpx);
     put("server_render_ms_per_ktri", c.server_render.ms_per_ktri);

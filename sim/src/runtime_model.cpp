@@ -187,6 +187,20 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         busy += ms;
     };
 
+    // Bits per layer pixel at scale s: the calibration's law when it has one, else the trace's.
+    auto bitsPerPx = [&](const WorkloadFrame& wf, double scale) {
+        if (c.bits_per_px_at_1 > 0.0)
+            return c.bits_per_px_at_1 * std::pow(std::max(scale, 1.0), c.bits_scale_exponent);
+        return bitsPerPixelAt(header, wf, scale);
+    };
+    // Pixels UCA reads (every layer of both eyes at its own resolution).
+    auto layerPixels = [](const LayerPlan& plan) {
+        double px = 0.0;
+        for (const EyeLayers& e : plan.eyes)
+            px += double(e.fovea.pixels() + e.middle.pixels() + e.outer.pixels());
+        return px;
+    };
+
     // Renders, encodes and sends frame j's layers from `start`.
     auto serve = [&](int64_t j, double start) {
         FrameState& fs = state[static_cast<size_t>(j)];
@@ -197,11 +211,13 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         const double total_tris = sumTotal(wf.triangles_per_ring);
         std::vector<LayerJob> jobs;
         if (whole_frame) {
-            const double bytes = bitsPerPixelAt(header, wf, 1.0) * eye_px / 8.0;
+            const double bytes = bitsPerPx(wf, 1.0) * eye_px / 8.0;
             for (int eye = 0; eye < 2; ++eye)
                 jobs.push_back({eye_px, total_tris / 2.0, bytes, true});
         } else {
-            const PeripheryBytes pb = peripheryBytes(header, wf, fs.plan);
+            const PeripheryBytes pb = {
+                2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1) / 8.0,
+                2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2) / 8.0};
             const double mid_tris =
                 sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e2_deg);
             for (int eye = 0; eye < 2; ++eye) {
@@ -362,7 +378,10 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         // 6. UCA with the newest pose; a late frame re-warps older layers.
         rf.reused = !have_current;
         rf.uca_start_ms = hs;
-        work(c.uca.at(2.0 * eye_px, 0.0) + c.frame_overhead_ms);
+        // What UCA reads: this frame's layers, or for a reused frame the older ones it re-warps
+        // (same plan shape).
+        const double uca_px = whole_frame ? 2.0 * eye_px : layerPixels(fs.plan);
+        work(c.uca.at(uca_px, 0.0) + c.frame_overhead_ms);
         rf.uca_end_ms = hs;
         rf.mtp_ms = rf.uca_end_ms - rf.pose_ms;
         // 7. Scan-out at the next free vsync slot.

@@ -101,8 +101,12 @@ struct RuntimeCosts {
     LinearCost decision{0.5, 0.0, 0.04};  // BVH ring counts to e1 + 6°: triangles counted
     LinearCost fovea{2.0, 50.0, 0.02};    // one eye's fovea (or full frame) render pass
     LinearCost decode{0.3, 4.0, 0.0};     // one stream, per decoded layer pixel
-    LinearCost uca{1.0, 1.3, 0.0};        // one frame, per display pixel (both eyes)
+    LinearCost uca{5.0, 1.3, 0.0};        // one frame: base + per layer pixel read (both eyes)
     double frame_overhead_ms = 0.5;       // per frame: pumps, telemetry, bookkeeping
+    // The codec's P-frame size on the calibration's scene: bits per layer pixel b·s^γ at scale
+    // s. 0: take bits per pixel from the workload trace instead.
+    double bits_per_px_at_1 = 0.0;
+    double bits_scale_exponent = 0.0;
     // Server, one core (render thread): per layer render and encode, and per request.
     LinearCost server_render{2.0, 60.0, 0.01};
     LinearCost encode{0.5, 12.0, 0.0};
@@ -150,7 +154,8 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //   [runtime] pipeline ("paper" or "runtime"); every cost in ms, 0…10000:
 //             decision_base_ms, decision_ms_per_ktri, fovea_base_ms, fovea_ms_per_mpx,
 //             fovea_ms_per_ktri, decode_base_ms, decode_ms_per_mpx, uca_base_ms, uca_ms_per_mpx,
-//             frame_overhead_ms, server_render_base_ms, server_render_ms_per_mpx,
+//             frame_overhead_ms, bits_per_px_at_1 (0…100), bits_scale_exponent (−4…4),
+//             server_render_base_ms, server_render_ms_per_mpx,
 //             server_render_ms_per_ktri, encode_base_ms, encode_ms_per_mpx, server_frame_ms,
 //             link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536)
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
