@@ -245,6 +245,17 @@ expect_error "calibrate --profile /nonexistent.toml" calibrate --profile /nonexi
 expect_error "calibrate --codec bogus" calibrate --codec bogus --out "$tmp/cal.toml"
 expect_error "run --hardware /nonexistent" run --hardware /nonexistent.toml --frames 2 --out "$tmp/run"
 expect_error "run --hardware <bad runtime.pipeline>" run --hardware "$tmp/rt_bad.toml" --frames 2 --out "$tmp/run"
+expect_error "validate --depths 3" validate --depths 3 --dry-run --out "$tmp/val"
+expect_error "validate --frames 2" validate --frames 2 --dry-run --out "$tmp/val"
+expect_error "validate --reps 0" validate --reps 0 --dry-run --out "$tmp/val"
+expect_error "validate --scenes ''" validate --scenes "" --dry-run --out "$tmp/val"
+if run_ok "validate --dry-run lists its commands" validate --dry-run --links wifi,lte --scenes builtin:room --depths 1,2 --out "$tmp/val"; then
+    if [ "$(grep -c ' run --scene' "$tmp/out.json")" -eq 4 ] && grep -q ' calibrate --scene' "$tmp/out.json"; then
+        pass "validate plans one calibration and 2 links x 2 depths runs"
+    else
+        fail "validate plans one calibration and 2 links x 2 depths runs" "$(head -c 600 "$tmp/out.json")"
+    fi
+fi
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

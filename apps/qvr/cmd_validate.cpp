@@ -1,0 +1,354 @@
+// `qvr validate`: the simulator's correlation sheet. Calibrates once per scene (qvr calibrate,
+// before and apart from every run), then runs `qvr run` for each condition — links × scenes ×
+// pipeline depths, every design, a few repetitions — each predicted with that calibration, and
+// prints one table of the signed prediction errors with their mean absolute and worst values.
+// docs/MODEL.md §8.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "calibration.h"
+#include "commands.h"
+#include "qvr/runtime/server_process.h"
+
+namespace qvr::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ValidateOptions {
+    std::string designs = "local,remote,ffr,sw,qvr";
+    std::string links;  // default: wifi,lte,5g and the ATT Mahimahi trace when found
+    std::string scenes = "builtin:room,openarena:oa_dm5";
+    std::string depths = "1,2";
+    int frames = 40;
+    int reps = 1;
+    std::string profile = "default";
+    std::string out = "qvr-validate";
+    bool dry_run = false;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+    std::vector<std::string> out;
+    size_t start = 0;
+    while (start <= s.size()) {
+        const size_t comma = s.find(',', start);
+        const std::string item =
+            s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        if (!item.empty())
+            out.push_back(item);
+        if (comma == std::string::npos)
+            break;
+        start = comma + 1;
+    }
+    return out;
+}
+
+// A Mahimahi trace of the shared data: searched upward from the working directory and the
+// executable's folder for shared/data/network or data/network.
+std::string findMahimahiTrace(const std::string& file) {
+    std::error_code ec;
+    std::vector<fs::path> starts = {fs::current_path(ec)};
+    if (auto exe = runtime::selfExecutable(); exe)
+        starts.push_back(fs::path(*exe).parent_path());
+    for (const fs::path& start : starts)
+        for (fs::path p = start; !p.empty(); p = p.parent_path()) {
+            for (const fs::path& c :
+                 {p / "shared" / "data" / "network" / file, p / "data" / "network" / file})
+                if (fs::exists(c, ec))
+                    return c.string();
+            if (p == p.parent_path())
+                break;
+        }
+    return {};
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s)
+        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+std::string safeName(const std::string& s) {
+    std::string out;
+    for (char c : s)
+        out += (std::isalnum(static_cast<unsigned char>(c)) || c == '-') ? c : '_';
+    return out.size() > 40 ? out.substr(out.size() - 40) : out;
+}
+
+int runCommand(const std::string& cmd) {
+    const int st = std::system(cmd.c_str());
+    if (st == -1)
+        return -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+}
+
+struct Row {
+    std::string scene, link, design;
+    int depth = 0;
+    std::vector<double> fps_err, mtp_err, bytes_err, e1_err_abs, fps_meas, fps_pred;
+};
+
+double mean(const std::vector<double>& v) {
+    if (v.empty())
+        return NAN;
+    double s = 0;
+    for (double x : v)
+        s += x;
+    return s / double(v.size());
+}
+
+double spread(const std::vector<double>& v) {  // max − min
+    if (v.size() < 2)
+        return 0.0;
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    return *hi - *lo;
+}
+
+std::string cell(double v, const char* f) {
+    return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : std::string("—");
+}
+
+int runValidate(const ValidateOptions& o) {
+    const auto exe = runtime::selfExecutable();
+    if (!exe) {
+        std::fprintf(stderr, "qvr validate: %s\n", exe.error().c_str());
+        return 1;
+    }
+    if (o.frames < 5 || o.frames > 100000) {
+        std::fprintf(stderr, "qvr validate: --frames must be within 5..100000\n");
+        return 2;
+    }
+    std::vector<std::string> links = splitList(o.links);
+    if (o.links.empty()) {
+        links = {"wifi", "lte", "5g"};
+        const std::string att = findMahimahiTrace("ATT-LTE-driving-2016.down");
+        if (!att.empty())
+            links.push_back("trace:" + att);
+        else
+            std::fprintf(stderr,
+                         "qvr validate: no ATT-LTE-driving-2016.down found (shared/data/network); "
+                         "validating without a Mahimahi trace\n");
+    }
+    const std::vector<std::string> scenes = splitList(o.scenes);
+    std::vector<int> depths;
+    for (const std::string& d : splitList(o.depths)) {
+        if (d != "1" && d != "2") {
+            std::fprintf(stderr, "qvr validate: --depths takes 1 and/or 2, got '%s'\n", d.c_str());
+            return 2;
+        }
+        depths.push_back(d == "1" ? 1 : 2);
+    }
+    if (links.empty() || scenes.empty() || depths.empty() || splitList(o.designs).empty()) {
+        std::fprintf(stderr, "qvr validate: empty --links, --scenes, --depths or --designs\n");
+        return 2;
+    }
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (ec) {
+        std::fprintf(stderr, "qvr validate: cannot create '%s': %s\n", o.out.c_str(),
+                     ec.message().c_str());
+        return 1;
+    }
+    const fs::path out(o.out);
+    const auto t0 = std::chrono::steady_clock::now();
+    const int conditions = int(links.size() * scenes.size() * depths.size());
+    fmt::print(
+        "qvr validate: {} conditions ({} links × {} scenes × {} depths) × {} repetition(s), "
+        "designs {}, {} frames each; {}\n",
+        conditions, links.size(), scenes.size(), depths.size(), o.reps, o.designs, o.frames,
+        machineDescriptionLine());
+
+    // 1. One calibration per scene, before any run.
+    std::map<std::string, std::string> calibration;
+    for (const std::string& scene : scenes) {
+        const std::string file = (out / ("calibration-" + safeName(scene) + ".toml")).string();
+        const std::string cmd = fmt::format(
+            "{} calibrate --scene {} --profile {} --out {} > {} 2>&1", shellQuote(*exe),
+            shellQuote(scene), shellQuote(o.profile), shellQuote(file), shellQuote(file + ".log"));
+        fmt::print("  calibrating on {} ...\n", scene);
+        std::fflush(stdout);
+        if (o.dry_run) {
+            fmt::print("    {}\n", cmd);
+        } else if (const int rc = runCommand(cmd); rc != 0) {
+            std::fprintf(stderr, "qvr validate: calibration on %s failed (exit %d), see %s.log\n",
+                         scene.c_str(), rc, file.c_str());
+            return rc == 2 ? 2 : 1;
+        }
+        calibration[scene] = file;
+    }
+
+    // 2. The runs.
+    std::map<std::string, Row> rows;  // key: scene|link|depth|design
+    std::vector<std::string> order;
+    int failures = 0;
+    for (int rep = 0; rep < o.reps; ++rep)
+        for (const std::string& scene : scenes)
+            for (const std::string& link : links)
+                for (int depth : depths) {
+                    const fs::path dir = out / fmt::format("{}_{}_d{}_r{}", safeName(scene),
+                                                           safeName(link), depth, rep + 1);
+                    const std::string cmd = fmt::format(
+                        "{} run --scene {} --net {} --pipeline {} --designs {} --frames {} "
+                        "--profile {} --hardware {} --no-video --out {} > {} 2>&1",
+                        shellQuote(*exe), shellQuote(scene), shellQuote(link), depth,
+                        shellQuote(o.designs), o.frames, shellQuote(o.profile),
+                        shellQuote(calibration[scene]), shellQuote(dir.string()),
+                        shellQuote((dir.string()) + ".log"));
+                    fmt::print("  {} | {} | depth {} | rep {} ...", scene, link, depth, rep + 1);
+                    std::fflush(stdout);
+                    if (o.dry_run) {
+                        fmt::print("\n    {}\n", cmd);
+                        continue;
+                    }
+                    const int rc = runCommand(cmd);
+                    nlohmann::json j;
+                    if (rc == 0) {
+                        std::ifstream f(dir / "summary.json");
+                        j = nlohmann::json::parse(f, nullptr, false);
+                    }
+                    if (rc != 0 || j.is_discarded() || !j.contains("designs")) {
+                        ++failures;
+                        fmt::print(" failed (exit {}), see {}.log\n", rc, dir.string());
+                        continue;
+                    }
+                    fmt::print(" done\n");
+                    for (auto it = j["designs"].begin(); it != j["designs"].end(); ++it) {
+                        const nlohmann::json& d = it.value();
+                        if (!d.contains("prediction_error_pct"))
+                            continue;
+                        const std::string key =
+                            fmt::format("{}|{}|{}|{}", scene, link, depth, it.key());
+                        if (!rows.count(key)) {
+                            order.push_back(key);
+                            rows[key] = Row{scene, link, it.key(), depth, {}, {}, {}, {}, {}, {}};
+                        }
+                        Row& r = rows[key];
+                        const nlohmann::json& e = d["prediction_error_pct"];
+                        auto num = [](const nlohmann::json& v) {
+                            return v.is_number() ? v.get<double>() : NAN;
+                        };
+                        r.fps_err.push_back(num(e["fps_mean"]));
+                        r.mtp_err.push_back(num(e["mtp_ms_mean"]));
+                        r.bytes_err.push_back(num(e["bytes_per_frame_mean"]));
+                        r.e1_err_abs.push_back(num(d["prediction_error_abs"]["e1_deg_mean"]));
+                        r.fps_meas.push_back(num(d["fps_mean"]));
+                        r.fps_pred.push_back(num(d["predicted"]["fps_mean"]));
+                    }
+                }
+    if (o.dry_run)
+        return 0;
+
+    // 3. The sheet.
+    std::string md = fmt::format(
+        "| scene | link | depth | design | FPS measured | FPS predicted | FPS error | MTP error | "
+        "bytes error | e1 error | FPS spread over reps |\n|---|---|---|---|---|---|---|---|---|---|"
+        "---|\n");
+    std::vector<double> abs_fps, abs_mtp, abs_bytes, abs_e1;
+    nlohmann::json rows_json = nlohmann::json::array();
+    for (const std::string& key : order) {
+        const Row& r = rows[key];
+        const double fe = mean(r.fps_err), me = mean(r.mtp_err), be = mean(r.bytes_err),
+                     ee = mean(r.e1_err_abs);
+        if (std::isfinite(fe))
+            abs_fps.push_back(std::fabs(fe));
+        if (std::isfinite(me))
+            abs_mtp.push_back(std::fabs(me));
+        if (std::isfinite(be))
+            abs_bytes.push_back(std::fabs(be));
+        if (std::isfinite(ee))
+            abs_e1.push_back(std::fabs(ee));
+        const std::string link_label =
+            r.link.rfind("trace:", 0) == 0
+                ? "trace:" + fs::path(r.link.substr(6)).filename().string()
+                : r.link;
+        md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.scene,
+                          link_label, r.depth, r.design, cell(mean(r.fps_meas), "{:.1f}"),
+                          cell(mean(r.fps_pred), "{:.1f}"), cell(fe, "{:+.1f}%"),
+                          cell(me, "{:+.1f}%"), cell(be, "{:+.1f}%"), cell(ee, "{:+.1f}°"),
+                          cell(spread(r.fps_meas), "{:.1f}"));
+        rows_json.push_back({{"scene", r.scene},
+                             {"link", r.link},
+                             {"depth", r.depth},
+                             {"design", r.design},
+                             {"fps_measured", r.fps_meas},
+                             {"fps_predicted", r.fps_pred},
+                             {"fps_error_pct", r.fps_err},
+                             {"mtp_error_pct", r.mtp_err},
+                             {"bytes_error_pct", r.bytes_err},
+                             {"e1_error_deg", r.e1_err_abs}});
+    }
+    auto worst = [](const std::vector<double>& v) {
+        return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
+    };
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    md += fmt::format(
+        "\nMean absolute error (worst): FPS {} ({}), MTP mean {} ({}), bytes/frame {} ({}), e1 {} "
+        "({}) over {} design × condition cells; {} failed runs; {:.0f} s.\n",
+        cell(mean(abs_fps), "{:.1f}%"), cell(worst(abs_fps), "{:.1f}%"),
+        cell(mean(abs_mtp), "{:.1f}%"), cell(worst(abs_mtp), "{:.1f}%"),
+        cell(mean(abs_bytes), "{:.1f}%"), cell(worst(abs_bytes), "{:.1f}%"),
+        cell(mean(abs_e1), "{:.1f}°"), cell(worst(abs_e1), "{:.1f}°"), order.size(), failures,
+        seconds);
+    fmt::print("\n{}", md);
+    std::ofstream(out / "validation.md") << md;
+    const nlohmann::json summary = {{"machine", machineDescriptionLine()},
+                                    {"seconds", seconds},
+                                    {"reps", o.reps},
+                                    {"frames", o.frames},
+                                    {"failed_runs", failures},
+                                    {"fps_abs_error_pct_mean", mean(abs_fps)},
+                                    {"fps_abs_error_pct_worst", worst(abs_fps)},
+                                    {"mtp_abs_error_pct_mean", mean(abs_mtp)},
+                                    {"mtp_abs_error_pct_worst", worst(abs_mtp)},
+                                    {"bytes_abs_error_pct_mean", mean(abs_bytes)},
+                                    {"bytes_abs_error_pct_worst", worst(abs_bytes)},
+                                    {"e1_abs_error_deg_mean", mean(abs_e1)},
+                                    {"e1_abs_error_deg_worst", worst(abs_e1)},
+                                    {"rows", rows_json}};
+    std::ofstream(out / "validation.json") << summary.dump(2) << "\n";
+    fmt::print("  wrote {}/validation.md and validation.json\n", o.out);
+    return failures > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+static Registered registerValidate(CLI::App& app) {
+    auto o = std::make_shared<ValidateOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "validate",
+        "Calibrate, then run qvr run over links x scenes x pipeline depths and tabulate the "
+        "calibrated simulator's prediction errors");
+    cmd->add_option("--designs", o->designs, "Designs of every run")->capture_default_str();
+    cmd->add_option("--links", o->links,
+                    "Comma-separated qvr run --net specs (default: wifi,lte,5g and the ATT "
+                    "Mahimahi trace of shared/data/network)");
+    cmd->add_option("--scenes", o->scenes, "Comma-separated scenes")->capture_default_str();
+    cmd->add_option("--depths", o->depths, "Frames in flight: 1, 2 or 1,2")->capture_default_str();
+    cmd->add_option("--frames", o->frames, "Frames per design per run")->capture_default_str();
+    cmd->add_option("--reps", o->reps, "Repetitions of every condition")
+        ->check(CLI::Range(1, 20))
+        ->capture_default_str();
+    cmd->add_option("--profile", o->profile, "Display profile")->capture_default_str();
+    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
+    cmd->add_flag("--dry-run", o->dry_run, "Print the commands without running them");
+    return {cmd, [o] { return runValidate(*o); }};
+}
+
+QVR_REGISTER_COMMAND(92, registerValidate);
+
+}  // namespace qvr::cli
