@@ -30,6 +30,7 @@
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
 #include "qvr/runtime/workload_probe.h"
+#include "qvr/sim/runtime_model.h"
 
 namespace qvr::cli {
 
@@ -230,6 +231,17 @@ std::string Calibration::toToml() const {
     return s + runtimeCostsToml(costs);
 }
 
+namespace {
+// The calibration's views: the default head motion and gaze over the span a default run covers
+// (150 frames at 90 Hz, 1.7 s). In an enclosed level the BVH counts almost the whole scene in
+// every view, so what a layer costs depends on what it sees at its level of detail, which the
+// cost's features do not capture: sampling other seconds of the motion mispredicted the room's
+// periphery layers by 2x (docs/MODEL.md §8).
+double poseTimeMs(int k) {
+    return 50.0 + 290.0 * k;
+}
+}  // namespace
+
 Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     using namespace qvr::runtime;
     const auto t_start = Clock::now();
@@ -272,7 +284,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     };
     std::vector<PoseSample> poses;
     for (int k = 0; k < n_poses; ++k) {
-        const double t_ms = 250.0 + 700.0 * k;  // spread over the first seconds
+        const double t_ms = poseTimeMs(k);
         PoseSample p;
         p.head = poseAt(inputs->traces.motion, t_ms);
         p.gaze = gazeAt(inputs->traces.gaze, t_ms);
@@ -358,7 +370,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         const PoseSample& p0 = poses[pi];
         for (double e1 : e1s) {
             for (int step = 0; step < sequence; ++step) {
-                const double t_ms = 250.0 + 700.0 * double(pi) + frame_ms * step;
+                const double t_ms = poseTimeMs(static_cast<int>(pi)) + frame_ms * step;
                 PoseSample p = p0;
                 p.head = poseAt(inputs->traces.motion, t_ms);
                 p.gaze = gazeAt(inputs->traces.gaze, t_ms);
@@ -397,8 +409,9 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                                               middle ? LayerKind::kMiddle : LayerKind::kOuter, img);
                         if (!st)
                             return makeError("layer render: " + st.error());
-                        server.push_back({msSince(t0), double(rect.pixels()),
-                                          (middle ? mid_tris : all_tris) / 2});
+                        server.push_back(
+                            {msSince(t0), double(rect.pixels()),
+                             serverLayerTriangles(middle ? mid_tris : all_tris, rect.scale)});
                         Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
                         if (!ch.enc) {
                             auto e = makeVideoEncoder(codec);
@@ -460,7 +473,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             const double ms = msSince(t0);
             fovea.push_back({ms, eye_px, all_tris / 2});
             // The server's whole-frame layer is the same view at scale 1.
-            server.push_back({ms, eye_px, all_tris / 2});
+            server.push_back({ms, eye_px, serverLayerTriangles(all_tris, 1.0)});
         }
         for (int rep_i = 0; rep_i < 2; ++rep_i) {
             const auto t0 = Clock::now();
@@ -495,7 +508,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     cal.costs.uca = fit(uca, true, false);
     cal.parts.push_back(
         summarise("fovea/local", "one eye's fovea or full-frame pass", fovea, cal.costs.fovea));
-    cal.parts.push_back(summarise("server render", "one periphery or whole-frame layer", server,
+    cal.parts.push_back(summarise("server render",
+                                  "one periphery or whole-frame layer (ktri: BVH/2/s²)", server,
                                   cal.costs.server_render));
     cal.parts.push_back(summarise("encode", "one layer, P-frame", encode, cal.costs.encode));
     cal.parts.push_back(summarise("decode", "one stream, P-frame", decode, cal.costs.decode));

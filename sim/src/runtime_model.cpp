@@ -119,6 +119,11 @@ Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double*
                      "': the runtime model knows wifi, lte, 5g, rate:MBPS and trace:PATH[@MBPS]");
 }
 
+double serverLayerTriangles(double cone_triangles_both_eyes, double scale) {
+    const double s = std::max(scale, 1.0);
+    return cone_triangles_both_eyes / 2.0 / (s * s);
+}
+
 Expected<Design> runtimeDesignByName(const std::string& name) {
     if (name == "local")
         return Design::Local;
@@ -213,7 +218,7 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         if (whole_frame) {
             const double bytes = bitsPerPx(wf, 1.0) * eye_px / 8.0;
             for (int eye = 0; eye < 2; ++eye)
-                jobs.push_back({eye_px, total_tris / 2.0, bytes, true});
+                jobs.push_back({eye_px, serverLayerTriangles(total_tris, 1.0), bytes, true});
         } else {
             const PeripheryBytes pb = {
                 2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1) / 8.0,
@@ -223,11 +228,13 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
             for (int eye = 0; eye < 2; ++eye) {
                 const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
                 if (!e.middle.empty())
-                    jobs.push_back(
-                        {double(e.middle.pixels()), mid_tris / 2.0, pb.middle / 2.0, true});
+                    jobs.push_back({double(e.middle.pixels()),
+                                    serverLayerTriangles(mid_tris, e.middle.scale), pb.middle / 2.0,
+                                    true});
                 if (!e.outer.empty())
-                    jobs.push_back(
-                        {double(e.outer.pixels()), total_tris / 2.0, pb.outer / 2.0, false});
+                    jobs.push_back({double(e.outer.pixels()),
+                                    serverLayerTriangles(total_tris, e.outer.scale), pb.outer / 2.0,
+                                    false});
             }
         }
         for (const LayerJob& job : jobs) {

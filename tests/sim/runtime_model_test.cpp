@@ -180,6 +180,35 @@ TEST(RuntimeModel, CostsScaleWithPixelsAndTriangles) {
     EXPECT_GT(large.summary.t_local_ms_mean, small.summary.t_local_ms_mean);
 }
 
+TEST(RuntimeModel, ServerLayersCostTheirTrianglesOverTheirScaleSquared) {
+    // Only a per-triangle server cost: a frame costs Σ layers cone triangles / 2 / s², middle
+    // over the cone to e2, outer over everything.
+    RuntimeCosts c = flatCosts(1.0, 1.0, 0.0);
+    c.server_render = {0.0, 0.0, 1.0};
+    const WorkloadTrace trace = flatTrace(10);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Ffr;
+    cfg.costs = c;
+    cfg.frames = 10;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[0].gaze, 5.0);
+    const WorkloadFrame& f = trace.frames[0];
+    const double mid = sumWithinDeg(f.triangles_per_ring, 1.0, plan.e2_deg);
+    const double all = sumTotal(f.triangles_per_ring);
+    double expected = 0.0;
+    for (const EyeLayers& e : plan.eyes) {
+        if (!e.middle.empty())
+            expected += serverLayerTriangles(mid, e.middle.scale) * 1e-3;
+        if (!e.outer.empty())
+            expected += serverLayerTriangles(all, e.outer.scale) * 1e-3;
+    }
+    EXPECT_GT(expected, 0.0);
+    EXPECT_NEAR(r.summary.server_busy_ms_mean, expected, 1e-9);
+    EXPECT_NEAR(serverLayerTriangles(1000.0, 2.0), 125.0, 1e-12);
+    EXPECT_NEAR(serverLayerTriangles(1000.0, 0.5), 500.0, 1e-12);  // scales below 1 count as 1
+}
+
 TEST(RuntimeModel, DesignNames) {
     EXPECT_EQ(*runtimeDesignByName("qvr"), Design::Qvr);
     EXPECT_EQ(*runtimeDesignByName("local"), Design::Local);

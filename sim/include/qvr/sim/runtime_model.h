@@ -88,6 +88,12 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
 // modelled. No noise: the emulator has none; packet headers are charged by the model.
 Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double* delay_ms);
 
+// The triangle feature of one server layer: the BVH's triangles in the layer's cone (both eyes)
+// halved for one eye and divided by the layer's scale squared — with a level of detail bound in
+// the layer's own pixels, a layer s times coarser draws about s² times fewer of a dense scene's
+// triangles. `qvr calibrate` fits server_render on it, the model charges it.
+double serverLayerTriangles(double cone_triangles_both_eyes, double scale);
+
 // The runtime design names (`qvr run --designs`) on the simulator's designs.
 Expected<Design> runtimeDesignByName(const std::string& name);
 
