@@ -167,8 +167,11 @@ std::string machineDescriptionLine() {
 }
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
-    const std::string text = fmt::format("{}|{}|{}|{}|{}|{}", machineDescriptionLine(), o.profile,
-                                         o.scene, o.codec, o.lod_px, o.core);
+    // What the calibration measures and how; a cached calibration of another version is not reused.
+    constexpr int kCalibrationVersion = 3;
+    const std::string text =
+        fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
+                    o.profile, o.scene, o.codec, o.lod_px, o.core);
     uint64_t h = 1469598103934665603ull;  // FNV-1a
     for (unsigned char c : text) {
         h ^= c;

@@ -332,7 +332,7 @@ Expected<CalibrationChoice> chooseCalibration(const RunOptions& o) {
         return c;
     }
     CalibrateOptions co;
-    co.scene = "builtin:room";
+    co.scene = o.scene;  // the bits law and the render costs are the scene's
     co.profile = o.profile;
     co.codec = o.codec;
     co.lod_px = o.lod_px;
@@ -358,7 +358,7 @@ Expected<CalibrationChoice> chooseCalibration(const RunOptions& o) {
     t.join();
     if (!cal)
         return makeError("calibration: " + cal.error());
-    cal->command = "qvr run (calibrating first: qvr calibrate --scene builtin:room --profile " +
+    cal->command = "qvr run (calibrating first: qvr calibrate --scene " + o.scene + " --profile " +
                    o.profile + ")";
     std::error_code ec;
     fs::create_directories(fs::path(cache).parent_path(), ec);
