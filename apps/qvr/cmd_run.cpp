@@ -4,6 +4,7 @@
 // gnuplot figures, the video the headset displayed for `qvr`, and `qvr sim`'s prediction for the
 // workload recorded during the run.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -29,6 +30,7 @@
 #include "qvr/compose/warp.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/net/link_emulator.h"
+#include "qvr/report/html_report.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/render_server.h"
@@ -168,42 +170,6 @@ private:
     std::vector<Fovea> m_foveae;
 };
 
-std::string shellQuote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s)
-        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-}
-
-bool runGnuplot(const fs::path& dir, const std::string& name, const std::string& body) {
-    for (const char* term : {"pngcairo", "png"}) {
-        std::ofstream(dir / (name + ".gp")) << fmt::format(
-            "set terminal {} size 1000,420 noenhanced\nset output '{}.png'\n"
-            "set datafile separator ','\nset key outside right\nset grid\n{}",
-            term, name, body);
-        const std::string cmd = "cd " + shellQuote(dir.string()) + " && gnuplot " +
-                                shellQuote(name + ".gp") + " >/dev/null 2>&1";
-        if (std::system(cmd.c_str()) == 0)
-            return true;
-    }
-    return false;
-}
-
-std::string htmlEscape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        if (c == '<')
-            out += "&lt;";
-        else if (c == '>')
-            out += "&gt;";
-        else if (c == '&')
-            out += "&amp;";
-        else
-            out += c;
-    }
-    return out;
-}
-
 std::string machineDescription() {
     std::string model;
     std::ifstream cpu("/proc/cpuinfo");
@@ -252,11 +218,11 @@ struct DesignRun {
 // What limits each design's frame rate on this machine: the headset's busy time per frame (its
 // core) against the server's service time per frame (T_remote: render, encode, link, decode
 // of the other core's work), and the headset's largest stage.
-std::string limitsHtml(const std::vector<DesignRun>& runs) {
-    std::string html =
-        "<h2>What limits the frame rate</h2>\n<table><tr><th>design</th><th>headset busy "
-        "ms/frame (core 0)</th><th>decision ms</th><th>fovea/local render ms</th><th>UCA "
-        "ms</th><th>T_remote ms (server, core 1)</th><th>limit</th></tr>\n";
+void limitsHtml(report::HtmlReport& page, const std::vector<DesignRun>& runs) {
+    page.heading(2, "What limits the frame rate");
+    report::Table table({"design", "headset busy ms/frame (core 0)", "decision ms",
+                         "fovea/local render ms", "UCA ms", "T_remote ms (server, core 1)",
+                         "limit"});
     for (const DesignRun& r : runs) {
         double busy = 0, decision = 0, local = 0, uca = 0, remote = 0;
         int n = 0, n_busy = 0, n_remote = 0;
@@ -291,17 +257,17 @@ std::string limitsHtml(const std::vector<DesignRun>& runs) {
                                              : "the decision (BVH ring counts)";
             limit = fmt::format("headset: busiest stage {}", stage);
         }
-        html += fmt::format(
-            "<tr><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}"
-            "</td><td style='text-align:left'>{}</td></tr>\n",
-            designName(r.design), busy, decision, local, uca, remote, htmlEscape(limit));
+        table.row({designName(r.design), fmt::format("{:.1f}", busy),
+                   fmt::format("{:.1f}", decision), fmt::format("{:.1f}", local),
+                   fmt::format("{:.1f}", uca), fmt::format("{:.1f}", remote),
+                   report::Cell(limit, "", true)});
     }
-    html +=
-        "</table>\n<p>Both sides run llvmpipe on one core each of this machine; the paper's "
+    page.table(table);
+    page.paragraph(
+        "Both sides run llvmpipe on one core each of this machine; the paper's "
         "premise is a mobile GPU on the headset and a far stronger server GPU. Frames in flight "
         "(two by default) let the server render frame n+1 while the headset finishes n, so a "
-        "design runs at the pace of the slower side.</p>\n";
-    return html;
+        "design runs at the pace of the slower side.");
 }
 
 // The calibration the prediction uses: the file given, this machine's cached one, or a fresh
@@ -427,7 +393,7 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
         "<h2>Measured against the simulator</h2>\n<p>Prediction for this run's frames. "
         "<b>calibrated</b>: the runtime pipeline model "
         "(docs/MODEL.md §8) with this machine's costs, " +
-        htmlEscape(calibration_note) +
+        report::htmlEscape(calibration_note) +
         ". <b>paper hardware</b>: the paper's pipeline on its modelled mobile GPU and server "
         "(the default of <code>qvr eval</code>), for reference, not this machine. Error = "
         "(predicted − measured) / measured.</p>\n<table><tr><th>design</th><th>metric</th>"
@@ -459,8 +425,8 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
             h += fmt::format(
                 "<tr>{}<td style='text-align:left'>{}</td><td>{}</td><td>{}</td><td>{}</td>"
                 "<td>{}</td></tr>\n",
-                first ? fmt::format("<td rowspan='5'>{}</td>", htmlEscape(it.key())) : "", m.label,
-                fmtCell(d.value(m.key, nlohmann::json()), m.f),
+                first ? fmt::format("<td rowspan='5'>{}</td>", report::htmlEscape(it.key())) : "",
+                m.label, fmtCell(d.value(m.key, nlohmann::json()), m.f),
                 fmtCell(d["predicted"].value(m.key, nlohmann::json()), m.f), err_cell,
                 fmtCell(paper, m.f));
             first = false;
@@ -468,7 +434,7 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
     }
     h += "</table>\n";
     if (!sim_note.empty())
-        h += "<p>" + htmlEscape(sim_note) + "</p>\n";
+        h += "<p>" + report::htmlEscape(sim_note) + "</p>\n";
     return h;
 }
 
@@ -844,14 +810,23 @@ int runRun(const RunOptions& o) {
     }
 
     // Figures.
-    const bool have_gnuplot = std::system("command -v gnuplot >/dev/null 2>&1") == 0;
-    std::vector<std::string> figures;
-    if (have_gnuplot) {
-        std::string e1_plot = "set xlabel 'frame'\nset ylabel 'e1 (deg)'\nplot ";
-        std::string mtp_plot = "set xlabel 'frame'\nset ylabel 'motion-to-photon (ms)'\nplot ";
+    report::Plotter plotter(out, 1000, 420);
+    const std::array<std::pair<std::string, std::string>, 4> kFigureTitles = {{
+        {"e1", "Fovea size e1 per frame (deg)"},
+        {"mtp", "Motion-to-photon latency per frame (ms)"},
+        {"bytes", "Bytes received per frame (KB, log scale)"},
+        {"scanout", "Interval between scan-outs (ms)"},
+    }};
+    {
+        const std::string common = "set datafile separator ','\nset key outside right\nset grid\n";
+        std::string e1_plot = common + "set xlabel 'frame'\nset ylabel 'e1 (deg)'\nplot ";
+        std::string mtp_plot =
+            common + "set xlabel 'frame'\nset ylabel 'motion-to-photon (ms)'\nplot ";
         std::string bytes_plot =
-            "set xlabel 'frame'\nset ylabel 'KB per frame'\nset logscale y\nplot ";
-        std::string ft_plot = "set xlabel 'frame'\nset ylabel 'scan-out interval (ms)'\nplot ";
+            common + "set xlabel 'frame'\nset ylabel 'KB per frame'\nset logscale y\nplot ";
+        std::string ft_plot = common +
+                              "prev=0\nset yrange [0:150]\nset xlabel 'frame'\nset ylabel "
+                              "'scan-out interval (ms)'\nplot ";
         bool first = true;
         for (const DesignRun& r : runs) {
             const std::string f = fmt::format("frames_{}.csv", designName(r.design));
@@ -870,62 +845,64 @@ int runRun(const RunOptions& o) {
                 sep, f, designName(r.design));
             first = false;
         }
-        ft_plot = "prev=0\nset yrange [0:150]\n" + ft_plot;
-        if (runGnuplot(out, "e1", e1_plot + "\n"))
-            figures.push_back("e1");
-        if (runGnuplot(out, "mtp", mtp_plot + "\n"))
-            figures.push_back("mtp");
-        if (runGnuplot(out, "bytes", bytes_plot + "\n"))
-            figures.push_back("bytes");
-        if (runGnuplot(out, "scanout", ft_plot + "\n"))
-            figures.push_back("scanout");
+        plotter.plot("e1", kFigureTitles[0].second, e1_plot + "\n");
+        plotter.plot("mtp", kFigureTitles[1].second, mtp_plot + "\n");
+        plotter.plot("bytes", kFigureTitles[2].second, bytes_plot + "\n");
+        plotter.plot("scanout", kFigureTitles[3].second, ft_plot + "\n");
     }
 
     // report.html
-    std::string html = "<!doctype html><meta charset='utf-8'><title>qvr run</title>\n";
-    html +=
-        "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}"
-        "table{border-collapse:collapse}td,th{border:1px solid #999;padding:3px 8px;"
-        "text-align:right}</style>\n";
-    html += "<h1>qvr run</h1>\n<p>" + htmlEscape(o.command_line) + "<br>" + htmlEscape(utcNow()) +
-            ", " + htmlEscape(machineDescription()) + "</p>\n";
-    html += fmt::format(
+    auto num = [](double v, int prec = 1) { return fmt::format("{:.{}f}", v, prec); };
+    report::HtmlReport page("qvr run");
+    page.heading(1, "qvr run");
+    page.html("<p>" + report::htmlEscape(o.command_line) + "<br>" + report::htmlEscape(utcNow()) +
+              ", " + report::htmlEscape(machineDescription()) + "</p>\n");
+    page.html(fmt::format(
         "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
         "the "
         "server's egress), {} frames per design. The headset (this process) is pinned to core {}, "
         "the server (a child <code>qvr server</code> process) to core {}. Motion-to-photon is pose "
         "sample → UCA output complete on the headset's "
         "steady clock.</p>\n",
-        htmlEscape(scene->name), profile->width_px, profile->height_px, profile->refresh_hz,
-        htmlEscape(o.net), o.frames, client_core, server_core);
-    html +=
-        "<table><tr><th>design</th><th>FPS</th><th>MTP mean ms</th><th>MTP p99 ms</th>"
-        "<th>KB/frame</th><th>e1 mean °</th><th>T_local ms</th><th>T_remote ms</th>"
-        "<th>UCA ms</th><th>displayed</th><th>reused</th></tr>\n";
+        report::htmlEscape(scene->name), profile->width_px, profile->height_px, profile->refresh_hz,
+        report::htmlEscape(o.net), o.frames, client_core, server_core));
+    report::Table designs_table({"design", "FPS", "MTP mean ms", "MTP p99 ms", "KB/frame",
+                                 "e1 mean °", "T_local ms", "T_remote ms", "UCA ms", "displayed",
+                                 "reused"});
     for (const DesignRun& r : runs) {
         const DesignSummary& s = r.result.summary;
-        html += fmt::format(
-            "<tr><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>"
-            "<td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{}</td><td>{}</td></"
-            "tr>\n",
-            s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean / 1e3,
-            s.e1_deg_mean, s.t_local_ms_mean, s.t_remote_ms_mean, s.uca_ms_mean, s.frames_displayed,
-            s.frames_reused);
+        designs_table.row({s.design, num(s.fps_mean), num(s.mtp_ms_mean), num(s.mtp_ms_p99),
+                           num(s.bytes_per_frame_mean / 1e3), num(s.e1_deg_mean),
+                           num(s.t_local_ms_mean), num(s.t_remote_ms_mean), num(s.uca_ms_mean),
+                           std::to_string(s.frames_displayed), std::to_string(s.frames_reused)});
     }
-    html += "</table>\n";
-    html += limitsHtml(runs);
-    html += validationHtml(dj, calibration->note + "; workload: " + trace_source, sim_note);
-    html += "<h2>Against the paper</h2>\n<pre>" + htmlEscape(j["ratios"].dump(2)) + "</pre>\n";
-    for (const std::string& f : figures)
-        html += "<h3>" + f + "</h3><img src='" + f + ".png' width='1000'>\n";
-    if (!have_gnuplot)
-        html += "<p>gnuplot not found: CSV written, no figures.</p>\n";
-    html += "<p>Video: " + htmlEscape(video_note) + "</p>\n";
+    page.table(designs_table);
+    limitsHtml(page, runs);
+    page.html(validationHtml(dj, calibration->note + "; workload: " + trace_source, sim_note));
+    page.heading(2, "Against the paper");
+    {
+        // The headline ratios: measured here, the paper's, the paper-hardware model's.
+        auto cell = [&](const char* name, double scale, int prec) -> std::string {
+            return ratios.contains(name) ? num(ratios[name].get<double>() * scale, prec) : "—";
+        };
+        report::Table t({"ratio", "measured", "paper", "simulator (paper hardware)"});
+        t.row({"Q-VR FPS over local (x)", cell("qvr_fps_over_local", 1, 2),
+               cell("paper_qvr_fps_over_local", 1, 2), cell("sim_qvr_fps_over_local", 1, 2)});
+        t.row({"Q-VR bytes saved vs remote (%)", cell("qvr_bytes_saved_vs_remote", 100, 1),
+               cell("paper_qvr_bytes_saved_vs_remote", 100, 1),
+               cell("sim_qvr_bytes_saved_vs_remote", 100, 1)});
+        page.table(t);
+    }
+    if (plotter.available())
+        for (const auto& [name, title] : kFigureTitles)
+            page.figure(out, name, title, 1000);
+    else
+        page.paragraph(plotter.note());
+    page.paragraph("Video: " + video_note);
     if (fs::exists(out / "qvr_display_still.png"))
-        html +=
-            "<img src='qvr_display_still.png' width='1000' alt='a frame the headset displayed "
-            "for qvr'>\n";
-    std::ofstream(out / "report.html") << html;
+        page.image("qvr_display_still.png", "a frame the headset displayed for qvr", 1000);
+    if (auto st = page.write(out / "report.html"); !st)
+        std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
 
     fmt::print("  ratios: {}\n", ratios.dump());
     if (!predicted.empty()) {

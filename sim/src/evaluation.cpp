@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "qvr/report/html_report.h"
 #include "qvr/sim/benches.h"
 
 namespace qvr {
@@ -56,17 +57,6 @@ double mean(const std::vector<double>& v) {
     return s / static_cast<double>(v.size());
 }
 
-std::string shellQuote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s) {
-        if (c == '\'')
-            out += "'\\''";
-        else
-            out += c;
-    }
-    return out + "'";
-}
-
 Status writeText(const fs::path& path, const std::string& text) {
     std::ofstream out(path, std::ios::binary);
     if (!out)
@@ -106,56 +96,6 @@ nlohmann::json runJson(const RunSummary& s) {
             {"net_ms_mean", s.net_ms_mean},
             {"preemptions_per_frame", s.preemptions_per_frame},
             {"meets_refresh", s.meets_refresh}};
-}
-
-// Runs gnuplot on a script; tries pngcairo, then the libgd png terminal.
-bool runGnuplot(const fs::path& script_path, const std::string& body, std::string& terminal) {
-    for (const char* term : {"pngcairo", "png"}) {
-        const std::string script =
-            fmt::format("set terminal {} size 1100,520 noenhanced {}\n{}", term,
-                        std::string(term) == "pngcairo" ? "font 'sans,10'" : "", body);
-        if (!writeText(script_path, script))
-            return false;
-        // Scripts name their CSV files relative to the output folder.
-        const std::string cmd = "cd " + shellQuote(script_path.parent_path().string()) +
-                                " && gnuplot " + shellQuote(script_path.filename().string()) +
-                                " 2>/dev/null";
-        if (std::system(cmd.c_str()) == 0) {
-            terminal = term;
-            return true;
-        }
-    }
-    return false;
-}
-
-bool gnuplotAvailable() {
-    return std::system("command -v gnuplot >/dev/null 2>&1") == 0;
-}
-
-std::string htmlEscape(const std::string& text) {
-    std::string out;
-    for (char c : text) {
-        switch (c) {
-            case '<':
-                out += "&lt;";
-                break;
-            case '>':
-                out += "&gt;";
-                break;
-            case '&':
-                out += "&amp;";
-                break;
-            case '\'':
-                out += "&#39;";
-                break;
-            case '"':
-                out += "&quot;";
-                break;
-            default:
-                out += c;
-        }
-    }
-    return out;
 }
 
 std::string fmtNum(double v, int prec = 2) {
@@ -363,19 +303,14 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     const size_t nb = benches.size();
     const std::vector<Design> compared = {Design::Remote, Design::Static, Design::Ffr,
                                           Design::Dfr,    Design::Sw,     Design::Qvr};
-    const bool have_gnuplot = gnuplotAvailable();
-    std::string terminal;
-    int plots_ok = 0, plots_tried = 0;
-    auto plot = [&](const std::string& name, const std::string& body) {
-        if (!have_gnuplot)
-            return;
-        ++plots_tried;
-        const std::string full = fmt::format("set output '{}.png'\n{}", name, body);
-        if (runGnuplot(out / (name + ".gp"), full, terminal)) {
-            ++plots_ok;
+    report::Plotter plotter(out, 1100, 520);
+    // The title goes above the figure in report.html; the script's own titles (per panel) win
+    // inside the image.
+    auto plot = [&](const std::string& name, const std::string& title, const std::string& body) {
+        if (plotter.plot(name, title, body))
             output.files.push_back(name + ".png");
-        }
-        output.files.push_back(name + ".gp");
+        if (plotter.available())
+            output.files.push_back(name + ".gp");
     };
     auto csv = [&](const std::string& name, const std::string& text) -> Status {
         output.files.push_back(name);
@@ -408,7 +343,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     }
     if (auto st = csv("fig12_speedup.csv", fig12); !st)
         return makeError(st.error());
-    plot("fig12",
+    plot("fig12", "Fig. 12: end-to-end speedup over local (x), FPS over local (x)",
          "set datafile separator ','\nset key autotitle columnheader\nset title 'Fig. 12: "
          "end-to-end speedup over local (500 MHz, "
          "Wi-Fi)'\nset style data histogram\nset style histogram clustered gap 1\n"
@@ -442,7 +377,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     }
     if (auto st = csv("fig13_data_resolution.csv", fig13); !st)
         return makeError(st.error());
-    plot("fig13",
+    plot("fig13", "Fig. 13: transmitted data and shaded resolution, normalised to remote (x)",
          "set datafile separator ','\nset multiplot layout 1,2 title 'Fig. 13: normalised to "
          "remote (500 MHz, Wi-Fi)'\nset style data histogram\nset style histogram clustered gap "
          "1\nset style fill solid 0.8 border -1\nset key top left font ',8'\nset grid ytics\n"
@@ -478,6 +413,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         if (auto st = csv("fig14_fps.csv", fpsf); !st)
             return makeError(st.error());
         plot("fig14",
+             "Fig. 14: latency ratio T_remote/T_local and FPS over 300 frames from e1 = 5 deg",
              fmt::format("set datafile separator ','\nset multiplot layout 1,2 title 'Fig. 14: "
                          "Q-VR over {} frames from e1 = 5 deg (500 MHz, Wi-Fi)'\nset key top "
                          "right font ',8'\nset grid\nset xlabel 'frame'\nset title '(a) latency "
@@ -518,7 +454,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         return makeError(st.error());
     if (auto st = csv("table4_plot.csv", t4_plot); !st)
         return makeError(st.error());
-    plot("table4",
+    plot("table4", "Table 4: steady-state e1 (deg) of Q-VR",
          fmt::format("set datafile separator ','\nset title 'Table 4: steady-state e1 (deg) of "
                      "Q-VR'\nset style data histogram\nset style histogram clustered gap 1\n"
                      "set style fill solid 0.8 border -1\nset key outside right\nset xtics "
@@ -548,12 +484,13 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     }
     if (auto st = csv("fig15_energy.csv", f15); !st)
         return makeError(st.error());
-    plot("fig15",
+    plot("fig15", "Fig. 15: Q-VR energy per frame normalised to local (x)",
          fmt::format("set datafile separator ','\nset title 'Fig. 15: Q-VR energy per frame "
                      "normalised to local'\nset style data histogram\nset style histogram "
                      "clustered gap 1\nset style fill solid 0.8 border -1\nset key outside "
-                     "right\nset xtics rotate by -30\nset grid ytics\nplot for [i=2:{}] "
-                     "'fig15_energy.csv' using i:xtic(1) title columnheader(i)\n",
+                     "right\nset xtics rotate by -30\nset grid ytics\nset ylabel 'energy / local "
+                     "energy (x)'\nplot for [i=2:{}] 'fig15_energy.csv' using i:xtic(1) title "
+                     "columnheader(i)\n",
                      nb + 2));
 
     // Trace-driven LTE: Q-VR, DFR and FFR on each Mahimahi trace rescaled to 100 Mbps.
@@ -588,7 +525,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             return makeError(st.error());
         if (auto st = csv("mahimahi_plot.csv", mm_plot); !st)
             return makeError(st.error());
-        plot("mahimahi",
+        plot("mahimahi", "MTP (ms) on Mahimahi LTE traces rescaled to 100 Mbps",
              "set datafile separator ','\nset key autotitle columnheader\nset title 'MTP on "
              "Mahimahi LTE traces rescaled to 100 Mbps (mean of the suite; 500 MHz)'\nset style "
              "data histogram\nset style histogram clustered gap 1\nset style fill solid 0.8 "
@@ -699,37 +636,31 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         return makeError(st.error());
     output.files.push_back("summary.json");
 
-    if (!have_gnuplot)
-        output.plot_note = "gnuplot not found: CSV written, no figures";
-    else
-        output.plot_note = fmt::format("{}/{} figures drawn by gnuplot ({} terminal)", plots_ok,
-                                       plots_tried, terminal.empty() ? "none" : terminal);
+    output.plot_note = plotter.note();
 
     // report.html
-    std::string html = fmt::format(
-        "<!doctype html><html><head><meta charset='utf-8'><title>qvr eval</title><style>"
-        "body{{font-family:sans-serif;max-width:1150px;margin:auto}}table{{border-collapse:"
-        "collapse}}td,th{{border:1px solid #999;padding:3px 7px;text-align:right}}"
-        ".bad{{text-decoration:underline;color:#b00}}.no{{color:#b00}}.yes{{color:#070}}"
-        "</style></head><body><h1>Q-VR simulator evaluation</h1><p>Command: <code>{}</code>"
-        "<br>Frames per run: {} (Q-VR at the default point: {}, of which Fig. 14 plots the "
-        "first 300); runs: {}; {}.<br>{} Models and constants: docs/MODEL.md.</p>",
-        htmlEscape(options.command_line), options.frames, frames, output.runs.size(),
-        output.plot_note, suiteDescription());
-    html +=
-        "<h2>Headline figures: paper vs. this simulator</h2><table><tr><th>metric</th>"
-        "<th>paper</th><th>ours</th></tr>";
+    report::HtmlReport page("qvr eval",
+                            ".bad{text-decoration:underline;color:#b00}.no{color:#b00}"
+                            ".yes{color:#070}");
+    page.heading(1, "Q-VR simulator evaluation");
+    page.html(fmt::format(
+        "<p>Command: <code>{}</code><br>Frames per run: {} (Q-VR at the default point: {}, of "
+        "which Fig. 14 plots the first 300); runs: {}; {}.<br>{} Models and constants: "
+        "docs/MODEL.md.</p>\n",
+        report::htmlEscape(options.command_line), options.frames, frames, output.runs.size(),
+        report::htmlEscape(output.plot_note), suiteDescription()));
+    page.heading(2, "Headline figures: paper vs. this simulator");
+    report::Table headlines({"metric", "paper", "ours"});
     for (const auto& h : output.headlines)
-        html += fmt::format(
-            "<tr><td style='text-align:left'>{}</td><td>{}{}</td><td>{}{}</td>"
-            "</tr>",
-            htmlEscape(h.metric), fmtNum(h.paper, 2), h.unit, fmtNum(h.ours, 2), h.unit);
-    html += "</table><h2>Qualitative findings</h2><ul>";
+        headlines.row({h.metric, fmtNum(h.paper, 2) + h.unit, fmtNum(h.ours, 2) + h.unit});
+    page.table(headlines);
+    page.heading(2, "Qualitative findings");
+    std::string findings = "<ul>";
     for (const auto& f : output.findings)
-        html += fmt::format("<li><b>{}</b>: <span class='{}'>{}</span> — {}</li>",
-                            htmlEscape(f.name), f.holds ? "yes" : "no",
-                            f.holds ? "holds" : "does not hold", htmlEscape(f.detail));
-    html += "</ul>";
+        findings += fmt::format("<li><b>{}</b>: <span class='{}'>{}</span> — {}</li>\n",
+                                report::htmlEscape(f.name), f.holds ? "yes" : "no",
+                                f.holds ? "holds" : "does not hold", report::htmlEscape(f.detail));
+    page.html(findings + "</ul>\n");
     {
         // The measured mechanism behind DFR vs FFR, from this run's own numbers.
         std::vector<double> dfr_e1, dfr_wait, ffr_remote, ffr_local, qvr_e1, dfr_ts, dfr_ts_e1;
@@ -744,7 +675,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             dfr_ts.push_back(get(b, Design::Local).mtp_ms_mean / ts.mtp_ms_mean);
             dfr_ts_e1.push_back(ts.e1_deg_steady);
         }
-        html += fmt::format(
+        page.html(fmt::format(
             "<h2>Where we differ from the paper, and why</h2><ul>"
             "<li><b>DFR vs FFR.</b> The paper has DFR 1.1x over FFR; here DFR/FFR = {:.2f}. At "
             "e1 = 5&deg; the synthetic periphery already costs only {:.1f} ms to send (T_local "
@@ -773,71 +704,56 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             "</ul><p>Models, constants and their sources: docs/MODEL.md.</p>",
             mean(speedups[Design::Dfr]) / mean(speedups[Design::Ffr]), mean(ffr_remote),
             mean(ffr_local), mean(dfr_wait), mean(dfr_e1), mean(qvr_e1), mean(dfr_ts_e1),
-            mean(dfr_ts) / mean(speedups[Design::Ffr]));
+            mean(dfr_ts) / mean(speedups[Design::Ffr])));
     }
     auto figure = [&](const std::string& title, const std::string& png, const std::string& csvs) {
-        html += fmt::format("<h2>{}</h2>", title);
+        page.heading(2, title);
         if (std::find(output.files.begin(), output.files.end(), png) != output.files.end())
-            html += fmt::format("<img src='{}' width='1100'>", png);
-        html += "<p>Data: " + csvs + "</p>";
+            page.image(png, title, 1100);
+        page.html("<p>Data: " + csvs + "</p>\n");
     };
-    auto table = [&](const std::string& csv_text, bool flag_table4) {
-        html += "<table>";
-        size_t pos = 0;
-        bool head = true;
-        while (pos < csv_text.size()) {
-            size_t end = csv_text.find('\n', pos);
-            if (end == std::string::npos)
-                end = csv_text.size();
-            const std::string line = csv_text.substr(pos, end - pos);
-            pos = end + 1;
-            std::vector<std::string> cells;
-            size_t p = 0;
-            while (true) {
-                const size_t c = line.find(',', p);
-                cells.push_back(line.substr(p, c == std::string::npos ? std::string::npos : c - p));
-                if (c == std::string::npos)
-                    break;
-                p = c + 1;
-            }
-            size_t shown = cells.size();
-            if (flag_table4)
-                shown = 2 + nb;
-            html += "<tr>";
-            for (size_t i = 0; i < shown && i < cells.size(); ++i) {
-                const bool miss = flag_table4 && !head && i >= 2 &&
-                                  2 + nb + (i - 2) < cells.size() && cells[2 + nb + (i - 2)] == "0";
-                html += fmt::format("<{0}{1}>{2}</{0}>", head ? "th" : "td",
-                                    miss ? " class='bad'" : "", cells[i]);
-            }
-            html += "</tr>";
-            head = false;
-        }
-        html += "</table>";
-    };
+    auto table = [&](const std::string& csv_text) { page.table(report::Table::fromCsv(csv_text)); };
     figure("Fig. 12: end-to-end speedup over local, FPS over local", "fig12.png",
            "<a href='fig12_speedup.csv'>fig12_speedup.csv</a>");
-    table(fig12, false);
+    table(fig12);
     figure("Fig. 13: transmitted data and shaded resolution, normalised to remote", "fig13.png",
            "<a href='fig13_data_resolution.csv'>fig13_data_resolution.csv</a>");
-    table(fig13, false);
+    table(fig13);
     figure("Fig. 14: latency ratio and FPS over 300 frames from e1 = 5&deg;", "fig14.png",
            "<a href='fig14_latency_ratio.csv'>fig14_latency_ratio.csv</a>, "
            "<a href='fig14_fps.csv'>fig14_fps.csv</a>");
     figure("Table 4: steady-state e1 (deg); underlined red = misses 90 FPS", "table4.png",
            "<a href='table4_e1.csv'>table4_e1.csv</a>");
-    table(t4, true);
+    {
+        // Table 4 without its meets-90-Hz columns; a cell that misses 90 FPS is marked.
+        report::Table t4_table = report::Table::fromCsv(t4);
+        std::vector<std::string> header = {"gpu_mhz", "net"};
+        for (const auto& b : benches)
+            header.push_back(b.label);
+        report::Table shown(header);
+        for (size_t r = 0; r < t4_table.rows(); ++r) {
+            const std::vector<report::Cell>& cells = t4_table.rowAt(r);
+            std::vector<report::Cell> row;
+            for (size_t i = 0; i < 2 + nb && i < cells.size(); ++i) {
+                const bool miss = i >= 2 && 2 + nb + (i - 2) < cells.size() &&
+                                  cells[2 + nb + (i - 2)].text == "0";
+                row.emplace_back(cells[i].text, miss ? "bad" : "");
+            }
+            shown.row(std::move(row));
+        }
+        page.table(shown);
+    }
     figure("Fig. 15: Q-VR energy per frame normalised to local", "fig15.png",
            "<a href='fig15_energy.csv'>fig15_energy.csv</a>");
-    table(f15, false);
+    table(f15);
     if (!trace_nets.empty()) {
         figure("Trace-driven links: MTP mean and p99 on Mahimahi LTE traces (rescaled to 100 Mbps)",
                "mahimahi.png", "<a href='mahimahi_lte.csv'>mahimahi_lte.csv</a>");
     } else {
-        html += "<p>No Mahimahi traces were given (<code>--mahimahi FILE...</code>).</p>";
+        page.html("<p>No Mahimahi traces were given (<code>--mahimahi FILE...</code>).</p>\n");
     }
-    html += "<h2>All runs</h2><p><a href='summary.json'>summary.json</a></p></body></html>\n";
-    if (auto st = writeText(out / "report.html", html); !st)
+    page.heading(2, "All runs").html("<p><a href='summary.json'>summary.json</a></p>\n");
+    if (auto st = page.write(out / "report.html"); !st)
         return makeError(st.error());
     output.files.push_back("report.html");
     return output;
