@@ -14,8 +14,9 @@ QVR_PACKAGES=(
     # textures (assimp-testmodels is listed with trace below)
     libzip-dev libassimp-dev libstb-dev
     openarena-081-maps openarena-081-textures openarena-data
-    # codec: H.264 through libavcodec + libx264; trace: CMU motion capture (BVH) for head motion
-    libavcodec-dev libavutil-dev libswscale-dev libx264-dev assimp-testmodels
+    # codec: H.264 through libavcodec + libx264, the display video as MP4 through libavformat;
+    # trace: CMU motion capture (BVH) for head motion
+    libavcodec-dev libavformat-dev libavutil-dev libswscale-dev libx264-dev assimp-testmodels
     # render: headless OpenGL 4.5 through EGL (GLVND headers and loaders, Mesa's EGL and llvmpipe)
     libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
     # compose: libopencv-dev only for the optional QVR_WITH_OPENCV benchmark anchor, not listed

@@ -24,8 +24,7 @@
 #include "calibration.h"
 #include "cli_parse.h"
 #include "commands.h"
-#include "qvr/codec/frame_header.h"
-#include "qvr/codec/video_codec.h"
+#include "qvr/codec/mp4_writer.h"
 #include "qvr/compose/png_io.h"
 #include "qvr/compose/warp.h"
 #include "qvr/foveation/eye_geometry.h"
@@ -65,6 +64,7 @@ struct RunOptions {
     double remote_timeout_ms = 250.0;
     bool video = true;
     bool fovea_border = true;
+    bool quiet = false;
     int video_max_frames = 900;
     bool one_pass_periphery = false;
     int pipeline_depth = 2;
@@ -84,7 +84,8 @@ public:
                    const std::array<ImageRgba8, 2>& eyes) override {
         if (static_cast<int>(m_frames.size()) >= m_max_frames || eyes[0].empty())
             return;
-        const int w = eyes[0].width() / 2, h = eyes[0].height() / 2;
+        // Even sides: the MP4 is 4:2:0.
+        const int w = eyes[0].width() / 2, h = (eyes[0].height() / 2) & ~1;
         ImageRgba8 img(2 * w, h);
         for (int e = 0; e < 2; ++e)
             for (int y = 0; y < h; ++y)
@@ -120,31 +121,22 @@ public:
                 }
             }
     }
-    // An H.264 Annex B elementary stream (plays in ffplay/mpv/VLC).
-    Status writeH264(const std::string& path) const {
-        CodecConfig cfg;
-        cfg.crf = 20;
-        cfg.keyint_frames = 90;
-        auto enc = makeVideoEncoder(cfg);
-        if (!enc)
-            return makeError(enc.error());
-        std::ofstream out(path, std::ios::binary);
-        if (!out)
-            return makeError("cannot write " + path);
+    // H.264 in MP4 (mp4_writer.h): plays in browsers, so report.html embeds it.
+    Status writeMp4(const std::string& path) const {
+        if (m_frames.empty())
+            return makeError("no displayed frames");
+        auto mp4 = Mp4Writer::open(path, m_frames[0].width(), m_frames[0].height(),
+                                   static_cast<int>(std::lround(m_profile.refresh_hz)));
+        if (!mp4)
+            return makeError(mp4.error());
         for (size_t i = 0; i < m_frames.size(); ++i) {
             ImageRgba8 f = m_frames[i];
             if (m_fovea_border && m_foveae[i].e1_deg > 0)
                 drawFoveaBorder(f, m_foveae[i].gaze, m_foveae[i].e1_deg);
-            auto e = (*enc)->encode(f);
-            if (!e)
-                return makeError("video: " + e.error());
-            auto parsed = parseFrame(e->bytes);
-            if (!parsed)
-                return makeError("video: " + parsed.error());
-            out.write(reinterpret_cast<const char*>(parsed->payload.data()),
-                      static_cast<std::streamsize>(parsed->payload.size()));
+            if (auto st = (*mp4)->write(f); !st)
+                return st;
         }
-        return out ? Status{} : Status(makeError("error writing " + path));
+        return (*mp4)->finish();
     }
     size_t frames() const { return m_frames.size(); }
     // One displayed frame as PNG (with the fovea edge when drawn in the video), for a look
@@ -168,6 +160,40 @@ private:
     bool m_fovea_border;
     std::vector<ImageRgba8> m_frames;
     std::vector<Fovea> m_foveae;
+};
+
+// Progress on a terminal while a design runs (design, frame k of N, FPS so far), redrawn at
+// most five times a second on stderr; forwards each frame to the sink it wraps (the video).
+class ProgressDisplay final : public DisplaySink {
+public:
+    ProgressDisplay(std::string design, int frames, DisplaySink* inner)
+        : m_design(std::move(design)),
+          m_frames(frames),
+          m_inner(inner),
+          m_start(std::chrono::steady_clock::now()) {}
+    ~ProgressDisplay() override { std::fputs("\r\033[K", stderr); }
+    void onScanout(const FrameTelemetry& frame, const LayerPlan& plan,
+                   const std::array<ImageRgba8, 2>& eyes) override {
+        if (m_inner)
+            m_inner->onScanout(frame, plan, eyes);
+        ++m_shown;
+        const auto now = std::chrono::steady_clock::now();
+        if (now - m_last < std::chrono::milliseconds(200) && m_shown < m_frames)
+            return;
+        m_last = now;
+        const double s = std::chrono::duration<double>(now - m_start).count();
+        std::fprintf(stderr, "\r\033[K  %-6s frame %lld of %d  %5.1f fps so far", m_design.c_str(),
+                     static_cast<long long>(frame.frame + 1), m_frames, s > 0 ? m_shown / s : 0.0);
+        std::fflush(stderr);
+    }
+
+private:
+    std::string m_design;
+    int m_frames;
+    DisplaySink* m_inner;
+    std::chrono::steady_clock::time_point m_start;
+    std::chrono::steady_clock::time_point m_last{};
+    int m_shown = 0;
 };
 
 std::string machineDescription() {
@@ -574,9 +600,15 @@ int runRun(const RunOptions& o) {
                 recorded_workload = true;
             }
         }
+        std::unique_ptr<ProgressDisplay> progress;
+        if (!o.quiet && isatty(STDERR_FILENO)) {
+            progress = std::make_unique<ProgressDisplay>(designName(d), o.frames, hc.display);
+            hc.display = progress.get();
+        }
         Expected<HeadsetResult> result = makeError("not run");
         std::thread headset([&] { result = runHeadset(hc, scene, bvh, traces); });
         headset.join();
+        progress.reset();  // clears the progress line
         if (!result) {
             std::fprintf(stderr, "qvr run: %s: %s\n", designName(d), result.error().c_str());
             return 1;
@@ -790,17 +822,17 @@ int runRun(const RunOptions& o) {
     if (frames_rendered > 0)
         j["server"]["render_ms_per_frame"] =
             server_stats.value("render_ms_total", 0.0) / frames_rendered;
-    std::ofstream(out / "summary.json") << j.dump(2) << "\n";
 
     // Video of what the headset displayed for qvr.
     std::string video_note = "not recorded";
     if (o.video && recorder.frames() > 0) {
-        const fs::path video = out / "qvr_display.h264";
-        if (auto st = recorder.writeH264(video.string()); st)
+        const fs::path video = out / "qvr_display.mp4";
+        if (auto st = recorder.writeMp4(video.string()); st)
             video_note = fmt::format(
-                "qvr_display.h264: {} frames, both eyes side by side at half "
-                "resolution{}, H.264 Annex B at 90 fps (ffplay -f h264)",
-                recorder.frames(), o.fovea_border ? ", fovea edge (e1) drawn in yellow" : "");
+                "qvr_display.mp4: {} frames, both eyes side by side at half "
+                "resolution{}, H.264 in MP4 at {} fps",
+                recorder.frames(), o.fovea_border ? ", fovea edge (e1) drawn in yellow" : "",
+                profile->refresh_hz);
         else
             video_note = "video failed: " + st.error();
         // The middle frame as a still beside it.
@@ -808,6 +840,17 @@ int runRun(const RunOptions& o) {
         if (auto st = recorder.writePngFrame(still, (out / "qvr_display_still.png").string()); st)
             video_note += fmt::format("; frame {} of it as qvr_display_still.png", still);
     }
+    // The video as a player sees it, read back through libavformat.
+    if (fs::exists(out / "qvr_display.mp4")) {
+        if (auto info = probeVideoFile((out / "qvr_display.mp4").string()))
+            j["video"] = {{"path", "qvr_display.mp4"}, {"container", info->format_name},
+                          {"codec", info->codec_name}, {"profile", info->profile},
+                          {"width_px", info->width},   {"height_px", info->height},
+                          {"fps", info->fps},          {"frames", info->frames}};
+        else
+            video_note += "; the written MP4 does not read back: " + info.error();
+    }
+    std::ofstream(out / "summary.json") << j.dump(2) << "\n";
 
     // Figures.
     report::Plotter plotter(out, 1000, 420);
@@ -899,6 +942,8 @@ int runRun(const RunOptions& o) {
     else
         page.paragraph(plotter.note());
     page.paragraph("Video: " + video_note);
+    if (fs::exists(out / "qvr_display.mp4"))
+        page.video("qvr_display.mp4", "qvr_display_still.png", 1000);
     if (fs::exists(out / "qvr_display_still.png"))
         page.image("qvr_display_still.png", "a frame the headset displayed for qvr", 1000);
     if (auto st = page.write(out / "report.html"); !st)
@@ -971,6 +1016,7 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_flag("--recalibrate", o->recalibrate,
                   "Measure the calibration again even when a cached one exists");
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
+    cmd->add_flag("--quiet", o->quiet, "No progress line on a terminal");
     cmd->add_flag("!--no-fovea-border", o->fovea_border,
                   "Do not draw the e1 circle (the fovea layer's edge) in the video");
     return {cmd, [o] {
