@@ -20,6 +20,11 @@ bool parseU64(std::string_view s, uint64_t& out) {
     return ec == std::errc() && p == s.data() + s.size();
 }
 
+// Below 1 kbit/s a full queue (up to 1 GiB) would take longer than int64 nanoseconds can count.
+constexpr double kMinLinkMbps = 0.001;
+// Deliveries later than this (~146 years) are refused rather than rounded into overflow.
+constexpr double kMaxDeliveryNs = 4.6e18;
+
 }  // namespace
 
 const std::vector<std::string>& linkProfileNames() {
@@ -50,8 +55,10 @@ Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
         c.rate_bps = 500e6;
     } else if (profile.starts_with("rate:")) {
         double mbps = 0;
-        if (!parseDouble(profile.substr(5), mbps) || mbps <= 0 || mbps > 1e6) {
-            return makeError("link '" + spec + "': rate:MBPS needs a rate in (0, 1e6] Mbit/s");
+        if (!parseDouble(profile.substr(5), mbps) || mbps < kMinLinkMbps || mbps > 1e6) {
+            return makeError("link '" + spec +
+                             "': rate:MBPS needs a rate in [0.001, 1e6] Mbit/s (slower rates "
+                             "would hold a packet for longer than the clock can count)");
         }
         c.rate_bps = mbps * 1e6;
     } else if (profile.starts_with("trace:")) {
@@ -59,8 +66,9 @@ Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
         const size_t at = path.rfind('@');
         if (at != std::string_view::npos) {
             double mbps = 0;
-            if (!parseDouble(path.substr(at + 1), mbps) || mbps <= 0 || mbps > 1e6) {
-                return makeError("link '" + spec + "': trace:PATH@MBPS needs a mean in (0, 1e6]");
+            if (!parseDouble(path.substr(at + 1), mbps) || mbps < kMinLinkMbps || mbps > 1e6) {
+                return makeError("link '" + spec +
+                                 "': trace:PATH@MBPS needs a mean in [0.001, 1e6] Mbit/s");
             }
             c.trace_target_bps = mbps * 1e6;
             path = path.substr(0, at);
@@ -229,6 +237,12 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         return false;
     }
     const double departure = departureNs(static_cast<double>(now_ns), bytes);
+    // A configuration the parser would refuse (a rate near zero) could put a departure beyond
+    // what int64 nanoseconds hold: such a packet can never leave, so it is a queue drop.
+    if (!(departure + m_config.delay_ms * 1e6 + m_config.jitter_ms * 1e6 < kMaxDeliveryNs)) {
+        ++m_stats.dropped_queue;
+        return false;
+    }
     if (departure > static_cast<double>(now_ns)) {
         m_queue.push_back({departure, bytes});
         m_queue_bytes += bytes;
