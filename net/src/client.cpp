@@ -46,6 +46,12 @@ const char* byeText(ByeReason r) {
             return "is full";
         case ByeReason::kTimeout:
             return "timed out the handshake";
+        case ByeReason::kVersionMismatch:
+            return "refused our protocol version";
+        case ByeReason::kCodecMismatch:
+            return "refused our codec (codec mismatch)";
+        case ByeReason::kProfileMismatch:
+            return "refused our display profile (profile mismatch)";
     }
     return "said bye";
 }
@@ -127,6 +133,25 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
     }
     const Nonce client_nonce = randomNonce();
     ServerChallenge challenge;
+    // Why the server said bye; a refusal of our version or settings is counted as permanent.
+    const auto byeError = [this, &where](ByeReason reason) {
+        std::string text = "connect " + where + ": the server " + byeText(reason);
+        if (reason == ByeReason::kVersionMismatch || reason == ByeReason::kCodecMismatch ||
+            reason == ByeReason::kProfileMismatch) {
+            {
+                std::lock_guard lock(mutex);
+                ++stats.incompatible_refusals;
+            }
+            if (reason == ByeReason::kVersionMismatch) {
+                text += " (this client speaks version " + std::to_string(kProtocolVersion) + ")";
+            } else if (reason == ByeReason::kCodecMismatch) {
+                text += " (this client: codec " + codecNameOf(options.settings) + ")";
+            } else {
+                text += " (this client: " + profileTextOf(options.settings) + ")";
+            }
+        }
+        return makeError(text);
+    };
 
     asio::async_connect(
         c.control, endpoints, [&](const asio::error_code& cec, const tcp::endpoint&) {
@@ -153,8 +178,20 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                 return;
             }
             const uint16_t media_port = c.media.local_endpoint(e).port();
-            c.writer.push(c.control, encodeControl(ClientHello{client_nonce, media_port}));
+            c.writer.push(c.control,
+                          encodeControl(ClientHello{client_nonce, media_port, options.settings}));
             c.reader.read(c.control, [&, media_port](detail::ReadResult r) {
+                if (!r.ec && r.error == WireError::kWrongVersion) {
+                    {
+                        std::lock_guard lock(mutex);
+                        ++stats.incompatible_refusals;
+                    }
+                    finish(makeError("connect " + where +
+                                     ": the server speaks another protocol version (this client "
+                                     "speaks version " +
+                                     std::to_string(kProtocolVersion) + ")"));
+                    return;
+                }
                 if (r.ec || r.error != WireError::kNone) {
                     finish(makeError("connect " + where + ": no valid challenge from the server (" +
                                      (r.ec ? r.ec.message() : std::string(wireErrorName(r.error))) +
@@ -162,7 +199,7 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                     return;
                 }
                 if (const auto* bye = std::get_if<Bye>(&r.message)) {
-                    finish(makeError("connect " + where + ": the server " + byeText(bye->reason)));
+                    finish(byeError(bye->reason));
                     return;
                 }
                 const auto* ch = std::get_if<ServerChallenge>(&r.message);
@@ -194,8 +231,7 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                         return;
                     }
                     if (const auto* bye = std::get_if<Bye>(&w.message)) {
-                        finish(
-                            makeError("connect " + where + ": the server " + byeText(bye->reason)));
+                        finish(byeError(bye->reason));
                         return;
                     }
                     const auto* welcome = std::get_if<Welcome>(&w.message);

@@ -2,7 +2,9 @@
 // read through ByteReader only, check every field's range, and allocate nothing.
 #include "qvr/net/protocol.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "bytes.h"
 #include "qvr/core/check.h"
@@ -22,11 +24,13 @@ constexpr uint8_t kFlagKeyFrame = 0x01;
 constexpr size_t kLayerGeometryBytes = 4 * 4 + 4 + 4 + 4;  // rect, scale, width, height
 constexpr size_t kFrameRequestBytes = 4 + 8 + 7 * 4 + 2 * 4 + 4 * 4 + 2 * 3 * kLayerGeometryBytes;
 
+constexpr size_t kSettingsBytes = 2 * kSettingNameBytes + 2 + 2 + 4;
+
 // The fixed payload size of each type; 0 for types this version does not define.
 size_t payloadBytesOf(ControlType type) {
     switch (type) {
         case ControlType::kClientHello:
-            return kNonceBytes + 2;
+            return kNonceBytes + 2 + kSettingsBytes;
         case ControlType::kServerChallenge:
             return kNonceBytes + 8 + kMacBytes;
         case ControlType::kClientAuth:
@@ -82,6 +86,11 @@ struct Encoder {
     void operator()(const ClientHello& m) {
         w.bytes(m.client_nonce);
         w.u16(m.media_port);
+        w.bytes(m.settings.codec);
+        w.bytes(m.settings.profile);
+        w.u16(m.settings.width_px);
+        w.u16(m.settings.height_px);
+        w.u32(m.settings.refresh_mhz);
     }
     void operator()(const ServerChallenge& m) {
         w.bytes(m.server_nonce);
@@ -181,7 +190,91 @@ WireError decodeFrameRequest(ByteReader& r, FrameRequest& m) {
     return WireError::kNone;
 }
 
+// Printable ASCII, then only NUL padding.
+bool validName(const std::array<uint8_t, kSettingNameBytes>& name) {
+    bool ended = false;
+    for (const uint8_t c : name) {
+        if (c == 0) {
+            ended = true;
+        } else if (ended || c < 0x20 || c > 0x7e) {
+            return false;
+        }
+    }
+    return true;
+}
+
+std::array<uint8_t, kSettingNameBytes> nameBytes(std::string_view text) {
+    std::array<uint8_t, kSettingNameBytes> out{};
+    size_t n = 0;
+    for (const char c : text) {
+        if (n == out.size()) {
+            break;
+        }
+        const auto u = static_cast<uint8_t>(c);
+        out[n++] = u >= 0x20 && u <= 0x7e ? u : uint8_t{'?'};
+    }
+    return out;
+}
+
+std::string nameText(const std::array<uint8_t, kSettingNameBytes>& name) {
+    std::string out;
+    for (const uint8_t c : name) {
+        if (c == 0) {
+            break;
+        }
+        out.push_back(static_cast<char>(c));
+    }
+    return out;
+}
+
 }  // namespace
+
+SessionSettings makeSessionSettings(std::string_view codec, std::string_view profile, int width_px,
+                                    int height_px, double refresh_hz) {
+    SessionSettings s;
+    s.codec = nameBytes(codec);
+    s.profile = nameBytes(profile);
+    s.width_px = static_cast<uint16_t>(std::clamp(width_px, 0, 65535));
+    s.height_px = static_cast<uint16_t>(std::clamp(height_px, 0, 65535));
+    const double mhz = std::isfinite(refresh_hz) ? std::round(refresh_hz * 1000.0) : 0.0;
+    s.refresh_mhz = static_cast<uint32_t>(std::clamp(mhz, 0.0, 4.0e9));
+    return s;
+}
+
+std::string codecNameOf(const SessionSettings& s) {
+    const std::string name = nameText(s.codec);
+    return name.empty() ? "(unspecified)" : name;
+}
+
+std::string profileTextOf(const SessionSettings& s) {
+    const std::string name = nameText(s.profile);
+    char numbers[64];
+    std::snprintf(numbers, sizeof numbers, " %ux%u@%.3gHz", unsigned{s.width_px},
+                  unsigned{s.height_px}, s.refresh_mhz / 1000.0);
+    return (name.empty() ? std::string("(unspecified)") : name) + numbers;
+}
+
+std::string_view byeReasonName(ByeReason r) {
+    switch (r) {
+        case ByeReason::kNormal:
+            return "normal";
+        case ByeReason::kAuthFailed:
+            return "auth failed";
+        case ByeReason::kProtocolError:
+            return "protocol error";
+        case ByeReason::kServerFull:
+            return "server full";
+        case ByeReason::kTimeout:
+            return "handshake timeout";
+        case ByeReason::kVersionMismatch:
+            return "protocol version mismatch";
+        case ByeReason::kCodecMismatch:
+            return "codec mismatch";
+        case ByeReason::kProfileMismatch:
+            return "display profile mismatch";
+    }
+    return "?";
+}
 
 std::string_view wireErrorName(WireError e) {
     switch (e) {
@@ -329,7 +422,13 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
             ClientHello m;
             r.bytes(m.client_nonce);
             m.media_port = r.u16();
-            if (m.media_port == 0) {
+            r.bytes(m.settings.codec);
+            r.bytes(m.settings.profile);
+            m.settings.width_px = r.u16();
+            m.settings.height_px = r.u16();
+            m.settings.refresh_mhz = r.u32();
+            if (m.media_port == 0 || !validName(m.settings.codec) ||
+                !validName(m.settings.profile)) {
                 return WireError::kBadField;
             }
             out = m;
@@ -414,7 +513,7 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
         }
         case ControlType::kBye: {
             const uint8_t reason = r.u8();
-            if (reason > static_cast<uint8_t>(ByeReason::kTimeout)) {
+            if (reason > kMaxByeReason) {
                 return WireError::kBadField;
             }
             out = Bye{static_cast<ByeReason>(reason)};

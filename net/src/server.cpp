@@ -49,6 +49,7 @@ struct Server::Impl {
     std::vector<std::shared_ptr<Session>> sessions;  // every open connection
     int pending = 0;
     ServerStats stats;
+    int64_t last_unauth_report_ns = INT64_MIN / 2;
 };
 
 struct Session : std::enable_shared_from_this<Session> {
@@ -97,8 +98,20 @@ struct Session : std::enable_shared_from_this<Session> {
         if (state == State::kClosed) {
             return;
         }
+        last_rx_ns = SteadyClock::instance().nowNs();
         if (r.ec) {
             close();  // the client went away
+            return;
+        }
+        if (r.error == WireError::kWrongVersion && state == State::kAwaitHello) {
+            count([&](ServerStats& st) {
+                st.control_drops.count(r.error);
+                ++st.version_mismatches;
+            });
+            report("refused a client speaking another protocol version (this server speaks " +
+                       std::to_string(kProtocolVersion) + ")",
+                   true);
+            refuse(ByeReason::kVersionMismatch);
             return;
         }
         if (r.error != WireError::kNone) {
@@ -129,6 +142,7 @@ struct Session : std::enable_shared_from_this<Session> {
                 }
                 client_nonce = hello->client_nonce;
                 media_port = hello->media_port;
+                client_settings = hello->settings;
                 server_nonce = randomNonce();
                 session_id = randomSessionId();
                 ServerChallenge c;
@@ -154,6 +168,20 @@ struct Session : std::enable_shared_from_this<Session> {
                     refuse(ByeReason::kAuthFailed);
                     return false;
                 }
+                if (const auto why = settingsMismatch(); why != ByeReason::kNormal) {
+                    count([](ServerStats& st) { ++st.settings_refusals; });
+                    const SessionSettings& mine = server.options.settings;
+                    report(why == ByeReason::kCodecMismatch
+                               ? "refused a client: codec mismatch (client " +
+                                     codecNameOf(client_settings) + ", server " +
+                                     codecNameOf(mine) + ")"
+                               : "refused a client: display profile mismatch (client " +
+                                     profileTextOf(client_settings) + ", server " +
+                                     profileTextOf(mine) + ")",
+                           false);
+                    refuse(why);
+                    return false;
+                }
                 return admit();
             }
             case State::kAuthed:
@@ -164,6 +192,55 @@ struct Session : std::enable_shared_from_this<Session> {
         count([](ServerStats& st) { ++st.protocol_errors; });
         refuse(ByeReason::kProtocolError);
         return false;
+    }
+
+    ByeReason settingsMismatch() const {
+        const SessionSettings& mine = server.options.settings;
+        if (client_settings.codec != mine.codec) {
+            return ByeReason::kCodecMismatch;
+        }
+        if (client_settings != mine) {
+            return ByeReason::kProfileMismatch;
+        }
+        return ByeReason::kNormal;
+    }
+
+    // Tells the operator why a client was refused; unauthenticated causes at most once a second.
+    void report(const std::string& what, bool unauthenticated) {
+        if (!server.options.on_refusal) {
+            return;
+        }
+        if (unauthenticated) {
+            const int64_t now_ns = SteadyClock::instance().nowNs();
+            std::lock_guard lock(server.mutex);
+            if (now_ns - server.last_unauth_report_ns < 1'000'000'000) {
+                return;
+            }
+            server.last_unauth_report_ns = now_ns;
+        }
+        server.options.on_refusal(what);
+    }
+
+    // After authentication the handshake timer watches for silence instead.
+    void armIdle(int64_t after_ms) {
+        if (server.options.idle_timeout_ms <= 0) {
+            return;
+        }
+        handshake_timer.expires_after(std::chrono::milliseconds(after_ms));
+        handshake_timer.async_wait([self = shared_from_this()](const asio::error_code& ec) {
+            if (ec || self->state != State::kAuthed) {
+                return;
+            }
+            const int64_t idle_ms =
+                (SteadyClock::instance().nowNs() - self->last_rx_ns) / 1'000'000;
+            const int64_t limit = self->server.options.idle_timeout_ms;
+            if (idle_ms >= limit) {
+                self->count([](ServerStats& st) { ++st.idle_timeouts; });
+                self->refuse(ByeReason::kTimeout);
+                return;
+            }
+            self->armIdle(limit - idle_ms);
+        });
     }
 
     bool admit() {
@@ -196,6 +273,7 @@ struct Session : std::enable_shared_from_this<Session> {
             return false;
         }
         server.handler.onClientConnected(session_id);
+        armIdle(server.options.idle_timeout_ms);
         return state == State::kAuthed;
     }
 
@@ -289,6 +367,8 @@ struct Session : std::enable_shared_from_this<Session> {
         estimator.onSend(frame_id, static_cast<int64_t>(bytes.size()), now_ns);
         auto& kept = history[stream_id];
         for (auto& p : packets) {
+            retransmit_budget +=
+                server.options.retransmit_budget_ratio * static_cast<double>(p.size());
             if (server.options.retransmit_history_packets > 0) {
                 kept.push_back({seq[stream_id] - static_cast<uint32_t>(packets.size()) +
                                     static_cast<uint32_t>(&p - packets.data()),
@@ -305,9 +385,9 @@ struct Session : std::enable_shared_from_this<Session> {
 
     // Resends what the client asked for from the history, through the link like any packet.
     void retransmit(const Nack& nack) {
-        const auto& kept = history[nack.stream_id];
+        auto& kept = history[nack.stream_id];
         const int64_t now_ns = SteadyClock::instance().nowNs();
-        uint64_t resent = 0, missing = 0;
+        uint64_t resent = 0, missing = 0, refused = 0, resent_bytes = 0;
         for (int i = 0; i < 64; ++i) {
             if (!((nack.missing_mask >> i) & 1)) {
                 continue;
@@ -320,13 +400,24 @@ struct Session : std::enable_shared_from_this<Session> {
                 ++missing;
                 continue;
             }
-            link.send(kept[static_cast<size_t>(offset)].bytes, now_ns);
+            Sent& sent = kept[static_cast<size_t>(offset)];
+            if (sent.resent >= server.options.max_retransmissions_per_packet ||
+                retransmit_budget < static_cast<double>(sent.bytes.size())) {
+                ++refused;  // bounds what NACKs can draw: ≤ (1 + max) × what was sent
+                continue;
+            }
+            ++sent.resent;
+            retransmit_budget -= static_cast<double>(sent.bytes.size());
+            link.send(sent.bytes, now_ns);
+            resent_bytes += sent.bytes.size();
             ++resent;
         }
         count([&](ServerStats& st) {
             ++st.nacks;
             st.packets_retransmitted += resent;
             st.packets_not_in_history += missing;
+            st.retransmissions_refused += refused;
+            st.bytes_retransmitted += resent_bytes;
         });
         flush();
     }
@@ -375,6 +466,10 @@ struct Session : std::enable_shared_from_this<Session> {
     Nonce server_nonce{};
     uint64_t session_id = 0;
     uint16_t media_port = 0;
+    SessionSettings client_settings;
+    asio::ip::address peer_address;  // fixed at accept
+    int64_t accepted_ns = 0;
+    int64_t last_rx_ns = 0;  // the last control message (or its start) from the peer
     udp::endpoint media_endpoint;
     LinkEmulator link;
     LinkStats link_stats;  // a copy for other threads, under server.mutex
@@ -383,7 +478,9 @@ struct Session : std::enable_shared_from_this<Session> {
     struct Sent {
         uint32_t seq;
         std::vector<uint8_t> bytes;
+        int resent = 0;  // times NACKed and sent again
     };
+    double retransmit_budget = 0.0;  // bytes NACKs may still draw (retransmit_budget_ratio)
     std::array<std::deque<Sent>, kMaxStreams> history;
     std::vector<std::vector<uint8_t>> out;
     std::atomic<int64_t> queued_bytes{0};
@@ -414,18 +511,58 @@ void Server::Impl::onAccepted(tcp::socket socket) {
     asio::error_code ec;
     socket.set_option(tcp::no_delay(true), ec);  // small control messages must not wait
     detail::enableKeepAlive(socket);
+    const asio::ip::address source = socket.remote_endpoint(ec).address();
+    if (ec) {
+        return;  // already gone
+    }
     std::shared_ptr<Session> session;
+    std::shared_ptr<Session> victim;
     {
         std::lock_guard lock(mutex);
         ++stats.connections;
-        if (pending >= options.max_pending_handshakes) {
+        if (options.max_pending_handshakes <= 0) {
             ++stats.refused_full;
             socket.close(ec);
             return;
         }
+        // Unauthenticated connections per source, and the oldest of each source.
+        std::map<asio::ip::address, std::pair<int, Session*>> by_source;
+        for (const auto& s : sessions) {
+            if (!s->pending) {
+                continue;
+            }
+            auto& [n, oldest] = by_source[s->peer_address];
+            ++n;
+            if (!oldest || s->accepted_ns < oldest->accepted_ns) {
+                oldest = s.get();
+            }
+        }
+        Session* evict = nullptr;
+        if (const auto it = by_source.find(source);
+            it != by_source.end() && it->second.first >= options.max_pending_per_source) {
+            evict = it->second.second;  // a source churns only its own slots
+        } else if (pending >= options.max_pending_handshakes) {
+            int most = 0;  // the source holding the most slots gives one up
+            for (const auto& [address, entry] : by_source) {
+                if (entry.first > most ||
+                    (entry.first == most && entry.second->accepted_ns < evict->accepted_ns)) {
+                    most = entry.first;
+                    evict = entry.second;
+                }
+            }
+        }
+        if (evict) {
+            ++stats.pending_evicted;
+            victim = evict->shared_from_this();
+        }
         ++pending;
         session = std::make_shared<Session>(*this, std::move(socket));
+        session->peer_address = source;
+        session->accepted_ns = SteadyClock::instance().nowNs();
         sessions.push_back(session);
+    }
+    if (victim) {
+        victim->refuse(ByeReason::kServerFull);  // releases its slot (close() takes the lock)
     }
     session->start();
 }

@@ -138,6 +138,9 @@ public:
             net::ClientOptions o;
             o.key = m_config.key;
             o.connect_timeout_ms = m_config.connect_timeout_ms;
+            o.settings = net::makeSessionSettings(
+                m_config.codec.backend, m_config.profile.name, m_config.profile.width_px,
+                m_config.profile.height_px, m_config.profile.refresh_hz);
             m_client = std::make_unique<net::Client>(o);
         }
         return {};
@@ -159,9 +162,12 @@ public:
         m_depth = depth;
         std::deque<Prepared> ahead;
         int64_t next = 0;
-        for (int64_t i = 0; i < m_config.frames; ++i) {
-            while (ahead.size() < depth && next < m_config.frames)
+        // A server that refused our version, codec or profile will not change its mind: stop.
+        for (int64_t i = 0; i < m_config.frames && m_refusal.empty(); ++i) {
+            while (ahead.size() < depth && next < m_config.frames && !stopRequested())
                 ahead.push_back(prepare(next++, result));
+            if (ahead.empty())
+                break;  // stopped: every started frame was finished
             finish(ahead.front(), result);
             ahead.pop_front();
         }
@@ -179,6 +185,7 @@ public:
     }
 
 private:
+    bool stopRequested() const { return m_config.stop && m_config.stop->load(); }
     int64_t rel(int64_t t_ns) const { return t_ns - m_origin_ns; }
     double frameTimeMs(int64_t i) const { return 1000.0 * double(i) / m_config.profile.refresh_hz; }
 
@@ -201,6 +208,8 @@ private:
             if (proof_failures > m_proof_failures_seen)
                 m_last_connect_try_ns = now_ns + int64_t(kKeyMismatchBackoffMs) * 1'000'000;
             m_proof_failures_seen = proof_failures;
+            if (m_client->stats().incompatible_refusals > 0)
+                m_refusal = st.error();
         }
     }
 
@@ -633,6 +642,12 @@ private:
     size_t m_depth = 1;
     double m_last_e1_deg = 5.0;
     uint64_t m_proof_failures_seen = 0;
+    std::string m_refusal;  // why the server refused our settings, empty while it has not
+
+public:
+    const std::string& refusal() const { return m_refusal; }
+
+private:
     bool m_was_connected = false;
 };
 
@@ -652,7 +667,10 @@ Expected<HeadsetResult> runHeadset(const HeadsetConfig& config, std::shared_ptr<
     auto headset = std::make_unique<Headset>(config, std::move(scene), std::move(bvh), traces);
     if (auto st = headset->setUp(); !st)
         return makeError(st.error());
-    return headset->run();
+    HeadsetResult result = headset->run();
+    if (!headset->refusal().empty())
+        return makeError(headset->refusal());
+    return result;
 }
 
 }  // namespace qvr::runtime

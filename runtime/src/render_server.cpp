@@ -247,6 +247,10 @@ Expected<std::unique_ptr<RenderServer>> RenderServer::start(RenderServerConfig c
         return makeError("render server: " + st.error());
     auto impl = std::make_unique<Impl>();
     impl->config = std::move(config);
+    // Clients must stream with our codec at our display profile (refused in the handshake).
+    const HmdProfile& hp = impl->config.profile;
+    impl->config.net.settings = net::makeSessionSettings(impl->config.codec.backend, hp.name,
+                                                         hp.width_px, hp.height_px, hp.refresh_hz);
     impl->scene = std::move(scene);
     Impl* p = impl.get();
     impl->render_thread = std::thread([p] { p->renderLoop(); });

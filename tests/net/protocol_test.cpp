@@ -34,6 +34,7 @@ std::vector<ControlMessage> everyMessage() {
     ClientHello hello;
     hello.client_nonce.fill(7);
     hello.media_port = 40000;
+    hello.settings = makeSessionSettings("x264", "small-320x360", 320, 360, 90.0);
     ServerChallenge ch;
     ch.server_nonce.fill(9);
     ch.session_id = 0x1122334455667788ull;
@@ -60,6 +61,30 @@ TEST(NetProtocol, EveryControlMessageRoundTrips) {
         ASSERT_EQ(back.index(), m.index());
         // Re-encoding what was decoded gives the same bytes: nothing lost or invented.
         EXPECT_EQ(encodeControl(back), wire) << m.index();
+    }
+}
+
+TEST(NetProtocol, ClientHelloCarriesTheSessionSettings) {
+    ClientHello hello{{}, 40000, makeSessionSettings("raw", "run-480x540", 480, 540, 72.5)};
+    ControlMessage back;
+    ASSERT_EQ(decodeControl(encodeControl(hello), back), WireError::kNone);
+    const auto& got = std::get<ClientHello>(back).settings;
+    EXPECT_EQ(got, hello.settings);
+    EXPECT_EQ(codecNameOf(got), "raw");
+    EXPECT_EQ(profileTextOf(got), "run-480x540 480x540@72.5Hz");
+    EXPECT_NE(got, makeSessionSettings("raw", "run-480x540", 480, 540, 90.0));
+    // Names longer than the field are cut, never overflow; unprintable bytes are replaced.
+    const auto longer = makeSessionSettings("a-very-long-codec-name", "p\x01q", 1, 1, 1.0);
+    EXPECT_EQ(codecNameOf(longer), "a-very-long-code");
+    EXPECT_EQ(profileTextOf(longer).substr(0, 3), "p?q");
+    // A name must be printable ASCII then NUL padding: anything else is a bad field.
+    const size_t codec_at = kControlHeaderBytes + kNonceBytes + 2;
+    for (const auto& [offset, byte] : {std::pair<size_t, uint8_t>{1, 0x07},     // a control char
+                                       std::pair<size_t, uint8_t>{5, 'x'},      // text after NUL
+                                       std::pair<size_t, uint8_t>{0, 0xC3}}) {  // not ASCII
+        auto wire = encodeControl(hello);
+        wire[codec_at + offset] = byte;
+        EXPECT_EQ(decodeControl(wire, back), WireError::kBadField) << offset;
     }
 }
 

@@ -26,12 +26,17 @@ struct ClientOptions {
     int key_frame_retry_ms = 100;    // at most one key-frame request per stream in this time
     size_t max_ready_streams = 256;  // completed streams the caller has not taken yet
     size_t max_control_queue = 256;
+    // Sent in the ClientHello; a server with other settings refuses the session (Bye reason).
+    SessionSettings settings;
 };
 
 struct ClientStats {
     uint64_t connects = 0;
     uint64_t connect_failures = 0;
     uint64_t server_proof_failures = 0;  // the server did not prove the key
+    // The server refused our protocol version, codec or display profile (or spoke another
+    // version): reconnecting cannot help, lastError() says why.
+    uint64_t incompatible_refusals = 0;
     uint64_t disconnects = 0;
     DropCounters control_drops;
     DropCounters media_drops;

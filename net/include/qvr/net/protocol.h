@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 #include <variant>
 #include <vector>
@@ -16,7 +17,9 @@
 
 namespace qvr::net {
 
-inline constexpr uint8_t kProtocolVersion = 1;
+// 2: the ClientHello carries the session settings (codec, display profile) and the server
+// refuses a mismatch with a named Bye reason.
+inline constexpr uint8_t kProtocolVersion = 2;
 
 // Limits a decoder enforces before it trusts any length a peer sent.
 inline constexpr size_t kControlHeaderBytes = 8;
@@ -30,6 +33,7 @@ inline constexpr int kMaxStreams = 4;                // eye × {middle, outer}
 inline constexpr int32_t kMaxImageExtentPx = 16384;  // rectangle coordinates and framebuffer sizes
 inline constexpr size_t kNonceBytes = 32;
 inline constexpr size_t kMacBytes = 32;
+inline constexpr size_t kSettingNameBytes = 16;
 
 // Stream id = 2·eye + layer: the four parallel streams of Fig. 7.
 enum class Layer : uint8_t { kMiddle = 0, kOuter = 1 };
@@ -81,10 +85,29 @@ struct ControlHeader {
     uint32_t payload_bytes = 0;
 };
 
+// What both ends must agree on for the media to make sense: the codec backend and the display
+// profile (the layer sizes the server renders). Names are printable ASCII, NUL-padded; longer
+// names are cut to kSettingNameBytes (the profile's numbers still tell two profiles apart).
+// All zero: "unspecified", which only matches itself.
+struct SessionSettings {
+    std::array<uint8_t, kSettingNameBytes> codec{};
+    std::array<uint8_t, kSettingNameBytes> profile{};
+    uint16_t width_px = 0;  // per eye
+    uint16_t height_px = 0;
+    uint32_t refresh_mhz = 0;  // refresh rate in millihertz
+    bool operator==(const SessionSettings&) const = default;
+};
+SessionSettings makeSessionSettings(std::string_view codec, std::string_view profile, int width_px,
+                                    int height_px, double refresh_hz);
+// "x264", or "small-320x360 320x360@90Hz" for the profile.
+std::string codecNameOf(const SessionSettings& s);
+std::string profileTextOf(const SessionSettings& s);
+
 // Handshake (docs/PROTOCOL.md §Handshake): nonces both ways, HMAC proofs both ways, never the key.
 struct ClientHello {
     std::array<uint8_t, kNonceBytes> client_nonce{};
     uint16_t media_port = 0;  // the client's UDP port on the address it connected from
+    SessionSettings settings{};
 };
 struct ServerChallenge {
     std::array<uint8_t, kNonceBytes> server_nonce{};
@@ -156,8 +179,13 @@ enum class ByeReason : uint8_t {
     kAuthFailed = 1,
     kProtocolError = 2,
     kServerFull = 3,
-    kTimeout = 4
+    kTimeout = 4,
+    kVersionMismatch = 5,  // the ClientHello was of another protocol version
+    kCodecMismatch = 6,    // the client's codec is not the server's
+    kProfileMismatch = 7,  // nor its display profile
 };
+inline constexpr uint8_t kMaxByeReason = 7;
+std::string_view byeReasonName(ByeReason r);
 struct Bye {
     ByeReason reason = ByeReason::kNormal;
 };

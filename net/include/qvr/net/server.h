@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,14 +23,33 @@ struct ServerOptions {
     uint16_t port = 0;                       // 0: an ephemeral port, see Server::port()
     PresharedKey key;
     int max_clients = 8;
-    int max_pending_handshakes = 16;
+    // Admission under a flood of connections that never authenticate (docs/PROTOCOL.md
+    // §Admission): at most this many unauthenticated connections in all and per source address;
+    // a new connection beyond either limit evicts the oldest unauthenticated one of the source
+    // holding the most, so a flooding source churns only its own slots.
+    int max_pending_handshakes = 256;
+    int max_pending_per_source = 32;
     int handshake_timeout_ms = 2000;
+    // An authenticated session with no control message from its client for this long (a
+    // stopped or idle client holding a slot) is ended with Bye(timeout); 0: never.
+    int idle_timeout_ms = 10000;
     size_t max_control_queue = 256;           // outgoing control messages per client
     int64_t max_media_queue_bytes = 8 << 20;  // accepted by sendStream, not yet in the link
     LinkConfig link;                          // each client gets its own emulator with this
     double throughput_alpha = 0.25;
     // Sent datagrams kept per client and stream for NACKed retransmission (~1.2 MB a stream).
     int retransmit_history_packets = 1024;
+    // Each sent datagram is resent at most this often however many NACKs name it (the client
+    // asks at most twice), and a session's retransmitted bytes never exceed this fraction of the
+    // bytes it first sent: a key holder's NACKs draw at most (1 + ratio) × the media.
+    int max_retransmissions_per_packet = 2;
+    double retransmit_budget_ratio = 1.0;
+    // What a client's ClientHello must carry (codec, display profile); an authenticated client
+    // with other settings is refused with Bye(codec / profile mismatch).
+    SessionSettings settings;
+    // Told why a client was refused for its version or settings (network thread; version
+    // mismatches come before authentication, so they are reported at most once a second).
+    std::function<void(const std::string&)> on_refusal;
 };
 
 // Called on the server's network thread: keep them short (hand work to the render thread),
@@ -49,7 +69,11 @@ struct ServerStats {
     uint64_t auth_failures = 0;
     uint64_t handshake_timeouts = 0;
     uint64_t refused_full = 0;
-    uint64_t protocol_errors = 0;  // wrong message for the state, or a broken stream
+    uint64_t pending_evicted = 0;     // unauthenticated connections pushed out by newer ones
+    uint64_t idle_timeouts = 0;       // authenticated sessions ended for silence
+    uint64_t protocol_errors = 0;     // wrong message for the state, or a broken stream
+    uint64_t version_mismatches = 0;  // a ClientHello of another protocol version
+    uint64_t settings_refusals = 0;   // authenticated, but another codec or display profile
     DropCounters control_drops;
     uint64_t frame_requests = 0;
     uint64_t key_frame_requests = 0;
@@ -60,7 +84,9 @@ struct ServerStats {
     uint64_t packets_send_failed = 0;  // the socket buffer was full
     uint64_t nacks = 0;
     uint64_t packets_retransmitted = 0;
-    uint64_t packets_not_in_history = 0;  // asked for too late (or never sent)
+    uint64_t packets_not_in_history = 0;   // asked for too late (or never sent)
+    uint64_t retransmissions_refused = 0;  // NACKed again after its retransmission budget
+    uint64_t bytes_retransmitted = 0;
 };
 
 class Server {

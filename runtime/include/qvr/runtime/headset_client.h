@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -70,6 +71,9 @@ struct HeadsetConfig {
     DisplaySink* display = nullptr;
     WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set
     std::function<void(int64_t frame)> before_frame;  // test hook, called at each frame start
+    // When set and true (e.g. from a SIGINT handler), no new frame starts; the frames already
+    // started are finished, so the result holds every frame shown and nothing half-done.
+    const std::atomic<bool>* stop = nullptr;
 };
 
 struct HeadsetStats {
