@@ -1,6 +1,8 @@
 // `qvr client`: the headset on its own (paper Fig. 4): head motion and gaze from traces, LIWC (or
 // another design) picks e1, the fovea renders locally, the periphery comes from `qvr server`,
 // UCA composes at the display rate; per-frame telemetry and a summary are written.
+#include <atomic>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,7 @@
 
 #include "cli_parse.h"
 #include "commands.h"
+#include "qvr/codec/video_codec.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
@@ -21,6 +24,14 @@ namespace qvr::cli {
 namespace {
 
 using namespace qvr::runtime;
+
+// Set by SIGINT/SIGTERM: the headset ends at the next frame boundary and everything measured so
+// far is written.
+std::atomic<bool> g_client_stop{false};
+
+void onClientSignal(int) {
+    g_client_stop.store(true);
+}
 
 struct ClientCmdOptions {
     std::string connect = "127.0.0.1:7400";
@@ -45,12 +56,22 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: %s\n", key.error().c_str());
         return 2;
     }
-    const size_t colon = o.connect.rfind(':');
-    int port = 0;
-    if (colon == std::string::npos ||
-        std::sscanf(o.connect.c_str() + colon + 1, "%d", &port) != 1 || port <= 0 || port > 65535) {
-        std::fprintf(stderr, "qvr client: --connect must be HOST:PORT, got '%s'\n",
-                     o.connect.c_str());
+    std::string host, why;
+    uint16_t port = 0;
+    if (!parseHostPort(o.connect, host, port, why)) {
+        std::fprintf(stderr, "qvr client: --connect: %s\n", why.c_str());
+        return 2;
+    }
+    {
+        CodecConfig codec;
+        codec.backend = o.codec;
+        if (auto st = validateCodecConfig(codec); !st) {
+            std::fprintf(stderr, "qvr client: --codec: %s\n", st.error().c_str());
+            return 2;
+        }
+    }
+    if (!makeOutputDir(o.out, why)) {
+        std::fprintf(stderr, "qvr client: --out: %s\n", why.c_str());
         return 2;
     }
     auto design = runtimeDesignByName(o.design);
@@ -77,21 +98,25 @@ int runClient(const ClientCmdOptions& o) {
     hc.design = *design;
     hc.profile = *profile;
     hc.codec.backend = o.codec;
-    hc.host = o.connect.substr(0, colon);
-    hc.port = static_cast<uint16_t>(port);
+    hc.host = host;
+    hc.port = port;
     hc.key = *key;
     hc.frames = o.frames;
     hc.core = o.core;
     GlRendererOptions gl;
     gl.lod_error_px = o.lod_px;
     hc.renderer = glRendererFactory(gl);
+    hc.stop = &g_client_stop;
+    g_client_stop.store(false);
+    std::signal(SIGINT, onClientSignal);
+    std::signal(SIGTERM, onClientSignal);
     auto result = runHeadset(hc, inputs->scene, inputs->bvh, inputs->traces);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
     if (!result) {
         std::fprintf(stderr, "qvr client: %s\n", result.error().c_str());
         return 1;
     }
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
     const std::filesystem::path out(o.out);
     if (auto st = writeTelemetryCsv((out / "telemetry.csv").string(), o.design, result->frames);
         !st) {
@@ -101,6 +126,9 @@ int runClient(const ClientCmdOptions& o) {
     const DesignSummary& s = result->summary;
     const HeadsetStats& st = result->stats;
     nlohmann::json j = {{"design", s.design},
+                        {"frames", s.frames},
+                        {"frames_requested", o.frames},
+                        {"interrupted", g_client_stop.load()},
                         {"fps_mean", s.fps_mean},
                         {"mtp_ms_mean", s.mtp_ms_mean},
                         {"mtp_ms_p99", s.mtp_ms_p99},
@@ -112,8 +140,14 @@ int runClient(const ClientCmdOptions& o) {
                         {"connects", st.connects},
                         {"connect_failures", st.connect_failures},
                         {"server_proof_failures", st.net.server_proof_failures},
+                        {"incompatible_refusals", st.net.incompatible_refusals},
                         {"media_drops", st.net.media_drops.total()},
-                        {"control_drops", st.net.control_drops.total()}};
+                        {"control_drops", st.net.control_drops.total()},
+                        {"key_frame_requests", st.key_frame_requests},
+                        {"nacks_sent", st.net.assembler.nacks},
+                        {"packets_nacked", st.net.assembler.packets_nacked},
+                        {"packets_recovered", st.net.assembler.packets_recovered},
+                        {"streams_lost", st.streams_lost}};
     std::ofstream(out / "summary.json") << j.dump(2) << "\n";
     fmt::print(
         "qvr client: {} fps {:.1f}, MTP {:.1f} ms (p99 {:.1f}), {:.0f} B/frame, e1 {:.1f} deg, "
@@ -123,6 +157,11 @@ int runClient(const ClientCmdOptions& o) {
         st.connect_failures);
     if (st.connects == 0 && st.net.server_proof_failures > 0)
         std::fprintf(stderr, "qvr client: the server did not prove the pre-shared key\n");
+    if (g_client_stop.load()) {
+        std::fprintf(stderr, "qvr client: interrupted: kept %zu of %d frames in %s\n",
+                     result->frames.size(), o.frames, o.out.c_str());
+        return 130;
+    }
     return 0;
 }
 

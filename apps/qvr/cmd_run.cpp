@@ -484,12 +484,17 @@ int runRun(const RunOptions& o) {
         std::fprintf(stderr, "qvr run: --profile: %s\n", profile.error().c_str());
         return 2;
     }
-    std::error_code ec;
-    fs::create_directories(o.out, ec);
-    if (ec) {
-        std::fprintf(stderr, "qvr run: cannot create '%s': %s\n", o.out.c_str(),
-                     ec.message().c_str());
-        return 1;
+    {
+        CodecConfig codec;
+        codec.backend = o.codec;
+        if (auto st = validateCodecConfig(codec); !st) {
+            std::fprintf(stderr, "qvr run: --codec: %s\n", st.error().c_str());
+            return 2;
+        }
+    }
+    if (std::string why; !makeOutputDir(o.out, why)) {
+        std::fprintf(stderr, "qvr run: --out: %s\n", why.c_str());
+        return 2;
     }
     const fs::path out(o.out);
     const auto t_start = std::chrono::steady_clock::now();

@@ -14,6 +14,7 @@
 
 #include "cli_parse.h"
 #include "commands.h"
+#include "qvr/codec/video_codec.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/render_server.h"
@@ -60,6 +61,29 @@ int runServer(const ServerCmdOptions& o) {
         std::fprintf(stderr, "qvr server: %s\n", key.error().c_str());
         return 2;
     }
+    if (!isIpAddress(o.bind)) {
+        std::fprintf(stderr, "qvr server: --bind: '%s' is not an IPv4 or IPv6 address\n",
+                     o.bind.c_str());
+        return 2;
+    }
+    if (!validDurationS(o.duration_s)) {
+        std::fprintf(stderr,
+                     "qvr server: --duration-s must be finite and in [0, 31536000], got %g\n",
+                     o.duration_s);
+        return 2;
+    }
+    {
+        CodecConfig codec;
+        codec.backend = o.codec;
+        if (auto st = validateCodecConfig(codec); !st) {
+            std::fprintf(stderr, "qvr server: --codec: %s\n", st.error().c_str());
+            return 2;
+        }
+    }
+    if (std::string why; !checkWritableFile(o.stats_json, why)) {
+        std::fprintf(stderr, "qvr server: --stats-json: %s\n", why.c_str());
+        return 2;
+    }
     auto profile = runtimeProfileByName(o.profile);
     if (!profile) {
         std::fprintf(stderr, "qvr server: --profile: %s\n", profile.error().c_str());
@@ -80,6 +104,9 @@ int runServer(const ServerCmdOptions& o) {
     cfg.net.port = o.port;
     cfg.net.key = *key;
     cfg.net.link = *link;
+    cfg.net.on_refusal = [](const std::string& why) {
+        std::fprintf(stderr, "qvr server: %s\n", why.c_str());
+    };
     cfg.profile = *profile;
     cfg.codec.backend = o.codec;
     cfg.core = o.core;
@@ -121,19 +148,39 @@ int runServer(const ServerCmdOptions& o) {
                                   {"key_frame_requests", s.key_frame_requests},
                                   {"render_ms_total", s.render_ms_total},
                                   {"encode_ms_total", s.encode_ms_total},
+                                  {"connections", s.net.connections},
+                                  {"clients_accepted", s.net.clients_accepted},
                                   {"auth_failures", s.net.auth_failures},
+                                  {"handshake_timeouts", s.net.handshake_timeouts},
+                                  {"refused_full", s.net.refused_full},
+                                  {"pending_evicted", s.net.pending_evicted},
+                                  {"idle_timeouts", s.net.idle_timeouts},
+                                  {"protocol_errors", s.net.protocol_errors},
+                                  {"version_mismatches", s.net.version_mismatches},
+                                  {"settings_refusals", s.net.settings_refusals},
+                                  {"nacks", s.net.nacks},
+                                  {"packets_retransmitted", s.net.packets_retransmitted},
                                   {"control_drops", s.net.control_drops.total()},
                                   {"core", o.core}};
         std::ofstream f(o.stats_json);
         f << j.dump(2) << "\n";
-        if (!f)
+        if (!f) {
             std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
+            return 1;
+        }
     }
     fmt::print(
         "qvr server: {} requests ({} dropped, {} invalid), {} frames, {} streams sent, {} auth "
         "failures, {} malformed control messages\n",
         s.requests, s.requests_dropped, s.requests_invalid, s.frames_rendered, s.streams_sent,
         s.net.auth_failures, s.net.control_drops.total());
+    fmt::print(
+        "qvr server: {} connections, {} sessions; {} handshake timeouts, {} idle timeouts, {} "
+        "evicted, {} refused full, {} protocol errors, {} version / {} settings refusals; {} "
+        "NACKs, {} packets retransmitted\n",
+        s.net.connections, s.net.clients_accepted, s.net.handshake_timeouts, s.net.idle_timeouts,
+        s.net.pending_evicted, s.net.refused_full, s.net.protocol_errors, s.net.version_mismatches,
+        s.net.settings_refusals, s.net.nacks, s.net.packets_retransmitted);
     return 0;
 }
 
