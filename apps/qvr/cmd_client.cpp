@@ -15,6 +15,7 @@
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/video_codec.h"
+#include "qvr/runtime/chrome_trace.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
@@ -47,6 +48,7 @@ struct ClientCmdOptions {
     int core = -1;
     uint64_t seed = 1;
     std::string out = "qvr-client";
+    std::string server_stamps;
     float lod_px = 1.0f;
 };
 
@@ -69,6 +71,11 @@ int runClient(const ClientCmdOptions& o) {
             std::fprintf(stderr, "qvr client: --codec: %s\n", st.error().c_str());
             return 2;
         }
+    }
+    if (!o.server_stamps.empty() && !std::ifstream(o.server_stamps)) {
+        std::fprintf(stderr, "qvr client: --server-stamps: cannot read '%s'\n",
+                     o.server_stamps.c_str());
+        return 2;
     }
     if (!makeOutputDir(o.out, why)) {
         std::fprintf(stderr, "qvr client: --out: %s\n", why.c_str());
@@ -148,6 +155,29 @@ int runClient(const ClientCmdOptions& o) {
                         {"packets_nacked", st.net.assembler.packets_nacked},
                         {"packets_recovered", st.net.assembler.packets_recovered},
                         {"streams_lost", st.streams_lost}};
+    // trace.json: the headset's stages, and the server's when its stamps file is given (a server
+    // on this machine: qvr server --stamps-csv F; read after the server has stopped or flushed).
+    std::vector<ServerFrameStamps> stamps;
+    if (!o.server_stamps.empty()) {
+        auto read = readServerStamps(o.server_stamps);
+        if (!read) {
+            std::fprintf(stderr, "qvr client: --server-stamps: %s\n", read.error().c_str());
+            return 2;
+        }
+        stamps = std::move(*read);
+    }
+    auto trace = writeChromeTrace(
+        (out / "trace.json").string(),
+        {{o.design, result->origin_ns, profile->refresh_hz, &result->frames}}, stamps);
+    if (!trace) {
+        std::fprintf(stderr, "qvr client: %s\n", trace.error().c_str());
+        return 1;
+    }
+    j["trace"] = {{"path", "trace.json"},
+                  {"events", trace->events},
+                  {"server_frames", trace->server_frames_matched},
+                  {"server_offset_ms", trace->offset.offset_ns * 1e-6},
+                  {"server_offset_bound_ms", trace->offset.bound_ns * 1e-6}};
     std::ofstream(out / "summary.json") << j.dump(2) << "\n";
     fmt::print(
         "qvr client: {} fps {:.1f}, MTP {:.1f} ms (p99 {:.1f}), {:.0f} B/frame, e1 {:.1f} deg, "
@@ -188,7 +218,9 @@ static Registered registerClient(CLI::App& app) {
     cmd->add_option("--core", o->core, "Pin the headset loop to this core (-1: no)")
         ->capture_default_str();
     cmd->add_option("--seed", o->seed, "Gaze model seed")->capture_default_str();
-    cmd->add_option("--out", o->out, "Output folder (telemetry.csv, summary.json)")
+    cmd->add_option("--server-stamps", o->server_stamps,
+                    "The server's --stamps-csv file: its stages go on trace.json's timeline");
+    cmd->add_option("--out", o->out, "Output folder (telemetry.csv, summary.json, trace.json)")
         ->capture_default_str();
     return {cmd, [o] { return runClient(*o); }};
 }

@@ -17,6 +17,7 @@
 #include "qvr/codec/video_codec.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/affinity.h"
+#include "qvr/runtime/chrome_trace.h"
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
@@ -45,6 +46,7 @@ struct ServerCmdOptions {
     int core = -1;
     double duration_s = 0.0;
     std::string stats_json;
+    std::string stamps_csv;
     bool one_pass_periphery = false;
     float lod_px = 1.0f;
 };
@@ -114,6 +116,29 @@ int runServer(const ServerCmdOptions& o) {
     GlRendererOptions gl;
     gl.lod_error_px = o.lod_px;
     cfg.renderer = glRendererFactory(gl);
+    // Per-frame stamps for timelines (qvr run's trace.json): one line per layer sent, on this
+    // process's steady clock; bounded so a long-running server cannot fill the disk.
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> stamps(nullptr, std::fclose);
+    if (!o.stamps_csv.empty()) {
+        stamps.reset(std::fopen(o.stamps_csv.c_str(), "w"));
+        if (!stamps) {
+            std::fprintf(stderr, "qvr server: --stamps-csv: cannot write '%s'\n",
+                         o.stamps_csv.c_str());
+            return 2;
+        }
+        std::fputs(kServerStampsHeader, stamps.get());
+        cfg.on_frame = [f = stamps.get(), lines = int64_t{0}](const ServerFrameStamps& st) mutable {
+            for (const ServerFrameStamps::Layer& l : st.layers) {
+                if (++lines > kMaxServerStampLines)
+                    return;
+                fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", st.client, st.frame_id,
+                           st.client_send_ns, st.queued_ns, st.start_ns, st.end_ns, l.stream_id,
+                           l.render_start_ns, l.render_end_ns, l.encode_end_ns, l.sent_ns);
+            }
+            // Whole frames on disk: a client on this machine reads the file while we run.
+            std::fflush(f);
+        };
+    }
     auto server = RenderServer::start(cfg, std::make_shared<const Scene>(std::move(*scene)));
     if (!server) {
         std::fprintf(stderr, "qvr server: %s\n", server.error().c_str());
@@ -134,6 +159,8 @@ int runServer(const ServerCmdOptions& o) {
     }
     const RenderServerStats s = (*server)->stats();
     (*server)->stop();
+    if (stamps && std::fflush(stamps.get()) != 0)
+        std::fprintf(stderr, "qvr server: error writing '%s'\n", o.stamps_csv.c_str());
     if (!o.stats_json.empty()) {
         const nlohmann::json j = {{"requests", s.requests},
                                   {"requests_dropped", s.requests_dropped},
@@ -204,6 +231,8 @@ static Registered registerServer(CLI::App& app) {
         ->capture_default_str();
     addLodOption(cmd, o->lod_px);
     cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit");
+    cmd->add_option("--stamps-csv", o->stamps_csv,
+                    "Write per-layer render/encode/send stamps (steady clock ns) here");
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
     cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")

@@ -150,6 +150,7 @@ public:
         HeadsetResult result;
         result.frames.reserve(static_cast<size_t>(std::max(m_config.frames, 0)));
         m_origin_ns = m_clock.nowNs();
+        result.origin_ns = m_origin_ns;
         m_pacer.reset();
         if (m_client)
             tryConnect(true);

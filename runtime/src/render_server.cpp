@@ -34,7 +34,11 @@ RendererFactory nullRendererFactory() {
 namespace {
 
 struct ClientState {
-    std::deque<net::FrameRequest> pending;  // guarded by Impl::mutex
+    struct Queued {
+        net::FrameRequest request;
+        int64_t queued_ns = 0;
+    };
+    std::deque<Queued> pending;  // guarded by Impl::mutex
     std::atomic<uint8_t> key_frame_mask{0};
     // Touched by the render thread only.
     std::array<std::unique_ptr<VideoEncoder>, net::kMaxStreams> encoders;
@@ -53,6 +57,12 @@ bool planFits(const HmdProfile& profile, const LayerPlan& plan) {
         if (!layerFits(profile, e.middle) || !layerFits(profile, e.outer))
             return false;
     return true;
+}
+
+int64_t steadyNs() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
 }
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -94,7 +104,7 @@ struct RenderServer::Impl final : net::ServerHandler {
             if (it == clients.end())
                 return;
             auto& q = it->second->pending;
-            q.push_back(request);
+            q.push_back({request, steadyNs()});
             while (q.size() > std::max<size_t>(config.max_pending_requests, 1)) {
                 q.pop_front();
                 ++stats.requests_dropped;
@@ -111,7 +121,8 @@ struct RenderServer::Impl final : net::ServerHandler {
     }
 
     // The next request, round robin over headsets; false when stopping.
-    bool next(net::ClientId& id, std::shared_ptr<ClientState>& state, net::FrameRequest& req) {
+    bool next(net::ClientId& id, std::shared_ptr<ClientState>& state, net::FrameRequest& req,
+              int64_t& queued_ns) {
         std::unique_lock lock(mutex);
         for (;;) {
             if (stopping)
@@ -123,7 +134,8 @@ struct RenderServer::Impl final : net::ServerHandler {
                 if (!pick->second->pending.empty()) {
                     id = pick->first;
                     state = pick->second;
-                    req = state->pending.front();
+                    req = state->pending.front().request;
+                    queued_ns = state->pending.front().queued_ns;
                     state->pending.pop_front();
                     last_served = id;
                     return true;
@@ -158,7 +170,16 @@ struct RenderServer::Impl final : net::ServerHandler {
         net::ClientId id = 0;
         std::shared_ptr<ClientState> state;
         net::FrameRequest req;
-        while (next(id, state, req)) {
+        int64_t queued_ns = 0;
+        ServerFrameStamps stamps;
+        while (next(id, state, req, queued_ns)) {
+            stamps.client = id;
+            stamps.frame_id = req.frame_id;
+            stamps.client_send_ns = req.client_send_ns;
+            stamps.queued_ns = queued_ns;
+            stamps.start_ns = steadyNs();
+            stamps.layers.clear();
+            int64_t render_start_ns = 0, render_end_ns = 0;
             const LayerPlan plan = net::layerPlanOf(req);
             if (!planFits(config.profile, plan)) {
                 std::lock_guard lock(mutex);
@@ -185,7 +206,11 @@ struct RenderServer::Impl final : net::ServerHandler {
                     return;
                 }
                 delta.encode_ms_total += encoded->encode_ms;
+                const int64_t encode_end_ns = steadyNs();
                 const bool key = encoded->is_keyframe;
+                if (config.on_frame)  // stamped before the transport can deliver it
+                    stamps.layers.push_back(
+                        {sid, render_start_ns, render_end_ns, encode_end_ns, steadyNs()});
                 if (server->sendStream(id, req.frame_id, sid, key, std::move(encoded->bytes)))
                     ++delta.streams_sent;
                 else
@@ -195,9 +220,11 @@ struct RenderServer::Impl final : net::ServerHandler {
                 const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
                 if (config.one_pass_periphery && onePassPays(layers)) {
                     const auto t0 = std::chrono::steady_clock::now();
+                    render_start_ns = steadyNs();
                     auto rs = renderPeriphery(r, config.profile, plan, req.pose,
                                               static_cast<Eye>(eye), image, outer_image, scratch);
                     delta.render_ms_total += msSince(t0);
+                    render_end_ns = steadyNs();
                     if (!rs) {
                         delta.render_failures += 2;
                         continue;
@@ -214,9 +241,11 @@ struct RenderServer::Impl final : net::ServerHandler {
                     if (layerOf(layers, kind).empty())
                         continue;
                     const auto t0 = std::chrono::steady_clock::now();
+                    render_start_ns = steadyNs();
                     auto rs = renderLayer(r, config.profile, plan, req.pose, static_cast<Eye>(eye),
                                           kind, image);
                     delta.render_ms_total += msSince(t0);
+                    render_end_ns = steadyNs();
                     if (!rs) {
                         ++delta.render_failures;
                         continue;
@@ -224,6 +253,10 @@ struct RenderServer::Impl final : net::ServerHandler {
                     ++delta.layers_rendered;
                     send(net::streamId(eye, layer), image);
                 }
+            }
+            if (config.on_frame) {
+                stamps.end_ns = steadyNs();
+                config.on_frame(stamps);
             }
             std::lock_guard lock(mutex);
             ++stats.frames_rendered;

@@ -33,6 +33,43 @@ assert "<source src='qvr_display.mp4' type='video/mp4'>" in html, "no video elem
 assert "<img src='qvr_display_still.png'" in html, "no still"
 for key in ["fps_mean", "mtp_ms_mean", "frames_displayed"]:
     assert key in d["designs"]["local"], key
+# trace.json: Chrome trace events; every frame's stages in order on one (the headset's) clock.
+t = json.load(open(os.path.join(out, "trace.json")))
+assert d["trace"]["events"] == len(t["traceEvents"]), (d["trace"], len(t["traceEvents"]))
+assert d["trace"]["server_frames"] > 0, d["trace"]
+assert abs(d["trace"]["server_offset_ms"]) <= d["trace"]["server_offset_bound_ms"] + 1.0, d["trace"]
+stages = {}  # (design pid, frame) -> stage -> [start, end] in µs
+flows = {"s": 0, "f": 0}
+for e in t["traceEvents"]:
+    if e["ph"] in flows:
+        flows[e["ph"]] += 1
+    if e["ph"] != "X":
+        continue
+    assert e["dur"] >= 0 and e["ts"] >= -1e3, e
+    design = (e["pid"] - 1) // 2
+    side = "server" if e["pid"] % 2 == 0 else "headset"
+    key = (design, e["args"]["frame"])
+    stage = side + ":" + e["name"].split(" ")[0]
+    a = stages.setdefault(key, {}).setdefault(stage, [e["ts"], e["ts"] + e["dur"]])
+    a[0] = min(a[0], e["ts"]); a[1] = max(a[1], e["ts"] + e["dur"])
+assert len({k[0] for k in stages}) == 2, "both designs on the timeline"
+assert flows["s"] == flows["f"] == 24, flows
+order = ["headset:decide", "headset:request", "server:queued", "server:render", "server:encode",
+         "server:send", "headset:receive", "headset:decode"]
+checked = 0
+for key, s in stages.items():
+    assert "headset:decide" in s and "headset:scan-out" in s, (key, sorted(s))
+    assert s["headset:decide"][0] <= s["headset:render"][0], (key, s)
+    assert s["headset:UCA"][1] <= s["headset:scan-out"][0] + 1e-3, (key, s)
+    present = [st for st in order if st in s]
+    for a, b in zip(present, present[1:]):
+        assert s[a][0] <= s[b][0] + 1e-3, ("frame", key, a, "after", b, s)
+    if "server:send" in s and "headset:receive" in s:
+        assert s["server:send"][1] <= s["headset:receive"][1] + 1e-3, (key, s)
+        checked += 1
+assert checked >= 10, checked
+print("PASS: trace.json holds %d frames, stages in order; server offset %+.3f ms +- %.3f ms"
+      % (len(stages), d["trace"]["server_offset_ms"], d["trace"]["server_offset_bound_ms"]))
 print("PASS: qvr run writes qvr_display.mp4 (%s, %d frames) and a report without JSON dumps"
       % (v["codec"], v["frames"]))
 PY

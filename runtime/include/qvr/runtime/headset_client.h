@@ -94,6 +94,7 @@ struct HeadsetStats {
 };
 
 struct HeadsetResult {
+    int64_t origin_ns = 0;  // the pacing clock at the run's start: telemetry's 0
     std::vector<FrameTelemetry> frames;
     HeadsetStats stats;
     DesignSummary summary;

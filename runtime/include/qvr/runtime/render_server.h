@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "qvr/codec/video_codec.h"
 #include "qvr/core/expected.h"
@@ -23,6 +24,25 @@ using RendererFactory = std::function<Expected<std::unique_ptr<Renderer>>()>;
 RendererFactory glRendererFactory(GlRendererOptions options = {});
 RendererFactory nullRendererFactory();
 
+// When and how long the server worked on one request, on the server's steady clock (ns since
+// the clock's epoch, CLOCK_MONOTONIC): for timelines (trace.json, docs/RUNTIME.md).
+struct ServerFrameStamps {
+    uint64_t client = 0;          // the transport's id of the headset
+    uint32_t frame_id = 0;        // the request's frame id
+    uint64_t client_send_ns = 0;  // echoed from the request (the headset's pose sample)
+    int64_t queued_ns = 0;        // the request was queued
+    int64_t start_ns = 0;         // the render thread took it
+    int64_t end_ns = 0;           // its last stream was handed to the transport
+    struct Layer {
+        uint8_t stream_id = 0;
+        int64_t render_start_ns = 0;
+        int64_t render_end_ns = 0;
+        int64_t encode_end_ns = 0;
+        int64_t sent_ns = 0;  // about to be handed to the transport (and its link emulator)
+    };
+    std::vector<Layer> layers;
+};
+
 struct RenderServerConfig {
     net::ServerOptions net;
     HmdProfile profile;  // must be the headsets' profile: requests larger than it are refused
@@ -36,6 +56,8 @@ struct RenderServerConfig {
     // displays); with LOD at the paper's display the extended grid's fill costs more than the
     // second pass saves (docs/RUNTIME.md), so it is off by default.
     bool one_pass_periphery = false;
+    // Called on the render thread after each rendered request (keep it cheap).
+    std::function<void(const ServerFrameStamps&)> on_frame;
 };
 
 struct RenderServerStats {
