@@ -57,9 +57,11 @@ touch "$tmp/a_file"
 expect_exit2 "client --out under a file" client "${K[@]}" --frames 3 --out "$tmp/a_file/sub"
 expect_exit2 "client --frames 0" client "${K[@]}" --frames 0 --out "$tmp/c"
 expect_exit2 "client --profile bogus" client "${K[@]}" --profile bogus --frames 3 --out "$tmp/c"
+expect_exit2 "client --server-stamps /nonexistent" client "${K[@]}" --server-stamps /nonexistent.csv --frames 3 --out "$tmp/c"
 
 expect_exit2 "server --stats-json into a missing folder" server "${K[@]}" --port 0 --duration-s 1 --stats-json "$tmp/missing/stats.json"
 expect_exit2 "server --stats-json a folder" server "${K[@]}" --port 0 --duration-s 1 --stats-json "$tmp"
+expect_exit2 "server --stamps-csv into a missing folder" server "${K[@]}" --port 0 --duration-s 1 --stamps-csv "$tmp/missing/stamps.csv"
 for d in -5 nan 1e300 inf; do
     expect_exit2 "server --duration-s $d" server "${K[@]}" --port 0 --duration-s "$d"
 done
