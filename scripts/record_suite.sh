@@ -44,8 +44,15 @@ plan=()
 seed=1
 for i in "${!levels[@]}"; do
     level="${levels[$i]}"
-    base="oa-${level//_/-}"
-    base="${base/oa-oa-/oa-}"
+    if [[ "$level" == *:* ]]; then
+        # A scene named in full (builtin:room): its name after the colon.
+        base="${level##*:}"
+        base="${base##*/}"
+        base="${base%.*}"
+    else
+        base="oa-${level//_/-}"
+        base="${base/oa-oa-/oa-}"
+    fi
     motion="${motions[$((i % 3))]}"
     plan+=("$base-h $level default $motion $seed")
     seed=$((seed + 1))
@@ -59,7 +66,9 @@ record() {
     local name="$1" level="$2" profile="$3" motion="$4" gaze_seed="$5"
     local start end
     start=$(date +%s)
-    "$qvr" trace record --scene "openarena:$level" --profile "$profile" --motion "$motion" \
+    local scene="openarena:$level"
+    [[ "$level" == *:* ]] && scene="$level"
+    "$qvr" trace record --scene "$scene" --profile "$profile" --motion "$motion" \
         --gaze-seed "$gaze_seed" --frames "$frames" --name "$name" \
         --out "$out/$name.jsonl.part" > "$out/$name.log" 2>&1
     mv "$out/$name.jsonl.part" "$out/$name.jsonl"

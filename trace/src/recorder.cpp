@@ -186,6 +186,9 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
     const size_t n_scales = options.scales.size();
     // Persistent streams, so P-frames predict from the previous frame as they would on the wire.
     std::array<std::vector<std::unique_ptr<VideoEncoder>>, 2> colour_enc;
+    std::array<std::vector<std::unique_ptr<VideoEncoder>>, 2> lossless_enc;
+    CodecConfig lossless = codec;
+    lossless.crf = 0;
     std::array<std::array<std::unique_ptr<VideoEncoder>, 2>, 2> depth_enc;
     for (int eye = 0; eye < 2; ++eye) {
         for (size_t s = 0; s < n_scales; ++s) {
@@ -193,6 +196,12 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
             if (!e)
                 return makeError(fmt::format("encoder: {}", e.error()));
             colour_enc[static_cast<size_t>(eye)].push_back(std::move(*e));
+            if (options.record_lossless) {
+                auto l = makeVideoEncoder(lossless);
+                if (!l)
+                    return makeError(fmt::format("lossless encoder: {}", l.error()));
+                lossless_enc[static_cast<size_t>(eye)].push_back(std::move(*l));
+            }
         }
         for (int p = 0; p < 2; ++p) {
             auto e = makeVideoEncoder(codec);
@@ -225,11 +234,13 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
         "recorded {} spawn {} by {}; motion {}; gaze {}; tri: BVH frustum counts per ring, both "
         "eyes; pix: fragments passing an early depth test in draw order, both faces (CPU z-buffer "
         "at 1/{} resolution); bpp: x264 {} crf {} keyint {}, one stream per eye and scale, the "
-        "full frame box-halved from the scale-1 render, 24-byte frame headers included; static: "
+        "full frame box-halved from the scale-1 render, 24-byte frame headers included; "
+        "bpp_lossless: {}the same streams at crf 0 (x264 lossless, the paper's setting); static: "
         "nearest {} visible non-flat objects (batch x {} m cells) by bounds distance, bg = the "
         "scale-1 frame, depth = 16 bits as two 8-bit planes (high, folded low) at 1/{} resolution",
         scene.name, options.spawn, renderer.name(), inputs.motion_source, inputs.gaze_source, r,
-        codec.preset, codec.crf, codec.keyint_frames, options.foreground_objects,
+        codec.preset, codec.crf, codec.keyint_frames, options.record_lossless ? "" : "not recorded; ",
+        options.foreground_objects,
         options.object_cell_m, r);
     h.profile = profile;
     h.ring_deg = options.ring_deg;
@@ -264,6 +275,7 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
         f.triangles_per_ring.assign(static_cast<size_t>(options.rings), 0.0);
         f.pixels_per_ring.assign(static_cast<size_t>(options.rings), 0.0);
         std::vector<double> bytes(n_scales, 0.0), pixels(n_scales, 0.0);
+        std::vector<double> lossless_bytes(n_scales, 0.0);
         double depth_bytes = 0.0;
 
         for (size_t p = 0; p < directions.size(); ++p) {
@@ -299,6 +311,13 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
                     return makeError(
                         fmt::format("frame {}: encode at scale {}: {}", n, s, encoded.error()));
                 bytes[next] += static_cast<double>(encoded->bytes.size());
+                if (options.record_lossless) {
+                    auto exact = lossless_enc[static_cast<size_t>(e)][next]->encode(*current);
+                    if (!exact)
+                        return makeError(fmt::format("frame {}: lossless encode at scale {}: {}",
+                                                     n, s, exact.error()));
+                    lossless_bytes[next] += static_cast<double>(exact->bytes.size());
+                }
                 pixels[next] += static_cast<double>(current->width()) * current->height();
                 ++next;
             }
@@ -325,6 +344,12 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
             v = std::round(v);
         for (size_t s = 0; s < n_scales; ++s)
             f.bits_per_pixel.push_back(roundSignificant(bytes[s] * 8.0 / pixels[s], 4));
+        if (options.record_lossless) {
+            for (size_t s = 0; s < n_scales; ++s)
+                f.bits_per_pixel_lossless.push_back(
+                    roundSignificant(lossless_bytes[s] * 8.0 / pixels[s], 4));
+            f.static_split.bg_bytes_lossless = lossless_bytes[0];
+        }
 
         // §6.1's interactive objects: the visible objects nearest the head by bounds distance.
         // Flat pieces (floor, wall and ceiling cells) are architecture, not objects a player

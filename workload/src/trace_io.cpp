@@ -227,6 +227,9 @@ bool parseFrame(const json& j, const WorkloadHeader& h, WorkloadFrame& f, FieldR
         !r.array(j, "pix", f.pixels_per_ring, rings, rings) ||
         !r.array(j, "bpp", f.bits_per_pixel, h.scales.size(), h.scales.size()))
         return false;
+    if (j.contains("bpp_lossless") &&
+        !r.array(j, "bpp_lossless", f.bits_per_pixel_lossless, h.scales.size(), h.scales.size()))
+        return false;
     const json* st = nullptr;
     if (!r.object(j, "static", st))
         return false;
@@ -234,7 +237,8 @@ bool parseFrame(const json& j, const WorkloadHeader& h, WorkloadFrame& f, FieldR
     return r.number(*st, "fg_tri", s.fg_triangles, 0, 1e12) &&
            r.number(*st, "fg_frac", s.fg_screen_fraction, 0, 1) &&
            r.number(*st, "bg_bytes", s.bg_bytes, 0, 1e12) &&
-           r.number(*st, "depth_bytes", s.depth_bytes, 0, 1e12);
+           r.number(*st, "depth_bytes", s.depth_bytes, 0, 1e12) &&
+           r.number(*st, "bg_bytes_lossless", s.bg_bytes_lossless, 0, 1e12, false);
 }
 
 json vec(const std::vector<double>& v) {
@@ -348,6 +352,10 @@ void WorkloadTraceWriter::writeFrame(const WorkloadFrame& f) {
                 {"fg_frac", f.static_split.fg_screen_fraction},
                 {"bg_bytes", f.static_split.bg_bytes},
                 {"depth_bytes", f.static_split.depth_bytes}}}};
+    if (!f.bits_per_pixel_lossless.empty())
+        j["bpp_lossless"] = vec(f.bits_per_pixel_lossless);
+    if (f.static_split.bg_bytes_lossless >= 0.0)
+        j["static"]["bg_bytes_lossless"] = f.static_split.bg_bytes_lossless;
     m_out << j.dump() << '\n';
     m_out.flush();
 }

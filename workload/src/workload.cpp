@@ -104,6 +104,11 @@ Status validateFrame(const WorkloadHeader& h, const WorkloadFrame& f, double pre
         return makeError("'pix' values must be finite and non-negative");
     if (!finiteNonNegative(f.bits_per_pixel))
         return makeError("'bpp' values must be finite and non-negative");
+    if (!f.bits_per_pixel_lossless.empty() && f.bits_per_pixel_lossless.size() != h.scales.size())
+        return makeError(fmt::format("{} lossless bits-per-pixel values, header has {} scales",
+                                     f.bits_per_pixel_lossless.size(), h.scales.size()));
+    if (!finiteNonNegative(f.bits_per_pixel_lossless))
+        return makeError("'bpp_lossless' values must be finite and non-negative");
     if (!std::isfinite(f.time_ms) || f.time_ms < previous_time_ms)
         return makeError("'t_ms' (time_ms) must be finite and non-decreasing");
     if (!std::isfinite(f.gaze.x_deg) || !std::isfinite(f.gaze.y_deg) ||
@@ -113,6 +118,46 @@ Status validateFrame(const WorkloadHeader& h, const WorkloadFrame& f, double pre
     if (!finiteNonNegative({s.fg_triangles, s.bg_bytes, s.depth_bytes}) ||
         !(s.fg_screen_fraction >= 0.0 && s.fg_screen_fraction <= 1.0))
         return makeError("static split values must be finite, non-negative, fraction in [0, 1]");
+    return Status::success();
+}
+
+Expected<CodecModel> parseCodecModel(const std::string& name) {
+    if (name == "stream")
+        return CodecModel::kStream;
+    if (name == "lossless")
+        return CodecModel::kLossless;
+    return makeError(
+        fmt::format("codec model '{}': expected lossless (the paper's, §2.3) or stream", name));
+}
+
+const char* codecModelName(CodecModel model) {
+    return model == CodecModel::kLossless ? "lossless" : "stream";
+}
+
+bool hasLosslessCodec(const WorkloadTrace& trace) {
+    if (trace.frames.empty())
+        return false;
+    for (const WorkloadFrame& f : trace.frames) {
+        if (f.bits_per_pixel_lossless.size() != trace.header.scales.size() ||
+            f.static_split.bg_bytes_lossless < 0.0)
+            return false;
+    }
+    return true;
+}
+
+Status applyCodecModel(WorkloadTrace& trace, CodecModel model) {
+    if (model == CodecModel::kStream)
+        return Status::success();
+    if (!hasLosslessCodec(trace))
+        return makeError(fmt::format(
+            "workload '{}' has no lossless codec measurements (bpp_lossless, "
+            "static.bg_bytes_lossless); record it again with qvr trace record, or use "
+            "--codec-model stream",
+            trace.header.name));
+    for (WorkloadFrame& f : trace.frames) {
+        f.bits_per_pixel = f.bits_per_pixel_lossless;
+        f.static_split.bg_bytes = f.static_split.bg_bytes_lossless;
+    }
     return Status::success();
 }
 

@@ -44,6 +44,10 @@ struct RecordOptions {
     int foreground_objects = 1;  // the nearest visible objects form the static design's foreground
     double flat_object_m = 0.1;  // objects thinner than this on some axis are architecture
     CodecConfig codec;
+    // The paper's codec setting (§2.3: "streamed with lossless H.264"), measured beside `codec`
+    // as its own persistent streams per eye and scale: `codec` with CRF 0, which x264 codes
+    // losslessly (of the 4:2:0 image it is given). Off: the trace has no bpp_lossless.
+    bool record_lossless = true;
     SceneLoadOptions scene_options;
 };
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "qvr/core/expected.h"
 #include "qvr/core/pose.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/foveation/hmd_profile.h"
@@ -27,6 +28,8 @@ struct StaticSplit {
     double fg_screen_fraction = 0.0;  // share of the full frame's pixels the foreground covers
     double bg_bytes = 0.0;            // encoded background, both eyes, full resolution
     double depth_bytes = 0.0;         // encoded depth the composition needs, both eyes
+    // The background in the paper's codec setting (lossless H.264, §2.3); < 0: not recorded.
+    double bg_bytes_lossless = -1.0;
 };
 
 struct WorkloadFrame {
@@ -41,6 +44,9 @@ struct WorkloadFrame {
     std::vector<double> pixels_per_ring;
     // Encoded bits per layer pixel of the periphery at each of the header's scales.
     std::vector<double> bits_per_pixel;
+    // The same in the paper's codec setting (lossless H.264, §2.3: "streamed with lossless
+    // H.264"); empty when the trace did not record it (docs/RECORDING.md).
+    std::vector<double> bits_per_pixel_lossless;
     StaticSplit static_split;
 };
 
@@ -75,6 +81,17 @@ struct PeripheryBytes {
 };
 PeripheryBytes peripheryBytes(const WorkloadHeader& header, const WorkloadFrame& frame,
                               const LayerPlan& plan);
+
+// Which recorded codec setting periphery and background bytes come from (docs/MODEL.md):
+// `stream` = our low-latency x264 setting (CRF 23), `lossless` = the paper's (§2.3).
+enum class CodecModel { kStream, kLossless };
+Expected<CodecModel> parseCodecModel(const std::string& name);
+const char* codecModelName(CodecModel model);
+// True when every frame carries the lossless measurements.
+bool hasLosslessCodec(const WorkloadTrace& trace);
+// Puts the chosen setting's measurements into bits_per_pixel and static_split.bg_bytes (the
+// fields every consumer reads). kLossless on a trace without them is an error naming the trace.
+Status applyCodecModel(WorkloadTrace& trace, CodecModel model);
 
 // Checks the invariants the reader enforces (sizes, finiteness, signs, monotonic time); used
 // by the generator and the recorder before they write.
