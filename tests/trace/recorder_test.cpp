@@ -96,7 +96,13 @@ TEST(Recorder, RecordsAValidTraceOfTheBuiltinRoomWithOpenGl) {
         EXPECT_GT(f.static_split.fg_screen_fraction, 0.0);
         EXPECT_LT(f.static_split.fg_screen_fraction, 1.0);
         coarse_over_fine += f.bits_per_pixel[3] / f.bits_per_pixel[0];
+        // The paper's setting (lossless) beside ours: every scale costs more bits losslessly.
+        ASSERT_EQ(f.bits_per_pixel_lossless.size(), f.bits_per_pixel.size());
+        for (size_t s = 0; s < f.bits_per_pixel.size(); ++s)
+            EXPECT_GT(f.bits_per_pixel_lossless[s], f.bits_per_pixel[s]) << "scale " << s;
+        EXPECT_GT(f.static_split.bg_bytes_lossless, f.static_split.bg_bytes);
     }
+    EXPECT_TRUE(hasLosslessCodec(*trace));
     // A coarser layer packs more detail into each pixel: more bits per pixel at scale 8 than at 1.
     EXPECT_GT(coarse_over_fine / 6.0, 1.2);
     // The first frame is a key frame; later ones predict from it and cost fewer bytes.

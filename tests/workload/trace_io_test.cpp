@@ -137,6 +137,8 @@ void expectSameTrace(const WorkloadTrace& a, const WorkloadTrace& b) {
         EXPECT_EQ(fa.static_split.fg_screen_fraction, fb.static_split.fg_screen_fraction);
         EXPECT_EQ(fa.static_split.bg_bytes, fb.static_split.bg_bytes);
         EXPECT_EQ(fa.static_split.depth_bytes, fb.static_split.depth_bytes);
+        EXPECT_EQ(fa.bits_per_pixel_lossless, fb.bits_per_pixel_lossless);
+        EXPECT_EQ(fa.static_split.bg_bytes_lossless, fb.static_split.bg_bytes_lossless);
     }
 }
 
@@ -530,6 +532,48 @@ TEST(LoadWorkloadTrace, NamesPathWhenFileIsMissing) {
     auto r = loadWorkloadTrace("/nonexistent/qvr/trace.jsonl");
     ASSERT_FALSE(r.ok());
     EXPECT_THAT(r.error(), HasSubstr("/nonexistent/qvr/trace.jsonl"));
+}
+
+// The paper's codec setting (lossless, §2.3) recorded beside ours: it reads back, replaces the
+// streaming bytes only when asked, and a trace without it or with a malformed one is an error.
+TEST(WorkloadCodecModel, ReadsLosslessBytesAndAppliesThemOnlyWhenAsked) {
+    WorkloadTrace t = handMadeTrace();
+    EXPECT_FALSE(hasLosslessCodec(t));
+    for (auto& f : t.frames) {
+        for (double b : f.bits_per_pixel)
+            f.bits_per_pixel_lossless.push_back(40.0 * b);
+        f.static_split.bg_bytes_lossless = 1.5e6;
+    }
+    auto back = readText(writeTrace(t));
+    ASSERT_TRUE(back) << back.error();
+    expectSameTrace(t, *back);
+    ASSERT_TRUE(hasLosslessCodec(*back));
+    WorkloadTrace stream = *back;
+    ASSERT_TRUE(applyCodecModel(stream, CodecModel::kStream));
+    EXPECT_EQ(stream.frames[1].bits_per_pixel, t.frames[1].bits_per_pixel);
+    ASSERT_TRUE(applyCodecModel(*back, CodecModel::kLossless));
+    EXPECT_EQ(back->frames[1].bits_per_pixel, t.frames[1].bits_per_pixel_lossless);
+    EXPECT_EQ(back->frames[2].static_split.bg_bytes, 1.5e6);
+    EXPECT_EQ(back->frames[2].static_split.depth_bytes, t.frames[2].static_split.depth_bytes);
+}
+
+TEST(WorkloadCodecModel, FailsWhenLosslessIsMissingMalformedOrUnknown) {
+    WorkloadTrace t = handMadeTrace();
+    const Status missing = applyCodecModel(t, CodecModel::kLossless);
+    ASSERT_FALSE(missing);
+    EXPECT_THAT(missing.error(), HasSubstr("no lossless"));
+    EXPECT_FALSE(parseCodecModel("h265"));
+    EXPECT_EQ(*parseCodecModel("lossless"), CodecModel::kLossless);
+    EXPECT_EQ(*parseCodecModel("stream"), CodecModel::kStream);
+
+    auto lines = validLines();
+    const auto at = lines[2].find("\"bpp\":[");
+    lines[2].insert(at, "\"bpp_lossless\":[1,2],");
+    expectErrorAtLine(joinLines(lines), 3, "bpp_lossless");
+    lines = validLines();
+    const auto st = lines[1].find("\"static\":{") + 10;
+    lines[1].insert(st, "\"bg_bytes_lossless\":-5,");
+    expectErrorAtLine(joinLines(lines), 2, "bg_bytes_lossless");
 }
 
 }  // namespace

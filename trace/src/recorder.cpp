@@ -239,8 +239,8 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
         "nearest {} visible non-flat objects (batch x {} m cells) by bounds distance, bg = the "
         "scale-1 frame, depth = 16 bits as two 8-bit planes (high, folded low) at 1/{} resolution",
         scene.name, options.spawn, renderer.name(), inputs.motion_source, inputs.gaze_source, r,
-        codec.preset, codec.crf, codec.keyint_frames, options.record_lossless ? "" : "not recorded; ",
-        options.foreground_objects,
+        codec.preset, codec.crf, codec.keyint_frames,
+        options.record_lossless ? "" : "not recorded; ", options.foreground_objects,
         options.object_cell_m, r);
     h.profile = profile;
     h.ring_deg = options.ring_deg;
@@ -314,8 +314,8 @@ Expected<RecordResult> recordWorkload(const RecordOptions& options, const Record
                 if (options.record_lossless) {
                     auto exact = lossless_enc[static_cast<size_t>(e)][next]->encode(*current);
                     if (!exact)
-                        return makeError(fmt::format("frame {}: lossless encode at scale {}: {}",
-                                                     n, s, exact.error()));
+                        return makeError(fmt::format("frame {}: lossless encode at scale {}: {}", n,
+                                                     s, exact.error()));
                     lossless_bytes[next] += static_cast<double>(exact->bytes.size());
                 }
                 pixels[next] += static_cast<double>(current->width()) * current->height();

@@ -149,11 +149,11 @@ Status applyCodecModel(WorkloadTrace& trace, CodecModel model) {
     if (model == CodecModel::kStream)
         return Status::success();
     if (!hasLosslessCodec(trace))
-        return makeError(fmt::format(
-            "workload '{}' has no lossless codec measurements (bpp_lossless, "
-            "static.bg_bytes_lossless); record it again with qvr trace record, or use "
-            "--codec-model stream",
-            trace.header.name));
+        return makeError(
+            fmt::format("workload '{}' has no lossless codec measurements (bpp_lossless, "
+                        "static.bg_bytes_lossless); record it again with qvr trace record, or use "
+                        "--codec-model stream",
+                        trace.header.name));
     for (WorkloadFrame& f : trace.frames) {
         f.bits_per_pixel = f.bits_per_pixel_lossless;
         f.static_split.bg_bytes = f.static_split.bg_bytes_lossless;
