@@ -2,6 +2,7 @@
 // CSV, gnuplot figures, summary.json and report.html in one folder.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -28,11 +29,13 @@ struct EvalCliOptions {
     std::string hardware;
     std::string suite = "auto";  // auto: recorded when data/workloads is found, else synthetic
     std::string workloads;
+    std::string codec_model = "auto";  // auto: lossless when every recorded trace has it
 };
 
 std::string joinArgs(const EvalCliOptions& o) {
-    std::string s = fmt::format("qvr eval --suite {} --frames {} --jobs {} --out {}", o.suite,
-                                o.frames, o.jobs, o.out);
+    std::string s =
+        fmt::format("qvr eval --suite {} --codec-model {} --frames {} --jobs {} --out {}", o.suite,
+                    o.codec_model, o.frames, o.jobs, o.out);
     if (!o.mahimahi.empty())
         s += " --mahimahi";
     for (const auto& m : o.mahimahi)
@@ -93,6 +96,36 @@ int runEval(const EvalCliOptions& o) {
             return 2;
         }
     }
+    // The codec setting: the paper's (lossless, §2.3) when the suite recorded it.
+    CodecModel codec = CodecModel::kLossless;
+    if (o.codec_model != "auto") {
+        auto m = parseCodecModel(o.codec_model);
+        if (!m) {
+            std::fprintf(stderr, "qvr eval: --codec-model: %s\n", m.error().c_str());
+            return 2;
+        }
+        codec = *m;
+    }
+    for (const auto& b : suiteBenches()) {
+        if (!o.benches.empty() &&
+            std::find(o.benches.begin(), o.benches.end(), b.name) == o.benches.end())
+            continue;
+        auto t = makeSuiteBench(b.name, 1);
+        if (!t) {
+            std::fprintf(stderr, "qvr eval: %s\n", t.error().c_str());
+            return 2;
+        }
+        if (selectedSuite() == SuiteKind::kRecorded && !hasLosslessCodec(*t)) {
+            if (o.codec_model == "lossless") {
+                std::fprintf(stderr,
+                             "qvr eval: --codec-model lossless: %s has no lossless measurements "
+                             "(record it again with scripts/record_suite.sh)\n",
+                             b.name.c_str());
+                return 2;
+            }
+            codec = CodecModel::kStream;
+        }
+    }
     if (!o.hardware.empty()) {
         auto hw = loadHardwareConfig(o.hardware, 500.0);
         if (!hw) {
@@ -102,6 +135,7 @@ int runEval(const EvalCliOptions& o) {
     }
     EvalOptions opts;
     opts.hardware_path = o.hardware;
+    opts.codec_model = codec;
     opts.mahimahi_traces = o.mahimahi;
     opts.benches = o.benches;
     opts.frames = o.frames;
@@ -161,6 +195,11 @@ static Registered registerEval(CLI::App& app) {
     cmd->add_option("--workloads", o->workloads,
                     "Folder of the recorded suite (suite.txt + *.jsonl; default: data/workloads "
                     "above the working directory or the executable)");
+    cmd->add_option("--codec-model", o->codec_model,
+                    "Periphery and background bytes of the recorded suite: lossless (the paper's "
+                    "setting, §2.3), stream (our CRF 23), or auto (lossless when recorded); the "
+                    "report shows the other beside it")
+        ->capture_default_str();
     cmd->add_option("--hardware", o->hardware,
                     "TOML file overriding the modelled hardware's constants (docs/MODEL.md)");
     cmd->add_option("--mahimahi", o->mahimahi,

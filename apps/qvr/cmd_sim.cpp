@@ -34,6 +34,7 @@ struct SimOptions {
     std::string pipeline;  // "", "paper" or "runtime"
     int depth = 2;
     double wait_limit_ms = 250.0;
+    std::string codec_model = "auto";  // auto: lossless when the trace has it, else stream
 };
 
 // The runtime pipeline model (sim/runtime_model.h): frames.csv and summary.json of its own.
@@ -140,10 +141,24 @@ int runSim(const SimOptions& o) {
         std::fprintf(stderr, "qvr sim: %s\n", link.error().c_str());
         return 2;
     }
+    if (o.codec_model != "auto" && !parseCodecModel(o.codec_model)) {
+        std::fprintf(stderr, "qvr sim: --codec-model: %s\n",
+                     parseCodecModel(o.codec_model).error().c_str());
+        return 2;
+    }
     Expected<WorkloadTrace> trace =
         o.trace.empty() ? makeSuiteBench(o.bench, o.frames) : loadWorkloadTrace(o.trace);
     if (!trace) {
         std::fprintf(stderr, "qvr sim: %s\n", trace.error().c_str());
+        return 2;
+    }
+    // The paper's codec setting when the trace recorded it (docs/MODEL.md, "Codec").
+    const CodecModel codec =
+        o.codec_model == "auto"
+            ? (hasLosslessCodec(*trace) ? CodecModel::kLossless : CodecModel::kStream)
+            : *parseCodecModel(o.codec_model);
+    if (Status st = applyCodecModel(*trace, codec); !st) {
+        std::fprintf(stderr, "qvr sim: %s\n", st.error().c_str());
         return 2;
     }
     if (trace->frames.empty()) {
@@ -239,6 +254,10 @@ static Registered registerSim(CLI::App& app) {
     cmd->add_option("--wait-limit-ms", o->wait_limit_ms,
                     "Runtime pipeline: remote layers later than this are late (frame reuse)")
         ->check(CLI::Range(1.0, 10000.0))
+        ->capture_default_str();
+    cmd->add_option("--codec-model", o->codec_model,
+                    "Periphery bytes from the trace's lossless (the paper's, §2.3) or stream "
+                    "(CRF 23) measurements; auto: lossless when recorded")
         ->capture_default_str();
     cmd->add_option("--seed", o->seed, "Seed of the network noise")->capture_default_str();
     cmd->add_option("--out", o->out, "Output folder for frames.csv and summary.json")->required();

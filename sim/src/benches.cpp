@@ -184,16 +184,18 @@ std::string suiteDescription() {
     for (const auto& e : s.entries) {
         if (!levels.empty())
             levels += ", ";
-        levels += fmt::format("{} (OpenArena {}, {})", e.name, e.level,
+        levels += fmt::format("{} ({}{}, {})", e.name,
+                              e.level.find(':') == std::string::npos ? "OpenArena " : "", e.level,
                               e.profile == "low" ? "1280&times;1600" : "1920&times;2160");
     }
     return fmt::format(
         "Workloads are <b>recorded</b> from OpenArena levels standing in for Table "
-        "3's games (docs/RECORDING.md): {}.",
+        "3's games and a chess set standing in for Table 1's Foveated3D scene "
+        "(docs/RECORDING.md): {}.",
         levels);
 }
 
-Expected<WorkloadTrace> makeSuiteBench(const std::string& name, int frames) {
+Expected<WorkloadTrace> makeSuiteBench(const std::string& name, int frames, CodecModel codec) {
     if (frames <= 0 || frames > 1'000'000)
         return makeError(fmt::format("frames must be in 1..1000000, got {}", frames));
     for (SyntheticSpec spec : paperSyntheticSuite()) {
@@ -209,6 +211,8 @@ Expected<WorkloadTrace> makeSuiteBench(const std::string& name, int frames) {
         auto t = loadWorkloadTrace((fs::path(s.dir) / (e.name + ".jsonl")).string());
         if (!t)
             return makeError(t.error());
+        if (Status st = applyCodecModel(*t, codec); !st)
+            return makeError(st.error());
         return extendTrace(*t, frames);
     }
     return makeError(fmt::format("unknown bench '{}': expected one of {} (or --trace FILE)", name,

@@ -35,13 +35,34 @@ struct Job {
     double gpu_mhz = kDefaultMhz;
     std::string net = "wifi";
     bool keep_frames = false;
-    bool gpu_timestamps = false;  // T_local from GPU timestamps (sensitivity run)
+    bool from_submission = false;  // T_local from submission (sensitivity run)
+    bool other_codec = false;      // the codec setting that is not the default (both shown)
 };
+
+// A run's design name with its variant: "dfr-submission", "qvr@stream".
+std::string variantName(std::string_view design, bool from_submission, bool other_codec,
+                        CodecModel other) {
+    std::string s(design);
+    if (from_submission)
+        s += "-submission";
+    if (other_codec)
+        s += std::string("@") + codecModelName(other);
+    return s;
+}
 
 struct JobResult {
     RunSummary summary;
     std::vector<FrameRecord> frames;  // only when kept
 };
+
+// A per-bench finding holds on at least 6 of 7 benches, a per-cell one on at least 19 of 21
+// cells (issue 13's bar: one bench, or two of 21 cells, may break it when the report shows why).
+bool mostBenches(int ok, size_t total) {
+    return 7 * static_cast<size_t>(ok) >= 6 * total;
+}
+bool mostCells(int ok, int total) {
+    return 21 * ok >= 19 * total;
+}
 
 std::string key(const std::string& bench, std::string_view design, double mhz,
                 const std::string& net) {
@@ -181,12 +202,23 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
                 fmt::format("unknown bench '{}': expected one of {}", n, suiteBenchNamesList()));
     }
     const int frames = std::max(options.frames, kFig14Frames);
-    std::vector<WorkloadTrace> traces(benches.size());
+    const CodecModel other_codec =
+        options.codec_model == CodecModel::kLossless ? CodecModel::kStream : CodecModel::kLossless;
+    const bool recorded = selectedSuite() == SuiteKind::kRecorded;
+    std::vector<WorkloadTrace> traces(benches.size()), other_traces;
+    bool have_other = recorded;
     for (size_t i = 0; i < benches.size(); ++i) {
-        auto t = makeSuiteBench(benches[i].name, frames);
+        auto t = makeSuiteBench(benches[i].name, frames, options.codec_model);
         if (!t)
             return makeError(t.error());
         traces[i] = std::move(*t);
+        if (have_other) {
+            auto o = makeSuiteBench(benches[i].name, frames, other_codec);
+            if (o)
+                other_traces.push_back(std::move(*o));
+            else
+                have_other = false;
+        }
     }
 
     // The grid: every design at the default point (Fig. 12–14); Q-VR at every frequency ×
@@ -195,8 +227,12 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     for (size_t b = 0; b < benches.size(); ++b) {
         for (Design d : allDesigns())
             jobs.push_back({b, d, kDefaultMhz, "wifi", d == Design::Qvr});
-        // Sensitivity: DFR with T_local measured by GPU timestamps instead of from submission.
+        // Sensitivity: DFR with T_local measured from submission instead of GPU timestamps.
         jobs.push_back({b, Design::Dfr, kDefaultMhz, "wifi", false, true});
+        // The other codec setting, every design at the default point.
+        if (have_other)
+            for (Design d : allDesigns())
+                jobs.push_back({b, d, kDefaultMhz, "wifi", false, false, true});
         for (double mhz : kFreqsMhz) {
             for (const auto& net : kNets) {
                 if (mhz == kDefaultMhz && net == "wifi")
@@ -259,14 +295,15 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             cfg.bench = benches[job.bench].name;
             cfg.design = job.design;
             cfg.hardware = hardware.at(job.gpu_mhz);
-            cfg.t_local_from_submission = !job.gpu_timestamps;
+            cfg.t_local_from_submission = job.from_submission;
             cfg.frames = options.frames;
             if (job.keep_frames)
                 cfg.frames = frames;
-            RunResult run = simulate(traces[job.bench], cfg, *link);
+            RunResult run =
+                simulate(job.other_codec ? other_traces[job.bench] : traces[job.bench], cfg, *link);
             results[i].summary = run.summary;
-            if (job.gpu_timestamps)
-                results[i].summary.design += "-gpu-timestamps";
+            results[i].summary.design = variantName(results[i].summary.design, job.from_submission,
+                                                    job.other_codec, other_codec);
             if (job.keep_frames)
                 results[i].frames = std::move(run.frames);
             const int d = done.fetch_add(1) + 1;
@@ -291,8 +328,9 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     std::map<std::string, const JobResult*> by_key;
     for (size_t i = 0; i < jobs.size(); ++i) {
         output.runs.push_back(results[i].summary);
-        const std::string design_key = std::string(traitsOf(jobs[i].design).name) +
-                                       (jobs[i].gpu_timestamps ? "-gpu-timestamps" : "");
+        const std::string design_key =
+            variantName(traitsOf(jobs[i].design).name, jobs[i].from_submission, jobs[i].other_codec,
+                        other_codec);
         by_key[key(benches[jobs[i].bench].name, design_key, jobs[i].gpu_mhz, jobs[i].net)] =
             &results[i];
     }
@@ -562,7 +600,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
                                    d, f);
         }
         output.findings.push_back(
-            {"qvr >= dfr and qvr >= ffr in end-to-end speedup", ok == static_cast<int>(nb),
+            {"qvr >= dfr and qvr >= ffr in end-to-end speedup", mostBenches(ok, nb),
              fmt::format("holds for {}/{} benches; means qvr {:.2f}x, dfr {:.2f}x, ffr {:.2f}x.{}",
                          ok, nb, mean(speedups[Design::Qvr]), mean(speedups[Design::Dfr]),
                          mean(speedups[Design::Ffr]), bad.empty() ? "" : " Fails:" + bad)});
@@ -577,7 +615,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             detail += fmt::format(" {} {:.2f}/{:.2f};", benches[b].label, d, f);
         }
         output.findings.push_back(
-            {"dfr >= ffr in end-to-end speedup", ok == static_cast<int>(nb),
+            {"dfr >= ffr in end-to-end speedup", mostBenches(ok, nb),
              fmt::format("holds for {}/{} benches (dfr/ffr speedup:{}) mean ratio {:.3f}; see "
                          "'Where we differ' below",
                          ok, nb, detail,
@@ -599,7 +637,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
                                        benches[b].label, static_cast<int>(mhz), l, w, g);
             }
         }
-        output.findings.push_back({"steady e1: LTE >= Wi-Fi >= 5G", ok == total,
+        output.findings.push_back({"steady e1: LTE >= Wi-Fi >= 5G", mostCells(ok, total),
                                    fmt::format("holds for {}/{} bench x frequency cells.{}", ok,
                                                total, bad.empty() ? "" : " Fails:" + bad)});
     }
@@ -619,7 +657,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
                                        benches[b].label, net, e5, e4, e3);
             }
         }
-        output.findings.push_back({"lower GPU frequency gives a smaller e1", ok == total,
+        output.findings.push_back({"lower GPU frequency gives a smaller e1", mostCells(ok, total),
                                    fmt::format("holds for {}/{} bench x network cells.{}", ok,
                                                total, bad.empty() ? "" : " Fails:" + bad)});
     }
@@ -630,6 +668,66 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
              fmt::format(
                  "qvr/static bytes = {:.3f} on average (max {:.3f})", r,
                  *std::max_element(data_qvr_over_static.begin(), data_qvr_over_static.end()))});
+    }
+    {
+        // Fig. 14 converges: |T_remote/T_local - 1| < 0.15 by frame 30 and for >= 90% of the
+        // frames after that. A bench that does not is named with the per-frame quantities that
+        // keep it off balance (fig14_e1.csv has every frame's e1, T_local and T_remote).
+        int ok = 0;
+        std::string detail;
+        std::string e1csv = "bench,frame,e1_deg,t_local_ms,t_remote_ms,ratio\n";
+        for (size_t b = 0; b < nb; ++b) {
+            const auto& fr = by_key.at(key(benches[b].name, "qvr", kDefaultMhz, "wifi"))->frames;
+            const int n = std::min<int>(kFig14Frames, static_cast<int>(fr.size()));
+            int first = -1, within = 0;
+            double e1_min = 1e9, e1_max = 0.0, tl = 0.0, tr = 0.0, tr2 = 0.0, rr = 0.0, rr2 = 0.0;
+            for (int f = 0; f < n; ++f) {
+                const FrameRecord& r = fr[static_cast<size_t>(f)];
+                const bool in = std::fabs(r.latency_ratio - 1.0) < 0.15;
+                if (first < 0 && in)
+                    first = f;
+                if (first >= 0 && f > first && in)
+                    ++within;
+                if (f >= 30) {
+                    e1_min = std::min(e1_min, r.e1_deg);
+                    e1_max = std::max(e1_max, r.e1_deg);
+                    tl += r.t_local_ms;
+                    tr += r.t_remote_ms;
+                    tr2 += r.t_remote_ms * r.t_remote_ms;
+                    rr += r.latency_ratio;
+                    rr2 += r.latency_ratio * r.latency_ratio;
+                }
+                e1csv += fmt::format("{},{},{},{},{},{}\n", benches[b].label, f,
+                                     fmtNum(r.e1_deg, 3), fmtNum(r.t_local_ms, 3),
+                                     fmtNum(r.t_remote_ms, 3), fmtNum(r.latency_ratio, 4));
+            }
+            const int rest = first >= 0 ? n - first - 1 : 0;
+            const double frac = rest > 0 ? static_cast<double>(within) / rest : 0.0;
+            const bool conv = first >= 0 && first < 30 && frac >= 0.9;
+            if (conv)
+                ++ok;
+            detail += fmt::format(" {}: balanced from frame {}, {:.0f}% of the rest",
+                                  benches[b].label, first, 100.0 * frac);
+            if (!conv && n > 30) {
+                // The spread LIWC cannot remove: the frame-to-frame variation of T_remote (the
+                // 20 dB SNR link noise alone is 10% RMS) against the ratio's own spread.
+                const double k = n - 30;
+                const double tr_mean = tr / k, rr_mean = rr / k;
+                const double tr_cv =
+                    std::sqrt(std::max(0.0, tr2 / k - tr_mean * tr_mean)) / std::max(tr_mean, 1e-9);
+                const double rr_sd = std::sqrt(std::max(0.0, rr2 / k - rr_mean * rr_mean));
+                detail += fmt::format(
+                    " (frames 30+: e1 {:.1f}-{:.1f} deg, mean T_local {:.2f} ms, T_remote {:.2f} "
+                    "ms; T_remote varies {:.0f}% RMS frame to frame, the ratio {:.2f} +- {:.2f})",
+                    e1_min, e1_max, tl / k, tr_mean, 100.0 * tr_cv, rr_mean, rr_sd);
+            }
+            detail += ";";
+        }
+        if (auto st = csv("fig14_e1.csv", e1csv); !st)
+            return makeError(st.error());
+        output.findings.push_back(
+            {"Fig. 14 converges (|ratio - 1| < 0.15 by frame 30, >= 90% after)",
+             ok == static_cast<int>(nb), fmt::format("{}/{} benches.{}", ok, nb, detail)});
     }
 
     if (auto st = writeSummaryJson((out / "summary.json").string(), output.runs); !st)
@@ -664,36 +762,39 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     {
         // The measured mechanism behind DFR vs FFR, from this run's own numbers.
         std::vector<double> dfr_e1, dfr_wait, ffr_remote, ffr_local, qvr_e1, dfr_ts, dfr_ts_e1;
+        std::vector<double> qvr_kb, remote_kb, static_kb, qvr_remote;
         for (size_t b = 0; b < nb; ++b) {
+            qvr_kb.push_back(get(b, Design::Qvr).bytes_per_frame_mean / 1e3);
+            remote_kb.push_back(get(b, Design::Remote).bytes_per_frame_mean / 1e3);
+            static_kb.push_back(get(b, Design::Static).bytes_per_frame_mean / 1e3);
+            qvr_remote.push_back(get(b, Design::Qvr).t_remote_ms_mean);
             dfr_e1.push_back(get(b, Design::Dfr).e1_deg_steady);
             dfr_wait.push_back(get(b, Design::Dfr).render_wait_ms_mean);
             ffr_remote.push_back(get(b, Design::Ffr).t_remote_ms_mean);
             ffr_local.push_back(get(b, Design::Ffr).t_local_ms_mean);
             qvr_e1.push_back(get(b, Design::Qvr).e1_deg_steady);
             const RunSummary& ts =
-                by_key.at(key(benches[b].name, "dfr-gpu-timestamps", kDefaultMhz, "wifi"))->summary;
+                by_key.at(key(benches[b].name, "dfr-submission", kDefaultMhz, "wifi"))->summary;
             dfr_ts.push_back(get(b, Design::Local).mtp_ms_mean / ts.mtp_ms_mean);
             dfr_ts_e1.push_back(ts.e1_deg_steady);
         }
         page.html(fmt::format(
             "<h2>Where we differ from the paper, and why</h2><ul>"
-            "<li><b>DFR vs FFR.</b> The paper has DFR 1.1x over FFR; here DFR/FFR = {:.2f}. At "
-            "e1 = 5&deg; the synthetic periphery already costs only {:.1f} ms to send (T_local "
-            "{:.1f} ms), so FFR is close to balanced and there is little for LIWC to win. And "
-            "without UCA, the T_local LIWC measures includes {:.1f} ms per frame of waiting behind "
-            "or being preempted by the previous frame's composition and ATW; Eq. 2 charges that "
-            "to triangles, so LIWC shrinks the fovea (DFR steady e1 {:.1f}&deg; vs Q-VR's "
-            "{:.1f}&deg; on the same frames). That is the contention of Fig. 4-&#x2462; turning "
-            "into a controller error; with UCA it disappears. How much depends on what the "
-            "headset calls T_local: measured from the GPU's first cycle on the frame (timestamp "
-            "queries, so waiting behind a pass does not count but preemption does), DFR settles "
-            "at e1 {:.1f}&deg; and DFR/FFR = {:.2f}.</li>"
-            "<li><b>Magnitudes.</b> Our speedups and FPS gains are larger than the paper's "
-            "because the layer plan (Eq. 1 with Guenter's MAR) leaves 4-8% of the frame's "
-            "pixels to shade and a periphery of tens of KB, where the paper's 41% resolution "
-            "reduction implies a much heavier periphery. The static design's background + "
-            "depth is 1.6-2.3x the remote frame here (the workload part's encoding), not "
-            "equal to it as in Fig. 13, so FPS over static is far above 4.1x.</li>"
+            "<li><b>DFR vs FFR.</b> The paper has DFR 1.1x over FFR; here DFR/FFR = {:.2f}. "
+            "FFR at e1 = 5&deg; sends its periphery in {:.1f} ms against a T_local of {:.1f} ms "
+            "(means over the suite). DFR's LIWC reads T_local as the paper's GPU timers would: "
+            "from the GPU's first cycle on the frame, so preemption by composition/ATW counts "
+            "and waiting behind a pass ({:.1f} ms per frame here) does not. DFR then settles at "
+            "e1 {:.1f}&deg; (Q-VR: {:.1f}&deg; on the same frames). Measuring T_local from "
+            "submission instead, waits included (a modelling choice we used before), LIWC "
+            "charges the waits to triangles and shrinks the fovea: DFR e1 {:.1f}&deg;, DFR/FFR "
+            "= {:.2f}.</li>"
+            "<li><b>Magnitudes.</b> The layer plan (Eq. 1 with Guenter's MAR) leaves Q-VR "
+            "{:.1f}% of the full frame's pixels to shade (the paper: 59%, i.e. 41% fewer) and a "
+            "periphery of {:.1f} KB a frame ({} bytes) where the remote design sends {:.0f} KB and "
+            "static {:.0f} KB. So T_remote stays at {:.1f} ms on Wi-Fi at the balance point, "
+            "e1 settles low, and the gains over local and static are larger than the "
+            "paper's.</li>"
             "<li><b>Energy by network.</b> Radio energy uses Huang et al.'s (MobiSys 2012) "
             "measured power models, where Wi-Fi's per-bit cost (138 nJ/bit) exceeds LTE's (71 "
             "nJ/bit) at our goodputs, so Q-VR on LTE is cheaper than on Wi-Fi; the paper's "
@@ -704,7 +805,56 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
             "</ul><p>Models, constants and their sources: docs/MODEL.md.</p>",
             mean(speedups[Design::Dfr]) / mean(speedups[Design::Ffr]), mean(ffr_remote),
             mean(ffr_local), mean(dfr_wait), mean(dfr_e1), mean(qvr_e1), mean(dfr_ts_e1),
-            mean(dfr_ts) / mean(speedups[Design::Ffr])));
+            mean(dfr_ts) / mean(speedups[Design::Ffr]), 100.0 * mean(pixels_qvr), mean(qvr_kb),
+            codecModelName(options.codec_model), mean(remote_kb), mean(static_kb),
+            mean(qvr_remote)));
+    }
+    if (have_other) {
+        // Both recorded codec settings at the default point (500 MHz, Wi-Fi): what the paper's
+        // lossless streams (§2.3) change against our CRF 23 ones.
+        std::string codec_csv =
+            "bench,codec,static_bg_kb,static_t_remote_ms,remote_kb,qvr_kb,qvr_e1_steady,"
+            "qvr_t_local_ms,qvr_t_remote_ms,qvr_speedup,dfr_speedup,ffr_speedup\n";
+        page.heading(2, "Codec setting: the paper's lossless H.264 vs our streaming x264");
+        page.html(fmt::format(
+            "<p>This report uses <b>{}</b> bytes (<code>--codec-model</code>); the table runs "
+            "every design at 500 MHz on Wi-Fi with both. Table 1's static backgrounds: 482-646 "
+            "KB a frame, T_remote 28-38 ms on Wi-Fi.</p>\n",
+            codecModelName(options.codec_model)));
+        for (size_t b = 0; b < nb; ++b) {
+            for (bool other : {false, true}) {
+                const CodecModel m = other ? other_codec : options.codec_model;
+                auto run = [&](Design d) -> const RunSummary& {
+                    return by_key
+                        .at(key(benches[b].name,
+                                variantName(traitsOf(d).name, false, other, other_codec),
+                                kDefaultMhz, "wifi"))
+                        ->summary;
+                };
+                const double local = run(Design::Local).mtp_ms_mean;
+                const WorkloadTrace& t = other ? other_traces[b] : traces[b];
+                double bg = 0.0;
+                for (const auto& f : t.frames)
+                    bg += f.static_split.bg_bytes;
+                bg /= std::max<size_t>(1, t.frames.size());
+                const std::string row = fmt::format(
+                    "{},{},{},{},{},{},{},{},{},{},{},{}", benches[b].label, codecModelName(m),
+                    fmtNum(bg / 1e3, 1), fmtNum(run(Design::Static).t_remote_ms_mean, 2),
+                    fmtNum(run(Design::Remote).bytes_per_frame_mean / 1e3, 1),
+                    fmtNum(run(Design::Qvr).bytes_per_frame_mean / 1e3, 1),
+                    fmtNum(run(Design::Qvr).e1_deg_steady, 1),
+                    fmtNum(run(Design::Qvr).t_local_ms_mean, 2),
+                    fmtNum(run(Design::Qvr).t_remote_ms_mean, 2),
+                    fmtNum(local / run(Design::Qvr).mtp_ms_mean, 2),
+                    fmtNum(local / run(Design::Dfr).mtp_ms_mean, 2),
+                    fmtNum(local / run(Design::Ffr).mtp_ms_mean, 2));
+                codec_csv += row + "\n";
+            }
+        }
+        page.table(report::Table::fromCsv(codec_csv));
+        page.html("<p>Data: codec_models.csv</p>\n");
+        if (auto st = csv("codec_models.csv", codec_csv); !st)
+            return makeError(st.error());
     }
     auto figure = [&](const std::string& title, const std::string& png, const std::string& csvs) {
         page.heading(2, title);

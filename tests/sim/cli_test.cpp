@@ -87,6 +87,8 @@ TEST_F(Cli, SimRejectsBadInputWithStatusTwoAndAMessage) {
         {"eval --jobs 0" + out, "--jobs"},
         {"eval --bench doom9" + out, "unknown bench"},
         {"eval --frames 30 --mahimahi " + bad_trace.string() + out, "expected a non-negative"},
+        {"eval --codec-model h265" + out, "codec model"},
+        {"sim --bench doom3-h --codec-model lossy" + out, "codec model"},
     };
     for (const Case& c : cases) {
         const Outcome o = run(c.args);
@@ -127,6 +129,11 @@ TEST_F(Cli, SimReplaysARecordedTraceFileAndRejectsAMalformedOne) {
         run("sim --trace " + good.string() + " --design dfr --frames 25 --out " + m_out.string());
     EXPECT_EQ(ok.status, 0) << ok.err;
     EXPECT_TRUE(fs::exists(m_out / "frames.csv"));
+    // The synthetic trace has no lossless measurements: asking for them is bad input.
+    const Outcome no_lossless = run("sim --trace " + good.string() +
+                                    " --codec-model lossless --frames 25 --out " + m_out.string());
+    EXPECT_EQ(no_lossless.status, 2);
+    EXPECT_NE(no_lossless.err.find("no lossless"), std::string::npos) << no_lossless.err;
     {
         std::ofstream f(good);
         f << "{\"not\": \"a trace header\"}\n";

@@ -97,12 +97,11 @@ void QvrBeatsDfrAndFfrOnEveryBench() {
     }
 }
 
-void DfrAndFfrAreWithinAFewPercentWhichThePaperDoesNotClaim() {
-    // The paper has DFR 1.1x over FFR. Here they tie: at e1 = 5 deg the synthetic periphery is
-    // small enough that FFR is already nearly balanced, and with composition and ATW on the
-    // GPU the T_local LIWC measures includes waiting behind those passes, which Eq. 2 charges
-    // to triangles, so LIWC under-sizes the fovea. report.html and docs/MODEL.md explain it;
-    // this test pins the divergence so a model change that alters it is noticed.
+void DfrIsAtLeastFfrWhenLiwcReadsGpuTimers() {
+    // The paper has DFR 1.1x over FFR. LIWC reads T_local as GPU timers would (first cycle to
+    // last, preemptions included, waiting behind a pass not): then DFR sizes the fovea to the
+    // balance FFR misses and is not slower than it. Measured from submission instead, the waits
+    // behind composition/ATW become "triangle time" and DFR falls behind (docs/MODEL.md §6).
     Suite& s = suite();
     double d = 0, f = 0;
     for (size_t b = 0; b < s.traces.size(); ++b) {
@@ -110,7 +109,8 @@ void DfrAndFfrAreWithinAFewPercentWhichThePaperDoesNotClaim() {
         d += local / s.at(b, Design::Dfr).mtp_ms_mean;
         f += local / s.at(b, Design::Ffr).mtp_ms_mean;
     }
-    EXPECT_NEAR(d / f, 1.0, 0.06);
+    EXPECT_GE(d / f, 1.0);
+    EXPECT_LT(d / f, 1.2);
 }
 
 void SteadyE1IsLargerOnLteAndSmallerOn5gThanOnWifi() {
@@ -158,8 +158,8 @@ TEST(Findings, ThePapersQualitativeFindingsOnTheSyntheticSuite) {
         QvrBeatsDfrAndFfrOnEveryBench();
     }
     {
-        SCOPED_TRACE("DfrAndFfrAreWithinAFewPercentWhichThePaperDoesNotClaim");
-        DfrAndFfrAreWithinAFewPercentWhichThePaperDoesNotClaim();
+        SCOPED_TRACE("DfrIsAtLeastFfrWhenLiwcReadsGpuTimers");
+        DfrIsAtLeastFfrWhenLiwcReadsGpuTimers();
     }
     {
         SCOPED_TRACE("SteadyE1IsLargerOnLteAndSmallerOn5gThanOnWifi");

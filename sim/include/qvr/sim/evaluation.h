@@ -21,6 +21,9 @@ struct EvalOptions {
     std::vector<std::string> mahimahi_traces;
     // TOML overrides of the hardware defaults (parseHardwareConfig); empty keeps them.
     std::string hardware_path;
+    // Which recorded codec setting the suite's bytes come from (docs/MODEL.md, "Codec"); every
+    // design at the default point also runs with the other one when the suite recorded both.
+    CodecModel codec_model = CodecModel::kLossless;
     // A subset of the suite by name; empty runs all seven.
     std::vector<std::string> benches;
     std::string command_line;                           // recorded in the report

@@ -22,10 +22,11 @@ struct SimConfig {
     Design design = Design::Qvr;
     HardwareConfig hardware = defaultHardware(500.0);
     int frames = 300;  // clamped to the trace's length
-    // How the headset measures T_local for the policy and the metrics: from submission (waits
-    // behind composition/ATW count, the default) or from the GPU's first cycle on the frame
-    // (timestamp queries: only preemptions count). docs/MODEL.md §6 shows what it changes.
-    bool t_local_from_submission = true;
+    // How the headset measures T_local for the policy and the metrics: from the GPU's first
+    // cycle on the frame (timestamp queries, what the paper's GPU timers see: preemptions count,
+    // waiting behind a composition/ATW pass does not; the default) or from submission (waits
+    // count). docs/MODEL.md §6 shows what it changes.
+    bool t_local_from_submission = false;
 };
 
 // Energy of one frame (Fig. 15), millijoules; total() is their sum and nothing else.
