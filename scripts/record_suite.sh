@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Records the default workload suite that `qvr eval` replays (docs/RECORDING.md; paper Table 3):
 # every level given at 1920x2160, the first two also at 1280x1600, into data/workloads/ with a
-# suite.txt that lists them in order. Works with any OpenArena level (openarena:NAME).
+# suite.txt that lists them in order. Works with any OpenArena level (openarena:NAME) and any
+# scene named in full (builtin:room, FILE.obj).
 #
 #   scripts/record_suite.sh [--frames N] [--out DIR] [--qvr PATH] [--jobs N] LEVEL...
-#   scripts/record_suite.sh oa_dm5 oa_ctf2 oa_dm1 oasago2 ps37ctf      (the committed suite)
+#   scripts/record_suite.sh --jobs 2 --frames 120 oa_dm5 builtin:room oa_dm1 oasago2 ps37ctf
+#                                                                       (the committed suite)
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -19,13 +21,13 @@ while [[ $# -gt 0 ]]; do
         --out) out="$2"; shift 2 ;;
         --qvr) qvr="$2"; shift 2 ;;
         --jobs) jobs="$2"; shift 2 ;;
-        -h|--help) sed -n '2,7p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
         -*) echo "record_suite.sh: unknown option $1" >&2; exit 2 ;;
         *) levels+=("$1"); shift ;;
     esac
 done
 if [[ ${#levels[@]} -lt 2 ]]; then
-    echo "record_suite.sh: give at least two OpenArena level names (e.g. oa_dm5 oa_ctf2 ...)" >&2
+    echo "record_suite.sh: give at least two levels or scenes (e.g. oa_dm5 builtin:room ...)" >&2
     exit 2
 fi
 if [[ ! -x "$qvr" ]]; then
