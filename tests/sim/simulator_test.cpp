@@ -155,7 +155,20 @@ TEST(Simulator, GpuContentionEmergesFromCompositionAndTimewarpOnTheGpu) {
     for (double bps : {20e6, 200e6}) {
         NoisyLink link = quietLink(bps);
         SimConfig cfg = config(Design::Ffr, 60);
+        // T_local from submission shows the waits behind passes (GPU timers, the default, do
+        // not count them; the next check shows they see less).
+        cfg.t_local_from_submission = true;
         const RunResult run = simulate(trace, cfg, link);
+        NoisyLink link_ts = quietLink(bps);
+        SimConfig cfg_ts = cfg;
+        cfg_ts.t_local_from_submission = false;
+        const RunResult timers = simulate(trace, cfg_ts, link_ts);
+        double waits = 0.0, waits_ts = 0.0;
+        for (size_t i = 0; i < run.frames.size() && i < timers.frames.size(); ++i) {
+            waits += run.frames[i].t_local_ms - run.frames[i].render_work_ms;
+            waits_ts += timers.frames[i].t_local_ms - timers.frames[i].render_work_ms;
+        }
+        EXPECT_LT(waits_ts, waits) << bps;
         int delayed = 0;
         for (const FrameRecord& r : run.frames) {
             EXPECT_GE(r.t_local_ms + 1e-9, r.render_work_ms);
