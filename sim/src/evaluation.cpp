@@ -871,7 +871,9 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
     table(fig13);
     figure("Fig. 14: latency ratio and FPS over 300 frames from e1 = 5&deg;", "fig14.png",
            "<a href='fig14_latency_ratio.csv'>fig14_latency_ratio.csv</a>, "
-           "<a href='fig14_fps.csv'>fig14_fps.csv</a>");
+           "<a href='fig14_fps.csv'>fig14_fps.csv</a>, <a href='fig14_e1.csv'>fig14_e1.csv</a> "
+           "(every frame's e1, T_local, T_remote and ratio: what keeps the ratio off 1 is in "
+           "its T_remote column, see the Fig. 14 finding above)");
     figure("Table 4: steady-state e1 (deg); underlined red = misses 90 FPS", "table4.png",
            "<a href='table4_e1.csv'>table4_e1.csv</a>");
     {
