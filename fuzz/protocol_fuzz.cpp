@@ -1,9 +1,13 @@
 // libFuzzer target for the qvr wire protocol (docs/PROTOCOL.md): whole control messages, header
 // then payload as the transport reads them, media datagrams, and a stream of datagrams through
-// the reassembler. A decoded message must re-encode to bytes that decode again.
+// the reassembler, and the sealed media format (open, seal → open, the replay window). A decoded
+// message must re-encode to bytes that decode again.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
+#include <vector>
 
 #include "qvr/core/check.h"
 #include "qvr/net/protocol.h"
@@ -35,6 +39,29 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (decodeMediaPacket(bytes, view) == WireError::kNone) {
         QVR_CHECK(view.payload.size() == view.header.payload_bytes);
         QVR_CHECK(view.payload.size() <= kMediaChunkBytes);
+    }
+
+    // The sealed form (docs/PROTOCOL.md §Sealed media): opening hostile bytes never crashes and
+    // never succeeds without the key's tag; what decodes plain must survive seal → open intact.
+    {
+        MediaKey key{};
+        key.fill(0x42);
+        std::vector<uint8_t> sealed(bytes.begin(), bytes.end());
+        const WireError e = openMediaPacket(sealed, key);
+        QVR_CHECK(e != WireError::kNone || sealed.size() >= kMediaHeaderBytes + kMediaTagBytes);
+        if (decodeMediaPacket(bytes, view) == WireError::kNone) {
+            std::vector<uint8_t> d(bytes.begin(), bytes.end());
+            sealMediaPacket(d, key);
+            QVR_CHECK(openMediaPacket(d, key) == WireError::kNone);
+            QVR_CHECK(std::equal(bytes.begin(), bytes.end(), d.begin()));
+        }
+        ReplayWindow window;
+        for (size_t i = 0; i + 4 <= size && i < 256; i += 4) {
+            uint32_t seq = 0;
+            std::memcpy(&seq, data + i, 4);
+            const bool first = window.accept(seq);
+            QVR_CHECK(!(first && window.accept(seq)));  // never twice
+        }
     }
 
     // The input as a sequence of datagrams, each prefixed by a 2-byte length, fed to one

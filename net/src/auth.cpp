@@ -98,6 +98,12 @@ uint64_t randomSessionId() {
     return id;
 }
 
+MediaKey mediaKey(const PresharedKey& key, const Nonce& client_nonce, const Nonce& server_nonce,
+                  uint64_t session_id) {
+    static_assert(kMediaKeyBytes == kMacBytes);
+    return hmac(key, "qvr2 media", transcript(client_nonce, server_nonce, session_id));
+}
+
 Mac serverProof(const PresharedKey& key, const Nonce& client_nonce, const Nonce& server_nonce,
                 uint64_t session_id) {
     return hmac(key, "qvr1 server", transcript(client_nonce, server_nonce, session_id));

@@ -79,7 +79,9 @@ struct Connection {
     uint64_t session_id = 0;
     // One byte more than the largest valid datagram, so an oversized one is seen as such
     // (the kernel truncates to the buffer) instead of passing as a maximal one.
-    std::array<uint8_t, kMaxDatagramBytes + 1> datagram{};
+    std::array<uint8_t, kMaxSealedDatagramBytes + 1> datagram{};
+    MediaKey media_key{};  // from the handshake: opens every datagram
+    std::array<ReplayWindow, kMaxStreams> replay;
     std::array<int64_t, kMaxStreams> last_key_request_ns{};
     std::thread thread;
     bool closed = false;
@@ -251,6 +253,8 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                         return;
                     }
                     c.session_id = welcome->session_id;
+                    c.media_key = mediaKey(options.key, client_nonce, challenge.server_nonce,
+                                           challenge.session_id);
                     finish(Status::success());
                 });
             });
@@ -355,10 +359,19 @@ void Client::Impl::readMedia(Connection& c) {
         // control connection is what says the server is gone.
         if (!ec) {
             const int64_t now_ns = SteadyClock::instance().nowNs();
+            // Forged or altered datagrams stop at the tag, before any field is believed;
+            // authentic ones are then checked like any packet, and each is taken only once.
+            const std::span<uint8_t> sealed(c.datagram.data(), n);
             MediaPacketView view;
-            WireError e = decodeMediaPacket(std::span<const uint8_t>(c.datagram.data(), n), view);
+            WireError e = openMediaPacket(sealed, c.media_key);
+            if (e == WireError::kNone) {
+                e = decodeMediaPacket(sealed.first(n - kMediaTagBytes), view);
+            }
             if (e == WireError::kNone && view.header.session_id != c.session_id) {
                 e = WireError::kWrongSession;
+            }
+            if (e == WireError::kNone && !c.replay[view.header.stream_id].accept(view.header.seq)) {
+                e = WireError::kReplayed;
             }
             if (e != WireError::kNone) {
                 std::lock_guard lock(mutex);

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+
+#include <sodium.h>
 
 #include "bytes.h"
 #include "qvr/core/check.h"
@@ -298,6 +301,8 @@ std::string_view wireErrorName(WireError e) {
             return "bad MAC";
         case WireError::kWrongSession:
             return "wrong session";
+        case WireError::kReplayed:
+            return "replayed";
     }
     return "?";
 }
@@ -653,6 +658,81 @@ std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t&
         encodeMediaPacket(h, bytes.subspan(offset, n), packets[i]);
     }
     return packets;
+}
+
+namespace {
+
+std::array<uint8_t, crypto_aead_chacha20poly1305_IETF_NPUBBYTES> mediaNonce(
+    std::span<const uint8_t> header) {
+    std::array<uint8_t, crypto_aead_chacha20poly1305_IETF_NPUBBYTES> nonce{};
+    std::memcpy(nonce.data(), header.data() + 12, 4);  // seq, little-endian as on the wire
+    nonce[4] = header[20];                             // stream_id
+    return nonce;
+}
+
+}  // namespace
+
+void sealMediaPacket(std::vector<uint8_t>& datagram, const MediaKey& key) {
+    QVR_CHECK(datagram.size() >= kMediaHeaderBytes);
+    const auto nonce = mediaNonce(datagram);
+    const size_t payload = datagram.size() - kMediaHeaderBytes;
+    datagram.resize(datagram.size() + kMediaTagBytes);
+    unsigned long long tag_len = 0;
+    crypto_aead_chacha20poly1305_ietf_encrypt_detached(
+        datagram.data() + kMediaHeaderBytes, datagram.data() + kMediaHeaderBytes + payload,
+        &tag_len, datagram.data() + kMediaHeaderBytes, payload, datagram.data(), kMediaHeaderBytes,
+        nullptr, nonce.data(), key.data());
+}
+
+WireError openMediaPacket(std::span<uint8_t> sealed, const MediaKey& key) {
+    if (sealed.size() > kMaxSealedDatagramBytes) {
+        return WireError::kOversized;
+    }
+    if (sealed.size() < kMediaHeaderBytes + kMediaTagBytes) {
+        return WireError::kTruncated;
+    }
+    if (sealed[0] != kMediaMagic0 || sealed[1] != kMediaMagic1) {
+        return WireError::kBadMagic;
+    }
+    if (sealed[2] != kProtocolVersion) {
+        return WireError::kWrongVersion;
+    }
+    const auto nonce = mediaNonce(sealed);
+    const size_t payload = sealed.size() - kMediaHeaderBytes - kMediaTagBytes;
+    if (crypto_aead_chacha20poly1305_ietf_decrypt_detached(
+            sealed.data() + kMediaHeaderBytes, nullptr, sealed.data() + kMediaHeaderBytes, payload,
+            sealed.data() + kMediaHeaderBytes + payload, sealed.data(), kMediaHeaderBytes,
+            nonce.data(), key.data()) != 0) {
+        return WireError::kBadMac;
+    }
+    return WireError::kNone;
+}
+
+bool ReplayWindow::accept(uint32_t seq) {
+    if (!m_started) {
+        m_started = true;
+        m_top = seq;
+        set(seq);
+        return true;
+    }
+    const int64_t ahead = static_cast<int32_t>(seq - m_top);
+    if (ahead > 0) {
+        if (ahead >= kBits) {
+            m_seen.fill(0);
+        } else {
+            for (uint32_t k = 1; k <= static_cast<uint32_t>(ahead); ++k) {
+                clear(m_top + k);
+            }
+        }
+        m_top = seq;
+        set(seq);
+        return true;
+    }
+    if (-ahead >= kBits || test(seq)) {
+        return false;
+    }
+    set(seq);
+    return true;
 }
 
 }  // namespace qvr::net

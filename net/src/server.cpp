@@ -5,6 +5,7 @@
 #include <asio.hpp>
 #include <atomic>
 #include <deque>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -168,6 +169,7 @@ struct Session : std::enable_shared_from_this<Session> {
                     refuse(ByeReason::kAuthFailed);
                     return false;
                 }
+                media_key = mediaKey(server.options.key, client_nonce, server_nonce, session_id);
                 if (const auto why = settingsMismatch(); why != ByeReason::kNormal) {
                     count([](ServerStats& st) { ++st.settings_refusals; });
                     const SessionSettings& mine = server.options.settings;
@@ -362,8 +364,18 @@ struct Session : std::enable_shared_from_this<Session> {
             return;
         }
         const int64_t now_ns = SteadyClock::instance().nowNs();
+        // A sequence number must never repeat under one key (it is the AEAD nonce): a session
+        // about to wrap a stream's 32-bit counter (≈ 5 TB) ends, and the client reconnects.
+        if (seq[stream_id] > std::numeric_limits<uint32_t>::max() -
+                                 packetCountFor(static_cast<uint32_t>(bytes.size()))) {
+            refuse(ByeReason::kNormal);
+            return;
+        }
         auto packets =
             packetizeStream(session_id, seq[stream_id], frame_id, stream_id, key_frame, bytes);
+        for (auto& p : packets) {
+            sealMediaPacket(p, media_key);
+        }
         estimator.onSend(frame_id, static_cast<int64_t>(bytes.size()), now_ns);
         auto& kept = history[stream_id];
         for (auto& p : packets) {
@@ -467,6 +479,7 @@ struct Session : std::enable_shared_from_this<Session> {
     uint64_t session_id = 0;
     uint16_t media_port = 0;
     SessionSettings client_settings;
+    MediaKey media_key{};  // seals every datagram of the session (docs/PROTOCOL.md §Sealed media)
     asio::ip::address peer_address;  // fixed at accept
     int64_t accepted_ns = 0;
     int64_t last_rx_ns = 0;  // the last control message (or its start) from the peer

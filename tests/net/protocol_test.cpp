@@ -88,6 +88,60 @@ TEST(NetProtocol, ClientHelloCarriesTheSessionSettings) {
     }
 }
 
+TEST(NetProtocol, SealedMediaOpensOnlyUnaltered) {
+    MediaKey key{};
+    key.fill(0x5A);
+    uint32_t seq = 41;
+    const auto frame = bytesOf(2 * kMediaChunkBytes + 10, 3);
+    const auto plain = packetizeStream(7, seq, 3, 1, true, frame);
+    for (const auto& p : plain) {
+        auto d = p;
+        sealMediaPacket(d, key);
+        ASSERT_EQ(d.size(), p.size() + kMediaTagBytes);
+        EXPECT_TRUE(std::equal(p.begin(), p.begin() + kMediaHeaderBytes, d.begin()));  // clear
+        EXPECT_FALSE(std::equal(p.begin() + kMediaHeaderBytes, p.end(),
+                                d.begin() + kMediaHeaderBytes));  // encrypted
+        auto opened = d;
+        ASSERT_EQ(openMediaPacket(opened, key), WireError::kNone);
+        EXPECT_TRUE(std::equal(p.begin(), p.end(), opened.begin()));
+        // Every single bit flipped anywhere past the version byte fails the tag.
+        for (size_t byte = 3; byte < d.size(); byte += 37) {
+            auto bad = d;
+            bad[byte] ^= 0x10;
+            EXPECT_EQ(openMediaPacket(bad, key), WireError::kBadMac) << byte;
+        }
+        MediaKey other = key;
+        other[0] ^= 1;
+        auto wrong = d;
+        EXPECT_EQ(openMediaPacket(wrong, other), WireError::kBadMac);
+    }
+    std::vector<uint8_t> tiny(kMediaHeaderBytes + kMediaTagBytes - 1, 0);
+    EXPECT_EQ(openMediaPacket(tiny, key), WireError::kTruncated);
+    std::vector<uint8_t> big(kMaxSealedDatagramBytes + 1, 0);
+    EXPECT_EQ(openMediaPacket(big, key), WireError::kOversized);
+}
+
+TEST(NetProtocol, ReplayWindowTakesEachSequenceNumberOnce) {
+    ReplayWindow w;
+    EXPECT_TRUE(w.accept(100));
+    EXPECT_FALSE(w.accept(100));
+    EXPECT_TRUE(w.accept(103));  // a gap
+    EXPECT_TRUE(w.accept(101));  // filled late (a retransmission)
+    EXPECT_FALSE(w.accept(101));
+    EXPECT_TRUE(w.accept(102));
+    EXPECT_TRUE(w.accept(100 + ReplayWindow::kBits));
+    EXPECT_FALSE(w.accept(100));  // now older than the window
+    EXPECT_FALSE(w.accept(103));  // same slot, older than the window
+    EXPECT_TRUE(w.accept(101 + ReplayWindow::kBits));
+    // Across the 32-bit wrap.
+    ReplayWindow wrap;
+    EXPECT_TRUE(wrap.accept(0xFFFFFFFEu));
+    EXPECT_TRUE(wrap.accept(1));
+    EXPECT_TRUE(wrap.accept(0xFFFFFFFFu));
+    EXPECT_FALSE(wrap.accept(0xFFFFFFFEu));
+    EXPECT_TRUE(wrap.accept(0));
+}
+
 TEST(NetProtocol, FrameRequestCarriesThePlan) {
     const LayerPlanner planner(defaultHmdProfile());
     const LayerPlan plan = planner.plan(Gaze{5.0, -3.0}, 12.0);

@@ -921,24 +921,49 @@ TEST(NetTransport, ClientDropsAndCountsMalformedMedia) {
     ASSERT_TRUE(connected.ok()) << connected.error();
 
     const asio::ip::udp::endpoint to(asio::ip::make_address("127.0.0.1"), hello.media_port);
+    // The fake server knows the nonces, so it holds the session's media key, as the real one.
+    const MediaKey key = mediaKey(testKey(), hello.client_nonce, server_nonce, session);
+    const auto sealed = [&](std::vector<uint8_t> d) {
+        sealMediaPacket(d, key);
+        return d;
+    };
     uint32_t seq = 0;
     const std::vector<uint8_t> bytes(1500, 0x42);
     auto packets = packetizeStream(session, seq, 9, 0, true, bytes);
     auto send = [&](std::vector<uint8_t> d) { media.send_to(asio::buffer(d), to); };
-    auto edited = [&](size_t at, uint8_t value) {
+    auto edited = [&](size_t at, uint8_t value) {  // edited, then sealed: the MAC holds
         auto d = packets[0];
         d[at] = value;
-        return d;
+        return sealed(d);
     };
-    send({'n', 'o', 'p', 'e'});                              // truncated
-    send(edited(0, 'X'));                                    // bad magic
-    send(edited(2, kProtocolVersion + 1));                   // wrong version
-    send(edited(20, 9));                                     // bad stream id
-    send(std::vector<uint8_t>(kMaxDatagramBytes + 100, 0));  // oversized
+    send({'n', 'o', 'p', 'e'});                                    // truncated
+    send(edited(0, 'X'));                                          // bad magic
+    send(edited(2, kProtocolVersion + 1));                         // wrong version
+    send(edited(20, 9));                                           // bad stream id
+    send(std::vector<uint8_t>(kMaxSealedDatagramBytes + 100, 0));  // oversized
     uint32_t other_seq = 0;
-    send(packetizeStream(session + 1, other_seq, 9, 0, true, bytes)[0]);  // another session
+    send(sealed(packetizeStream(session + 1, other_seq, 9, 0, true, bytes)[0]));  // other session
+    // Forged and tampered: never reach the assembler (issue 12: 400 forged datagrams with the
+    // right session id used to end the session).
+    send(packets[0]);  // unsealed, as before version 2: its last 16 bytes are not a tag
+    {
+        auto forged = sealed(packets[0]);
+        forged.back() ^= 0x01;  // the tag
+        send(forged);
+        auto flipped = sealed(packets[0]);
+        flipped[kMediaHeaderBytes + 7] ^= 0x80;  // a payload bit
+        send(flipped);
+        auto header_flipped = sealed(packets[0]);
+        header_flipped[24] ^= 0x01;  // packet_count, in clear but authenticated
+        send(header_flipped);
+        const MediaKey wrong = mediaKey(PresharedKey::fromPassphrase("other").value(),
+                                        hello.client_nonce, server_nonce, session);
+        auto other_key = packets[0];
+        sealMediaPacket(other_key, wrong);
+        send(other_key);
+    }
     for (const auto& p : packets) {
-        send(p);
+        send(sealed(p));
     }
     auto s = client.nextStream(2000);
     ASSERT_TRUE(s.ok() && s->has_value());
@@ -956,6 +981,20 @@ TEST(NetTransport, ClientDropsAndCountsMalformedMedia) {
     EXPECT_EQ(drops[WireError::kBadField], 1u);
     EXPECT_EQ(drops[WireError::kOversized], 1u);
     EXPECT_EQ(drops[WireError::kWrongSession], 1u);
+    EXPECT_EQ(drops[WireError::kBadMac], 5u);
+    // Replayed: an authentic datagram sent again, after its frame completed and while one is
+    // being assembled; neither reaches the assembler, the session stays.
+    send(sealed(packets[0]));
+    auto next = packetizeStream(session, seq, 10, 0, false, bytes);
+    send(sealed(next[0]));
+    send(sealed(next[0]));
+    send(sealed(next[1]));
+    auto s2 = client.nextStream(2000);
+    ASSERT_TRUE(s2.ok() && s2->has_value());
+    EXPECT_EQ((*s2)->frame_id, 10u);
+    (void)readMessage();  // its ack
+    EXPECT_EQ(client.stats().media_drops[WireError::kReplayed], 2u);
+    EXPECT_TRUE(client.connected());
 
     asio::write(peer, asio::buffer(encodeControl(ThroughputReport{123'000'000, 1})));
     const auto deadline = std::chrono::steady_clock::now() + 2s;

@@ -465,13 +465,21 @@ private:
             const std::vector<uint8_t> packet(datagram.begin(), datagram.begin() + n);
             uint16_t port = 0;
             uint64_t session = 0;
+            net::MediaKey key{};
             {
                 std::lock_guard lock(m_mutex);
                 port = m_headset_media_port;
                 session = m_session;
+                // Holding the key, the proxy can open the media and seal what it injects.
+                key = net::mediaKey(m_key, m_client_nonce, m_server_nonce, m_session);
             }
+            std::vector<uint8_t> plain = packet;
             net::MediaPacketView view;
-            const bool valid = net::decodeMediaPacket(packet, view) == net::WireError::kNone;
+            const bool valid =
+                net::openMediaPacket(plain, key) == net::WireError::kNone &&
+                net::decodeMediaPacket(std::span(plain).first(plain.size() - net::kMediaTagBytes),
+                                       view) == net::WireError::kNone;
+            plain.resize(plain.size() - std::min(plain.size(), net::kMediaTagBytes));
             // A burst of every kind of malformed datagram ahead of the first packet of every
             // third frame, until the last frames, so the headset has read them all by its end.
             const uint32_t frame = valid ? view.header.frame_id : 0;
@@ -479,7 +487,14 @@ private:
                 (!tampered_any || frame > tampered_up_to)) {
                 tampered_any = true;
                 tampered_up_to = frame;
-                injectBurst(port, session, packet, frame);
+                injectBurst(port, session, key, plain, frame);
+                sendTo(port, packet);
+                ++m_forwarded;
+                // The authentic datagram again: a replay.
+                sendTo(port, packet);
+                std::lock_guard lock(m_mutex);
+                m_injected.count(net::WireError::kReplayed);
+                continue;
             }
             sendTo(port, packet);
             ++m_forwarded;
@@ -494,10 +509,16 @@ private:
         ::sendto(m_to_headset, d.data(), d.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a);
     }
 
-    void injectBurst(uint16_t port, uint64_t session, const std::vector<uint8_t>& real,
-                     uint32_t frame) {
+    // `real` is an opened (plain) datagram of the session; what is injected is sealed with the
+    // session's key wherever the malformation lies behind the tag, so it is counted by reason.
+    void injectBurst(uint16_t port, uint64_t session, const net::MediaKey& key,
+                     const std::vector<uint8_t>& real, uint32_t frame) {
         using net::WireError;
         std::vector<std::pair<WireError, std::vector<uint8_t>>> bad;
+        auto sealed = [&](std::vector<uint8_t> d) {
+            net::sealMediaPacket(d, key);
+            return d;
+        };
         auto encoded = [&](net::MediaHeader h, size_t payload_bytes) {
             std::vector<uint8_t> out;
             net::encodeMediaPacket(h, std::vector<uint8_t>(payload_bytes, 0x77), out);
@@ -519,7 +540,8 @@ private:
         bad.emplace_back(WireError::kOversized,
                          std::vector<uint8_t>(net::kMaxDatagramBytes + 500, 0));
         // A real packet of this session cut short of its declared payload.
-        bad.emplace_back(WireError::kTruncated, std::vector<uint8_t>(real.begin(), real.end() - 1));
+        bad.emplace_back(WireError::kTruncated,
+                         sealed(std::vector<uint8_t>(real.begin(), real.end() - 1)));
         // A header declaring a full 1200-byte chunk with 100 bytes behind it.
         {
             net::MediaHeader full = h;
@@ -528,37 +550,47 @@ private:
             full.frame_bytes = 2 * net::kMediaChunkBytes;
             auto d = encoded(full, net::kMediaChunkBytes);
             d.resize(net::kMediaHeaderBytes + 100);
-            bad.emplace_back(WireError::kTruncated, d);
+            bad.emplace_back(WireError::kTruncated, sealed(d));
         }
         // More bytes than declared.
         {
             auto d = encoded(h, 100);
             d.insert(d.end(), 50, 0x33);
-            bad.emplace_back(WireError::kTrailingBytes, d);
+            bad.emplace_back(WireError::kTrailingBytes, sealed(d));
         }
         // A frame size beyond the protocol's limit.
         {
             net::MediaHeader big = h;
             big.frame_bytes = net::kMaxStreamFrameBytes + 1;
-            bad.emplace_back(WireError::kOversized, encoded(big, 100));
+            bad.emplace_back(WireError::kOversized, sealed(encoded(big, 100)));
         }
         // Packet 5 of a frame of one packet.
         {
             net::MediaHeader past = h;
             past.packet_index = 5;
-            bad.emplace_back(WireError::kBadField, encoded(past, 100));
+            bad.emplace_back(WireError::kBadField, sealed(encoded(past, 100)));
         }
         // Another protocol version.
         {
             auto d = real;
             d[2] = static_cast<uint8_t>(d[2] + 1);
-            bad.emplace_back(WireError::kWrongVersion, d);
+            bad.emplace_back(WireError::kWrongVersion, sealed(d));
+        }
+        // Forged: the plain datagram (no tag), and a sealed one with a payload bit flipped.
+        bad.emplace_back(real.size() < net::kMediaHeaderBytes + net::kMediaTagBytes
+                             ? WireError::kTruncated
+                             : WireError::kBadMac,
+                         real);
+        {
+            auto d = sealed(real);
+            d[net::kMediaHeaderBytes + 3] ^= 0x04;
+            bad.emplace_back(WireError::kBadMac, d);
         }
         // A well-formed packet of another session.
         {
             net::MediaHeader other = h;
             other.session_id = session + 1;
-            bad.emplace_back(WireError::kWrongSession, encoded(other, 100));
+            bad.emplace_back(WireError::kWrongSession, sealed(encoded(other, 100)));
         }
         for (const auto& [why, d] : bad) {
             sendTo(port, d);
@@ -609,10 +641,20 @@ TEST(Runtime, MalformedMediaDatagramsAreDroppedByReasonWhileFramesKeepComing) {
     const net::DropCounters& drops = r.stats.net.media_drops;
     for (int e = 1; e < net::kWireErrorCount; ++e) {
         const auto why = static_cast<net::WireError>(e);
+        if (why == net::WireError::kReplayed)
+            continue;
         EXPECT_EQ(drops[why], injected[why]) << net::wireErrorName(why);
     }
+    // A second copy is a second copy: besides the proxy's replays, a retransmission that raced
+    // its delayed original (the proxy holds packets while it injects) is dropped the same way,
+    // so at most one per packet the headset NACKed.
+    EXPECT_GE(drops[net::WireError::kReplayed], injected[net::WireError::kReplayed]);
+    EXPECT_LE(drops[net::WireError::kReplayed],
+              injected[net::WireError::kReplayed] + r.stats.net.assembler.packets_nacked);
     EXPECT_GT(drops[net::WireError::kWrongSession], 0u);
     EXPECT_GT(drops[net::WireError::kTrailingBytes], 0u);
+    EXPECT_GT(drops[net::WireError::kBadMac], 0u);    // forged and bit-flipped
+    EXPECT_GT(drops[net::WireError::kReplayed], 0u);  // authentic, sent twice
     EXPECT_EQ(drops[net::WireError::kTruncated], 3 * drops[net::WireError::kBadMagic]);
     // Frames kept coming from the server: every frame displayed, nearly all of them fresh.
     EXPECT_EQ(r.summary.frames_displayed, frames);

@@ -44,5 +44,9 @@ Mac clientProof(const PresharedKey& key, const Nonce& client_nonce, const Nonce&
                 uint64_t session_id, uint16_t media_port);
 // Constant-time comparison.
 bool macEqual(const Mac& a, const Mac& b);
+// The session's media key: HMAC-SHA-256(K, "qvr2 media" ‖ Nc ‖ Ns ‖ sid), fresh per session,
+// known only to the two ends that proved the key over these nonces.
+MediaKey mediaKey(const PresharedKey& key, const Nonce& client_nonce, const Nonce& server_nonce,
+                  uint64_t session_id);
 
 }  // namespace qvr::net

@@ -34,6 +34,11 @@ inline constexpr int32_t kMaxImageExtentPx = 16384;  // rectangle coordinates an
 inline constexpr size_t kNonceBytes = 32;
 inline constexpr size_t kMacBytes = 32;
 inline constexpr size_t kSettingNameBytes = 16;
+// Media datagrams are sealed (docs/PROTOCOL.md §Sealed media): a 16-byte Poly1305 tag follows.
+inline constexpr size_t kMediaTagBytes = 16;
+inline constexpr size_t kMaxSealedDatagramBytes = kMaxDatagramBytes + kMediaTagBytes;
+inline constexpr size_t kMediaKeyBytes = 32;
+using MediaKey = std::array<uint8_t, kMediaKeyBytes>;
 
 // Stream id = 2·eye + layer: the four parallel streams of Fig. 7.
 enum class Layer : uint8_t { kMiddle = 0, kOuter = 1 };
@@ -53,8 +58,9 @@ enum class WireError : uint8_t {
     kTrailingBytes,  // more bytes than the type's fixed layout
     kBadMac,         // handshake proof that does not verify
     kWrongSession,   // media of another session
+    kReplayed,       // sealed media seen before, or older than the replay window
 };
-inline constexpr int kWireErrorCount = 10;
+inline constexpr int kWireErrorCount = 11;
 std::string_view wireErrorName(WireError e);
 
 struct DropCounters {
@@ -237,6 +243,31 @@ WireError decodeMediaPacket(std::span<const uint8_t> datagram, MediaPacketView& 
 void encodeMediaPacket(const MediaHeader& header, std::span<const uint8_t> payload,
                        std::vector<uint8_t>& out);
 uint32_t packetCountFor(uint32_t frame_bytes);
+
+// ChaCha20-Poly1305-IETF over an encoded datagram, in place: the 32-byte header stays in clear
+// as associated data, the payload is encrypted and the tag appended. The nonce is the header's
+// (seq, stream_id), unique per session key while a stream's seq does not wrap (the server ends a
+// session before it would); a retransmission resends the same sealed bytes.
+void sealMediaPacket(std::vector<uint8_t>& datagram, const MediaKey& key);
+// Checks size, magic and version in clear, then the tag (kBadMac), and decrypts in place: the
+// first size − kMediaTagBytes bytes are then the plain datagram for decodeMediaPacket.
+WireError openMediaPacket(std::span<uint8_t> sealed, const MediaKey& key);
+
+// Sliding window over one stream's sequence numbers (sealed datagrams only: a forged seq never
+// gets here): each seq is accepted once, and anything older than the window is refused.
+class ReplayWindow {
+public:
+    static constexpr uint32_t kBits = 4096;
+    bool accept(uint32_t seq);
+
+private:
+    bool m_started = false;
+    uint32_t m_top = 0;
+    std::array<uint64_t, kBits / 64> m_seen{};
+    bool test(uint32_t seq) const { return (m_seen[(seq % kBits) / 64] >> (seq % 64)) & 1; }
+    void set(uint32_t seq) { m_seen[(seq % kBits) / 64] |= uint64_t{1} << (seq % 64); }
+    void clear(uint32_t seq) { m_seen[(seq % kBits) / 64] &= ~(uint64_t{1} << (seq % 64)); }
+};
 // Splits one stream's frame into datagrams; seq advances by the packet count.
 // Precondition: 0 < bytes.size() ≤ kMaxStreamFrameBytes, stream_id < kMaxStreams.
 std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t& seq,
