@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <thread>
@@ -26,9 +27,12 @@
 #include "commands.h"
 #include "qvr/codec/mp4_writer.h"
 #include "qvr/compose/png_io.h"
+#include "qvr/compose/quality.h"
+#include "qvr/compose/test_pattern.h"
 #include "qvr/compose/warp.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/net/link_emulator.h"
+#include "qvr/render/camera.h"
 #include "qvr/report/html_report.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/chrome_trace.h"
@@ -67,6 +71,7 @@ struct RunOptions {
     bool fovea_border = true;
     bool quiet = false;
     int video_max_frames = 900;
+    int quality_every = 15;  // every Nth displayed frame is measured against a full render
     bool one_pass_periphery = false;
     int pipeline_depth = 2;
     float lod_px = 1.0f;
@@ -196,6 +201,93 @@ private:
     std::chrono::steady_clock::time_point m_last{};
     int m_shown = 0;
 };
+
+// Keeps every Nth displayed frame's left eye at full resolution, with what its reference needs
+// after the run: the plan it showed, the frame whose layers it showed, and when UCA ran.
+class QualitySampler final : public DisplaySink {
+public:
+    struct Sample {
+        int64_t frame = 0;
+        int64_t shown_frame = 0;
+        int64_t pose_ns = 0;
+        int64_t uca_start_ns = 0;
+        LayerPlan plan;
+        ImageRgba8 left;
+    };
+    QualitySampler(int every, size_t max_samples, DisplaySink* inner)
+        : m_every(every), m_max(max_samples), m_inner(inner) {}
+    void onScanout(const FrameTelemetry& t, const LayerPlan& plan,
+                   const std::array<ImageRgba8, 2>& eyes) override {
+        if (m_inner)
+            m_inner->onScanout(t, plan, eyes);
+        if ((t.frame + 1) % m_every != 0 || m_samples.size() >= m_max || eyes[0].empty() ||
+            t.pose_ns < 0 || t.uca_start_ns < 0)
+            return;
+        m_samples.push_back({t.frame, t.shown_frame >= 0 ? t.shown_frame : t.frame, t.pose_ns,
+                             t.uca_start_ns, plan, eyes[0]});
+    }
+    const std::vector<Sample>& samples() const { return m_samples; }
+
+private:
+    int m_every;
+    size_t m_max;
+    DisplaySink* m_inner;
+    std::vector<Sample> m_samples;
+};
+
+// A design's display against the full-resolution render of the same frame, by band, averaged
+// over the sampled frames (PSNR averaged in dB, capped at 99 dB for identical images).
+struct DesignQuality {
+    int frames = 0;
+    std::array<double, 5> psnr_db{};  // fovea, blend, middle, outer, all
+    std::array<double, 5> ssim{};
+    std::array<int, 5> counted{};
+    std::map<double, std::pair<double, int>> psnr_by_ecc;  // bin centre → (sum, n)
+    double seconds = 0.0;
+};
+
+Expected<DesignQuality> measureDesignQuality(const std::vector<QualitySampler::Sample>& samples,
+                                             const HmdProfile& profile, const HeadsetTraces& traces,
+                                             Renderer& renderer) {
+    DesignQuality q;
+    const auto t0 = std::chrono::steady_clock::now();
+    ImageRgba8 full;
+    for (const QualitySampler::Sample& s : samples) {
+        // The poses the headset used: the shown frame's content time for the render, and the
+        // newest pose when UCA ran for the display (headset_client.cpp).
+        const double frame_ms = 1000.0 / profile.refresh_hz;
+        const Pose render_pose = poseAt(traces.motion, double(s.shown_frame) * frame_ms);
+        const Pose display_pose = poseAt(
+            traces.motion, double(s.frame) * frame_ms + double(s.uca_start_ns - s.pose_ns) * 1e-6);
+        auto st = renderer.render(fullFrameView(profile, render_pose, Eye::kLeft), full);
+        if (!st)
+            return makeError("quality reference: " + st.error());
+        const ImageRgbD truth = groundTruthWarp(profile, full, render_pose, display_pose);
+        const BandQuality b =
+            measureQualityBands(profile, s.plan, render_pose, display_pose, s.left, truth);
+        const RegionQuality* bands[5] = {&b.fovea, &b.blend, &b.middle, &b.outer, &b.all};
+        for (size_t i = 0; i < 5; ++i) {
+            if (bands[i]->pixels == 0)
+                continue;
+            q.psnr_db[i] += std::min(bands[i]->psnr_db, 99.0);
+            q.ssim[i] += bands[i]->ssim;
+            ++q.counted[i];
+        }
+        for (const BandQuality::Bin& bin : b.by_eccentricity) {
+            auto& [sum, n] = q.psnr_by_ecc[bin.center_deg];
+            sum += std::min(bin.q.psnr_db, 99.0);
+            ++n;
+        }
+        ++q.frames;
+    }
+    for (size_t i = 0; i < 5; ++i)
+        if (q.counted[i] > 0) {
+            q.psnr_db[i] /= q.counted[i];
+            q.ssim[i] /= q.counted[i];
+        }
+    q.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return q;
+}
 
 std::string machineDescription() {
     std::string model;
@@ -578,6 +670,9 @@ int runRun(const RunOptions& o) {
                server->port(), server_core, client_core, cores);
 
     std::vector<DesignRun> runs;
+    std::unique_ptr<Renderer> quality_renderer;
+    std::vector<std::pair<std::string, DesignQuality>> quality;
+    std::string quality_note;
     ScanoutRecorder recorder(*profile, o.video_max_frames, o.fovea_border);
     const fs::path workload_path = out / "workload.jsonl";
     bool recorded_workload = false;
@@ -609,6 +704,11 @@ int runRun(const RunOptions& o) {
                 recorded_workload = true;
             }
         }
+        std::unique_ptr<QualitySampler> sampler;
+        if (o.quality_every > 0) {
+            sampler = std::make_unique<QualitySampler>(o.quality_every, 12, hc.display);
+            hc.display = sampler.get();
+        }
         std::unique_ptr<ProgressDisplay> progress;
         if (!o.quiet && isatty(STDERR_FILENO)) {
             progress = std::make_unique<ProgressDisplay>(designName(d), o.frames, hc.display);
@@ -637,6 +737,26 @@ int runRun(const RunOptions& o) {
             !st)
             std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
         runs.push_back({d, std::move(*result)});
+        // Image quality, between the measured runs: each sampled display against a
+        // full-resolution render of the same frame (rendered now, on this thread).
+        if (sampler && !sampler->samples().empty()) {
+            if (!quality_renderer) {
+                auto made = glRendererFactory(gl)();
+                if (made && (*made)->upload(*scene))
+                    quality_renderer = std::move(*made);
+                else
+                    quality_note = "no reference renderer: " +
+                                   (made ? std::string("scene upload failed") : made.error());
+            }
+            if (quality_renderer) {
+                auto q =
+                    measureDesignQuality(sampler->samples(), *profile, traces, *quality_renderer);
+                if (q)
+                    quality.emplace_back(designName(d), std::move(*q));
+                else
+                    quality_note = q.error();
+            }
+        }
         // Let the server finish the last session before the next one starts.
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
@@ -858,6 +978,24 @@ int runRun(const RunOptions& o) {
     j["server"] = server_stats;
     j["server"]["exit_status"] = server_status;
     j["trace"] = trace_json;
+    {
+        nlohmann::json qj = nlohmann::json::object();
+        const char* band_names[5] = {"fovea", "blend", "middle", "outer", "all"};
+        for (const auto& [name, q] : quality) {
+            nlohmann::json d = {{"frames_sampled", q.frames}, {"seconds", q.seconds}};
+            for (size_t i = 0; i < 5; ++i)
+                if (q.counted[i] > 0)
+                    d[band_names[i]] = {{"psnr_db", q.psnr_db[i]}, {"ssim", q.ssim[i]}};
+            nlohmann::json bins = nlohmann::json::array();
+            for (const auto& [deg, sn] : q.psnr_by_ecc)
+                bins.push_back({deg, sn.first / sn.second});
+            d["psnr_db_by_eccentricity_deg"] = bins;
+            qj[name] = d;
+        }
+        if (!quality_note.empty())
+            qj["note"] = quality_note;
+        j["quality"] = qj;
+    }
     const double layers = server_stats.value("layers_rendered", 0.0);
     const double frames_rendered = server_stats.value("frames_rendered", 0.0);
     if (layers > 0)
@@ -936,6 +1074,22 @@ int runRun(const RunOptions& o) {
         plotter.plot("bytes", kFigureTitles[2].second, bytes_plot + "\n");
         plotter.plot("scanout", kFigureTitles[3].second, ft_plot + "\n");
     }
+    if (!quality.empty()) {
+        std::string q_plot =
+            "set datafile separator ','\nset key outside right\nset grid\nset xlabel "
+            "'eccentricity from the gaze (deg)'\nset ylabel 'PSNR (dB)'\nplot ";
+        for (size_t i = 0; i < quality.size(); ++i) {
+            const std::string f = fmt::format("quality_{}.csv", quality[i].first);
+            std::ofstream csv(out / f);
+            csv << "eccentricity_deg,psnr_db\n";
+            for (const auto& [deg, sn] : quality[i].second.psnr_by_ecc)
+                csv << fmt::format("{},{:.3f}\n", deg, sn.first / sn.second);
+            q_plot += fmt::format("{}'{}' every ::1 using 1:2 with linespoints title '{}'",
+                                  i ? ", " : "", f, quality[i].first);
+        }
+        plotter.plot("quality", "Display error vs eccentricity: PSNR against a full render (dB)",
+                     q_plot + "\n");
+    }
 
     // report.html
     auto num = [](double v, int prec = 1) { return fmt::format("{:.{}f}", v, prec); };
@@ -984,6 +1138,39 @@ int runRun(const RunOptions& o) {
             page.figure(out, name, title, 1000);
     else
         page.paragraph(plotter.note());
+    page.heading(2, "Image quality against a full-resolution render");
+    if (quality.empty()) {
+        page.paragraph(o.quality_every > 0 ? "Not measured: " + quality_note
+                                           : "Not measured (--quality-every 0).");
+    } else {
+        page.paragraph(fmt::format(
+            "Every {}th displayed frame (at most 12 per design), after that design's run and "
+            "off its measured clock: the left eye as the headset displayed it against the "
+            "full-resolution render of the same frame (the shown frame's render pose, the same "
+            "level of detail), timewarped and lens-mapped to the same display pose in double "
+            "precision. PSNR over RGB and SSIM of luma (7×7 windows), averaged over the sampled "
+            "frames, by eccentricity band of each frame's own plan: the fovea (e < e1), the "
+            "Eq. 4 blend bands (2 texels of the coarser layer either side of e1 and e2), the "
+            "middle and the outer layer; 99 dB stands for identical. It is a still-image "
+            "measure: temporal flicker and crawling of the down-sampled periphery from frame to "
+            "frame, which the eye is sensitive to there, are not captured.",
+            o.quality_every));
+        report::Table t({"design", "frames", "fovea dB", "fovea SSIM", "blend dB", "blend SSIM",
+                         "middle dB", "middle SSIM", "outer dB", "outer SSIM", "all dB",
+                         "all SSIM"});
+        for (const auto& [name, q] : quality) {
+            std::vector<report::Cell> row = {name, std::to_string(q.frames)};
+            for (size_t i = 0; i < 5; ++i) {
+                row.emplace_back(q.counted[i] ? num(q.psnr_db[i]) : "—");
+                row.emplace_back(q.counted[i] ? num(q.ssim[i], 3) : "—");
+            }
+            t.row(std::move(row));
+        }
+        page.table(t);
+        if (plotter.available())
+            page.figure(out, "quality",
+                        "Display error vs eccentricity: PSNR against a full render (dB)", 1000);
+    }
     page.paragraph("Timeline: " + trace_note +
                    ". Both processes read CLOCK_MONOTONIC of this machine, so the true offset "
                    "is 0; the estimate checks that the stamps agree.");
@@ -1064,6 +1251,11 @@ static Registered registerRun(CLI::App& app) {
                   "Measure the calibration again even when a cached one exists");
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
     cmd->add_flag("--quiet", o->quiet, "No progress line on a terminal");
+    cmd->add_option("--quality-every", o->quality_every,
+                    "Measure every Nth displayed frame against a full-resolution render after "
+                    "each design's run (0: off)")
+        ->check(CLI::Range(0, 100000))
+        ->capture_default_str();
     cmd->add_flag("!--no-fovea-border", o->fovea_border,
                   "Do not draw the e1 circle (the fovea layer's edge) in the video");
     return {cmd, [o] {

@@ -2,6 +2,7 @@
 // for UCA, paper §4.2). SSIM uses 7×7 box windows kept as running sums, so memory stays O(width).
 #include "qvr/compose/quality.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -45,19 +46,25 @@ struct Accum {
 
 }  // namespace
 
-QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
-                             const Pose& render_pose, const Pose& display_pose,
-                             const ImageRgba8& image, const ImageRgbD& truth) {
+namespace {
+
+// PSNR and SSIM per region, a region being what `label` makes of a pixel's eccentricity (deg):
+// 1..regions, or 0 to leave it out. The last accumulator holds every counted pixel.
+template <typename Label>
+std::vector<Accum> measureRegions(const HmdProfile& profile, const Gaze& gaze_deg,
+                                  const Pose& render_pose, const Pose& display_pose,
+                                  const ImageRgba8& image, const ImageRgbD& truth, int regions,
+                                  Label label) {
     const int width = image.width();
     const int height = image.height();
     QVR_CHECK(truth.width() == width && truth.height() == height);
     const EyeWarp warp(profile, render_pose.orientation, display_pose.orientation);
-    const glm::dvec3 gaze = glm::normalize(glm::dvec3(
-        std::tan(plan.gaze.x_deg / kDegPerRad), std::tan(plan.gaze.y_deg / kDegPerRad), -1.0));
-    const double cos_e1 = std::cos(plan.e1_deg / kDegPerRad);
+    const glm::dvec3 gaze = glm::normalize(glm::dvec3(std::tan(gaze_deg.x_deg / kDegPerRad),
+                                                      std::tan(gaze_deg.y_deg / kDegPerRad), -1.0));
     std::vector<uint8_t> region(static_cast<size_t>(width) * static_cast<size_t>(height));
     std::vector<float> ly_img(region.size()), ly_ref(region.size());
-    Accum acc[3];  // fovea, periphery, all
+    std::vector<Accum> acc(static_cast<size_t>(regions) + 1);
+    const size_t all = static_cast<size_t>(regions);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             const size_t i =
@@ -65,8 +72,8 @@ QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
             const WarpSample s = warp.map(x + 0.5, y + 0.5);
             uint8_t reg = kOff;
             if (s.inside) {
-                const double c = glm::dot(glm::normalize(s.dir), gaze);
-                reg = c >= cos_e1 ? kFovea : kPeriphery;
+                const double c = std::clamp(glm::dot(glm::normalize(s.dir), gaze), -1.0, 1.0);
+                reg = static_cast<uint8_t>(label(std::acos(c) * kDegPerRad));
             }
             region[i] = reg;
             const double r = image.at(x, y, 0), g = image.at(x, y, 1), b = image.at(x, y, 2);
@@ -80,7 +87,7 @@ QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
                 const double d = image.at(x, y, c) - truth.at(x, y, c);
                 e2 += d * d;
             }
-            for (Accum* a : {&acc[reg - 1], &acc[2]}) {
+            for (Accum* a : {&acc[reg - 1u], &acc[all]}) {
                 a->sq_err += e2;
                 a->samples += 3;
                 a->pixels += 1;
@@ -128,7 +135,7 @@ QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
                 const double cxy = s[4] / n - mx * my;
                 const double ssim = ((2 * mx * my + kC1) * (2 * cxy + kC2)) /
                                     ((mx * mx + my * my + kC1) * (vx + vy + kC2));
-                for (Accum* a : {&acc[reg - 1], &acc[2]}) {
+                for (Accum* a : {&acc[reg - 1u], &acc[all]}) {
                     a->ssim_sum += ssim;
                     a->ssim_windows += 1;
                 }
@@ -138,10 +145,60 @@ QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
         }
         addRow(y - kHalf, -1.0);
     }
+    return acc;
+}
+
+}  // namespace
+
+QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
+                             const Pose& render_pose, const Pose& display_pose,
+                             const ImageRgba8& image, const ImageRgbD& truth) {
+    const std::vector<Accum> acc =
+        measureRegions(profile, plan.gaze, render_pose, display_pose, image, truth, 2,
+                       [&](double e_deg) { return e_deg <= plan.e1_deg ? kFovea : kPeriphery; });
     QualityReport q;
     q.fovea = acc[0].finish();
     q.periphery = acc[1].finish();
     q.all = acc[2].finish();
+    return q;
+}
+
+BandQuality measureQualityBands(const HmdProfile& profile, const LayerPlan& plan,
+                                const Pose& render_pose, const Pose& display_pose,
+                                const ImageRgba8& image, const ImageRgbD& truth,
+                                double blend_band_texels, double bin_deg) {
+    QVR_CHECK(bin_deg > 0.0);
+    // The blend band around each layer border: blend_band_texels of the coarser layer.
+    const double w1_deg = blend_band_texels * plan.s1 * profile.pixelAngleDeg();
+    const double w2_deg = blend_band_texels * plan.s2 * profile.pixelAngleDeg();
+    const bool has_middle = plan.e1_deg < plan.cover_deg;
+    const bool has_outer = plan.e2_deg < plan.cover_deg;
+    auto band = [&](double e) -> uint8_t {
+        if ((has_middle && std::fabs(e - plan.e1_deg) <= w1_deg) ||
+            (has_outer && std::fabs(e - plan.e2_deg) <= w2_deg))
+            return 2;  // blend band
+        if (e < plan.e1_deg || !has_middle)
+            return 1;  // fovea
+        return e < plan.e2_deg || !has_outer ? 3 : 4;
+    };
+    const std::vector<Accum> b =
+        measureRegions(profile, plan.gaze, render_pose, display_pose, image, truth, 4, band);
+    BandQuality q;
+    q.fovea = b[0].finish();
+    q.blend = b[1].finish();
+    q.middle = b[2].finish();
+    q.outer = b[3].finish();
+    q.all = b[4].finish();
+    q.blend_deg = {w1_deg, w2_deg};
+    const int bins = static_cast<int>(std::ceil(180.0 / bin_deg));
+    const std::vector<Accum> e =
+        measureRegions(profile, plan.gaze, render_pose, display_pose, image, truth, bins,
+                       [&](double deg) { return std::min(bins, 1 + int(deg / bin_deg)); });
+    for (int i = 0; i < bins; ++i) {
+        if (e[static_cast<size_t>(i)].pixels == 0)
+            continue;
+        q.by_eccentricity.push_back({(i + 0.5) * bin_deg, e[static_cast<size_t>(i)].finish()});
+    }
     return q;
 }
 

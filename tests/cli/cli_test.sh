@@ -244,6 +244,7 @@ expect_error "calibrate without --out" calibrate
 expect_error "calibrate --profile /nonexistent.toml" calibrate --profile /nonexistent.toml --out "$tmp/cal.toml"
 expect_error "calibrate --codec bogus" calibrate --codec bogus --out "$tmp/cal.toml"
 expect_error "run --hardware /nonexistent" run --hardware /nonexistent.toml --frames 2 --out "$tmp/run"
+expect_error "run --quality-every -1" run --quality-every -1 --frames 2 --out "$tmp/run"
 expect_error "run --hardware <bad runtime.pipeline>" run --hardware "$tmp/rt_bad.toml" --frames 2 --out "$tmp/run"
 expect_error "validate --depths 3" validate --depths 3 --dry-run --out "$tmp/val"
 expect_error "validate --frames 2" validate --frames 2 --dry-run --out "$tmp/val"

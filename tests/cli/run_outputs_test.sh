@@ -9,7 +9,7 @@ trap 'rm -rf "$tmp"' EXIT
 # A calibration file, so the run does not measure this machine first.
 printf '[runtime]\npipeline = "runtime"\nfovea_base_ms = 1\n' >"$tmp/rt.toml"
 if ! timeout 300 "$QVR" run --profile small --frames 12 --designs local,qvr --hardware "$tmp/rt.toml" \
-    --out "$tmp/run" >"$tmp/out.txt" 2>"$tmp/err.txt"; then
+    --quality-every 6 --out "$tmp/run" >"$tmp/out.txt" 2>"$tmp/err.txt"; then
     echo "FAIL: qvr run exited non-zero: $(head -c 600 "$tmp/err.txt")"
     exit 1
 fi
@@ -70,6 +70,18 @@ for key, s in stages.items():
 assert checked >= 10, checked
 print("PASS: trace.json holds %d frames, stages in order; server offset %+.3f ms +- %.3f ms"
       % (len(stages), d["trace"]["server_offset_ms"], d["trace"]["server_offset_bound_ms"]))
+# Image quality: every design sampled (frames 6 and 12), the bands its plan has, in the report.
+q = d["quality"]
+for name in ["local", "qvr"]:
+    assert q[name]["frames_sampled"] == 2, q
+    assert 0.0 < q[name]["all"]["ssim"] <= 1.0 and q[name]["all"]["psnr_db"] > 10, q[name]
+    assert q[name]["psnr_db_by_eccentricity_deg"], q[name]
+    assert "<td class='l'>%s</td><td>2</td>" % name in html, "quality table row " + name
+assert "middle" not in q["local"], "local renders everything as its fovea"
+assert q["qvr"]["fovea"]["psnr_db"] > q["qvr"]["outer"]["psnr_db"] + 3, q["qvr"]
+assert "temporal flicker" in html
+print("PASS: quality by band for every design (qvr fovea %.1f dB, outer %.1f dB)"
+      % (q["qvr"]["fovea"]["psnr_db"], q["qvr"]["outer"]["psnr_db"]))
 print("PASS: qvr run writes qvr_display.mp4 (%s, %d frames) and a report without JSON dumps"
       % (v["codec"], v["frames"]))
 PY

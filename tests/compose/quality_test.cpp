@@ -95,3 +95,45 @@ TEST(ComposeQuality, UcaIsAtLeastAsGoodAsTwoPassInFoveaAndPeriphery) {
 
 }  // namespace
 }  // namespace qvr
+
+namespace qvr {
+namespace {
+
+TEST(ComposeQualityBands, SplitsThePixelsByBandAndFoveaBeatsOuterOnAFoveatedFrame) {
+    HmdProfile profile = defaultHmdProfile();
+    profile.width_px = 960;
+    profile.height_px = 1080;
+    const LayerPlan plan = LayerPlanner(profile).plan({3.0, -2.0}, 12.0);
+    ASSERT_LT(plan.e2_deg, plan.cover_deg);  // all four bands exist
+    const ImageRgba8 full = renderTestPattern(profile.width_px, profile.height_px);
+    const Pose render;
+    const LayerFrame frame = makeTestPatternFrame(profile, plan, render, 1, full);
+    Compositor c(profile);
+    std::array<ImageRgba8, 2> display;
+    ASSERT_TRUE(c.compose(frame, render, display).ok());
+    const ImageRgbD truth = groundTruthWarp(profile, full, render, render);
+    const BandQuality q = measureQualityBands(profile, plan, render, render, display[0], truth);
+    std::printf("fovea %.2f dB %.4f  blend %.2f dB  middle %.2f dB  outer %.2f dB %.4f\n",
+                q.fovea.psnr_db, q.fovea.ssim, q.blend.psnr_db, q.middle.psnr_db,
+                q.outer.psnr_db, q.outer.ssim);
+    for (const RegionQuality* r : {&q.fovea, &q.blend, &q.middle, &q.outer})
+        EXPECT_GT(r->pixels, 1000);
+    EXPECT_EQ(q.fovea.pixels + q.blend.pixels + q.middle.pixels + q.outer.pixels, q.all.pixels);
+    // The full-resolution fovea is close to the truth; the 1/s2² outer layer is not.
+    EXPECT_GT(q.fovea.psnr_db, q.outer.psnr_db + 3.0);
+    EXPECT_GT(q.fovea.ssim, q.outer.ssim);
+    EXPECT_GT(q.blend_deg[0], 0.0);
+    // The bins cover the same pixels, in increasing eccentricity.
+    int64_t binned = 0;
+    double last = -1.0;
+    for (const BandQuality::Bin& b : q.by_eccentricity) {
+        binned += b.q.pixels;
+        EXPECT_GT(b.center_deg, last);
+        last = b.center_deg;
+    }
+    EXPECT_EQ(binned, q.all.pixels);
+    EXPECT_GT(q.by_eccentricity.front().q.psnr_db, q.by_eccentricity.back().q.psnr_db);
+}
+
+}  // namespace
+}  // namespace qvr

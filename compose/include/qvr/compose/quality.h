@@ -2,7 +2,9 @@
 // §4.2): PSNR and SSIM, separately over the fovea (eccentricity ≤ e1) and the periphery.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <vector>
 
 #include "qvr/compose/test_pattern.h"
 #include "qvr/core/image.h"
@@ -30,5 +32,28 @@ struct QualityReport {
 QualityReport measureQuality(const HmdProfile& profile, const LayerPlan& plan,
                              const Pose& render_pose, const Pose& display_pose,
                              const ImageRgba8& image, const ImageRgbD& truth);
+
+// The same by eccentricity band of the layer plan — fovea (e < e1), the Eq. 4 blend bands
+// (within blend_band_texels of the coarser layer's texels of e1 or e2, both sides), middle,
+// outer — and in bins of bin_deg of eccentricity, for error-vs-eccentricity plots. Bins hold
+// only pixels on the rendered image. A still-image metric: it does not see temporal artefacts
+// (flicker and crawling of the periphery from frame to frame).
+struct BandQuality {
+    RegionQuality fovea;
+    RegionQuality blend;
+    RegionQuality middle;
+    RegionQuality outer;
+    RegionQuality all;
+    std::array<double, 2> blend_deg{};  // half-widths of the bands at e1 and e2
+    struct Bin {
+        double center_deg = 0.0;
+        RegionQuality q;
+    };
+    std::vector<Bin> by_eccentricity;
+};
+BandQuality measureQualityBands(const HmdProfile& profile, const LayerPlan& plan,
+                                const Pose& render_pose, const Pose& display_pose,
+                                const ImageRgba8& image, const ImageRgbD& truth,
+                                double blend_band_texels = 2.0, double bin_deg = 5.0);
 
 }  // namespace qvr
