@@ -149,6 +149,8 @@ int runClient(const ClientCmdOptions& o) {
                         {"server_proof_failures", st.net.server_proof_failures},
                         {"incompatible_refusals", st.net.incompatible_refusals},
                         {"media_drops", st.net.media_drops.total()},
+                        {"media_forged", st.net.media_drops[net::WireError::kBadMac]},
+                        {"media_replayed", st.net.media_drops[net::WireError::kReplayed]},
                         {"control_drops", st.net.control_drops.total()},
                         {"key_frame_requests", st.key_frame_requests},
                         {"nacks_sent", st.net.assembler.nacks},

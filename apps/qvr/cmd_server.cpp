@@ -187,6 +187,8 @@ int runServer(const ServerCmdOptions& o) {
                                   {"settings_refusals", s.net.settings_refusals},
                                   {"nacks", s.net.nacks},
                                   {"packets_retransmitted", s.net.packets_retransmitted},
+                                  {"bytes_retransmitted", s.net.bytes_retransmitted},
+                                  {"retransmissions_refused", s.net.retransmissions_refused},
                                   {"control_drops", s.net.control_drops.total()},
                                   {"core", o.core}};
         std::ofstream f(o.stats_json);

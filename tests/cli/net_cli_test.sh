@@ -120,6 +120,7 @@ else
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert d['connects'] >= 1 and d['incompatible_refusals'] == 0, d
+assert d['media_forged'] == 0 and d['media_replayed'] >= 0, d
 " "$tmp/ok/summary.json"; then
         pass "client with the server's settings connects"
     else
@@ -159,7 +160,8 @@ d = json.load(open(sys.argv[1]))
 assert d['settings_refusals'] == 2, d
 assert d['clients_accepted'] == 2, d
 for k in ('connections', 'handshake_timeouts', 'refused_full', 'protocol_errors',
-          'version_mismatches', 'nacks', 'packets_retransmitted'):
+          'version_mismatches', 'nacks', 'packets_retransmitted', 'bytes_retransmitted',
+          'retransmissions_refused', 'pending_evicted', 'idle_timeouts'):
     assert k in d, k
 " "$tmp/server_stats.json"; then
         pass "server stats count the refusals"
