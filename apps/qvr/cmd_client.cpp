@@ -81,7 +81,7 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: --out: %s\n", why.c_str());
         return 2;
     }
-    auto design = runtimeDesignByName(o.design);
+    auto design = designSpecByName(o.design);
     if (!design) {
         std::fprintf(stderr, "qvr client: --design: %s\n", design.error().c_str());
         return 2;
@@ -102,7 +102,8 @@ int runClient(const ClientCmdOptions& o) {
         return 2;
     }
     HeadsetConfig hc;
-    hc.design = *design;
+    hc.design = design->design;
+    hc.fixed_e1_deg = design->fixed_e1_deg;
     hc.profile = *profile;
     hc.codec.backend = o.codec;
     hc.host = host;

@@ -73,6 +73,7 @@ struct RunOptions {
     int video_max_frames = 900;
     int quality_every = 15;  // every Nth displayed frame is measured against a full render
     bool one_pass_periphery = false;
+    bool no_holes = false;
     int pipeline_depth = 2;
     float lod_px = 1.0f;
     std::string hardware;      // a calibration (qvr calibrate --out); none: cached or measured
@@ -330,8 +331,10 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
 }
 
 struct DesignRun {
-    RuntimeDesign design;
+    DesignSpec spec;
     HeadsetResult result;
+    RuntimeDesign design() const { return spec.design; }
+    std::string label() const { return spec.label(); }
 };
 
 // What limits each design's frame rate on this machine: the headset's busy time per frame (its
@@ -376,7 +379,7 @@ void limitsHtml(report::HtmlReport& page, const std::vector<DesignRun>& runs) {
                                              : "the decision (BVH ring counts)";
             limit = fmt::format("headset: busiest stage {}", stage);
         }
-        table.row({designName(r.design), fmt::format("{:.1f}", busy),
+        table.row({r.label(), fmt::format("{:.1f}", busy),
                    fmt::format("{:.1f}", decision), fmt::format("{:.1f}", local),
                    fmt::format("{:.1f}", uca), fmt::format("{:.1f}", remote),
                    report::Cell(limit, "", true)});
@@ -652,10 +655,14 @@ int runRun(const RunOptions& o) {
                                             server_stats_path.string(),
                                             "--stamps-csv",
                                             server_stamps_path.string(),
+                                            "--frames-csv",
+                                            (out / "server_frames.csv").string(),
                                             "--lod-px",
                                             fmt::format("{}", o.lod_px)};
     if (o.one_pass_periphery)
         server_args.push_back("--one-pass-periphery");
+    if (o.no_holes)
+        server_args.push_back("--no-holes");
     auto server = key_written ? ServerProcess::start(*exe, server_args)
                               : Expected<ServerProcess>(makeError("cannot write the key file"));
     unlink(key_path);
@@ -678,9 +685,12 @@ int runRun(const RunOptions& o) {
     bool recorded_workload = false;
     std::ofstream all_csv(out / "telemetry.csv");
     all_csv << telemetryCsvHeader();
-    for (RuntimeDesign d : *designs) {
+    for (const DesignSpec& spec : *designs) {
+        const RuntimeDesign d = spec.design;
+        const std::string label = spec.label();
         HeadsetConfig hc;
         hc.design = d;
+        hc.fixed_e1_deg = spec.fixed_e1_deg;
         hc.profile = *profile;
         hc.codec.backend = o.codec;
         hc.port = server->port();
@@ -719,7 +729,7 @@ int runRun(const RunOptions& o) {
         headset.join();
         progress.reset();  // clears the progress line
         if (!result) {
-            std::fprintf(stderr, "qvr run: %s: %s\n", designName(d), result.error().c_str());
+            std::fprintf(stderr, "qvr run: %s: %s\n", label.c_str(), result.error().c_str());
             return 1;
         }
         const DesignSummary& s = result->summary;
@@ -730,13 +740,13 @@ int runRun(const RunOptions& o) {
             s.e1_deg_mean, s.frames_displayed, s.frames_reused);
         std::fflush(stdout);
         for (const FrameTelemetry& t : result->frames)
-            all_csv << telemetryCsvRow(designName(d), t);
+            all_csv << telemetryCsvRow(label, t);
         if (auto st =
-                writeTelemetryCsv((out / fmt::format("frames_{}.csv", designName(d))).string(),
-                                  designName(d), result->frames);
+                writeTelemetryCsv((out / fmt::format("frames_{}.csv", label)).string(), label,
+                                  result->frames);
             !st)
             std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
-        runs.push_back({d, std::move(*result)});
+        runs.push_back({spec, std::move(*result)});
         // Image quality, between the measured runs: each sampled display against a
         // full-resolution render of the same frame (rendered now, on this thread).
         if (sampler && !sampler->samples().empty()) {
@@ -752,7 +762,7 @@ int runRun(const RunOptions& o) {
                 auto q =
                     measureDesignQuality(sampler->samples(), *profile, traces, *quality_renderer);
                 if (q)
-                    quality.emplace_back(designName(d), std::move(*q));
+                    quality.emplace_back(label, std::move(*q));
                 else
                     quality_note = q.error();
             }
@@ -860,7 +870,7 @@ int runRun(const RunOptions& o) {
                         ("no calibrated prediction: " + rt_link_check.error());
         if (trace && !trace->frames.empty()) {
             for (const DesignRun& r : runs) {
-                const std::string name = designName(r.design);
+                const std::string name = r.label();
                 Design sd = Design::Qvr;
                 double fixed_e1 = 5.0;
                 if (!simDesignOf(name, sd, fixed_e1))
@@ -931,7 +941,7 @@ int runRun(const RunOptions& o) {
     const DesignSummary* remote = nullptr;
     const DesignSummary* qvr = nullptr;
     for (const DesignRun& r : runs) {
-        const std::string name = designName(r.design);
+        const std::string name = r.label();
         dj[name] = summaryJson(r.result.summary, r.result.stats);
         if (predicted.contains(name)) {
             dj[name]["predicted"] = predicted[name];
@@ -942,11 +952,11 @@ int runRun(const RunOptions& o) {
         }
         if (predicted_paper.contains(name))
             dj[name]["predicted_paper_hardware"] = predicted_paper[name];
-        if (r.design == RuntimeDesign::kLocal)
+        if (r.design() == RuntimeDesign::kLocal)
             local = &r.result.summary;
-        if (r.design == RuntimeDesign::kRemote)
+        if (r.design() == RuntimeDesign::kRemote)
             remote = &r.result.summary;
-        if (r.design == RuntimeDesign::kQvr)
+        if (r.design() == RuntimeDesign::kQvr)
             qvr = &r.result.summary;
     }
     j["designs"] = dj;
@@ -1053,20 +1063,20 @@ int runRun(const RunOptions& o) {
                               "'scan-out interval (ms)'\nplot ";
         bool first = true;
         for (const DesignRun& r : runs) {
-            const std::string f = fmt::format("frames_{}.csv", designName(r.design));
+            const std::string f = fmt::format("frames_{}.csv", r.label());
             const std::string sep = first ? "" : ", ";
             // Columns (1-based, telemetryCsvHeader): 2 frame, 3 e1, 21 display_ns, 22 bytes, 31
             // mtp.
             e1_plot += fmt::format("{}'{}' every ::1 using 2:3 with lines title '{}'", sep, f,
-                                   designName(r.design));
+                                   r.label());
             mtp_plot += fmt::format("{}'{}' every ::1 using 2:31 with lines title '{}'", sep, f,
-                                    designName(r.design));
+                                    r.label());
             bytes_plot +=
                 fmt::format("{}'{}' every ::1 using 2:($22/1000+0.001) with lines title '{}'", sep,
-                            f, designName(r.design));
+                            f, r.label());
             ft_plot += fmt::format(
                 "{}'{}' every ::1 using 2:(d=($21-prev)/1e6, prev=$21, d) with lines title '{}'",
-                sep, f, designName(r.design));
+                sep, f, r.label());
             first = false;
         }
         plotter.plot("e1", kFigureTitles[0].second, e1_plot + "\n");
@@ -1238,6 +1248,9 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Server renders middle and outer in one geometry pass per eye (pays when "
                   "vertex-bound: no LOD, small displays)");
+    cmd->add_flag("--no-holes", o->no_holes,
+                  "Server draws every periphery layer whole, also where the headset's fovea (or "
+                  "the middle layer) covers it");
     addLodOption(cmd, o->lod_px);
     cmd->add_option("--pipeline", o->pipeline_depth,
                     "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
@@ -1261,10 +1274,11 @@ static Registered registerRun(CLI::App& app) {
     return {cmd, [o] {
                 o->command_line = fmt::format(
                     "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
-                    "--profile {} --codec {} --seed {} --lod-px {} --pipeline {}{}",
+                    "--profile {} --codec {} --seed {} --lod-px {} --pipeline {}{}{}",
                     o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile,
                     o->codec, o->seed, o->lod_px, o->pipeline_depth,
-                    o->one_pass_periphery ? " --one-pass-periphery" : "");
+                    o->one_pass_periphery ? " --one-pass-periphery" : "",
+                    o->no_holes ? " --no-holes" : "");
                 return runRun(*o);
             }};
 }

@@ -47,7 +47,9 @@ struct ServerCmdOptions {
     double duration_s = 0.0;
     std::string stats_json;
     std::string stamps_csv;
+    std::string frames_csv;
     bool one_pass_periphery = false;
+    bool no_holes = false;
     float lod_px = 1.0f;
 };
 
@@ -113,6 +115,7 @@ int runServer(const ServerCmdOptions& o) {
     cfg.codec.backend = o.codec;
     cfg.core = o.core;
     cfg.one_pass_periphery = o.one_pass_periphery;
+    cfg.holes.enabled = !o.no_holes;
     GlRendererOptions gl;
     gl.lod_error_px = o.lod_px;
     cfg.renderer = glRendererFactory(gl);
@@ -158,6 +161,7 @@ int runServer(const ServerCmdOptions& o) {
             break;
     }
     const RenderServerStats s = (*server)->stats();
+    const std::vector<ServerFrameRecord> frame_records = (*server)->frameRecords();
     (*server)->stop();
     if (stamps && std::fflush(stamps.get()) != 0)
         std::fprintf(stderr, "qvr server: error writing '%s'\n", o.stamps_csv.c_str());
@@ -175,6 +179,8 @@ int runServer(const ServerCmdOptions& o) {
                                   {"key_frame_requests", s.key_frame_requests},
                                   {"render_ms_total", s.render_ms_total},
                                   {"encode_ms_total", s.encode_ms_total},
+                                  {"readback_ms_total", s.readback_ms_total},
+                                  {"send_ms_total", s.send_ms_total},
                                   {"connections", s.net.connections},
                                   {"clients_accepted", s.net.clients_accepted},
                                   {"auth_failures", s.net.auth_failures},
@@ -195,6 +201,28 @@ int runServer(const ServerCmdOptions& o) {
         f << j.dump(2) << "\n";
         if (!f) {
             std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
+            return 1;
+        }
+    }
+    if (!o.frames_csv.empty()) {
+        std::ofstream f(o.frames_csv);
+        f << "client,frame,e1_deg,received_ns,start_ns,done_ns";
+        for (int sid = 0; sid < 4; ++sid)
+            f << fmt::format(",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
+                             "send_ms{0},bytes{0}",
+                             sid);
+        f << "\n";
+        for (const ServerFrameRecord& r : frame_records) {
+            f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg,
+                             r.received_ns, r.start_ns, r.done_ns);
+            for (size_t sid = 0; sid < 4; ++sid)
+                f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{}", r.pixels[sid],
+                                 r.triangles[sid], r.render_ms[sid], r.readback_ms[sid],
+                                 r.encode_ms[sid], r.send_ms[sid], r.bytes[sid]);
+            f << "\n";
+        }
+        if (!f) {
+            std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.frames_csv.c_str());
             return 1;
         }
     }
@@ -235,6 +263,12 @@ static Registered registerServer(CLI::App& app) {
     cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit");
     cmd->add_option("--stamps-csv", o->stamps_csv,
                     "Write per-layer render/encode/send stamps (steady clock ns) here");
+    cmd->add_option("--frames-csv", o->frames_csv,
+                    "Write one row per served frame (per-layer render, read-back, encode, send) "
+                    "here on exit");
+    cmd->add_flag("--no-holes", o->no_holes,
+                  "Draw every periphery layer whole, also where the compositor takes a finer "
+                  "layer");
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
     cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")

@@ -15,9 +15,13 @@ LiwcPolicy::LiwcPolicy(const WorkloadHeader& header, LiwcConfig config)
       m_gpu_theta{0.0, 1e5 / config.gpu_triangles_per_ms_initial,
                   1e5 / config.gpu_pixels_per_ms_initial},
       m_gpu_cov{1, 0, 0, 0, 1, 0, 0, 0, 1},
+
       m_throughput_bps(config.throughput_bps_initial),
       m_log_bits_at_1(std::log(config.bits_per_pixel_initial)),
       m_bits_exponent(config.bits_scale_exponent_initial),
+      m_local_fit({0.0, 1e5 / config.gpu_triangles_per_ms_initial,
+                   1e5 / config.gpu_pixels_per_ms_initial}),
+      m_server_fit({0.0, 0.0, 0.0}),
       m_e1_deg(config.e1_initial_deg) {
     QVR_CHECK(config.max_delta_deg == 5);  // the table's tags are −5…+5
     QVR_CHECK(config.alpha > 0.0f && config.alpha <= 1.0f);
@@ -68,6 +72,8 @@ double LiwcPolicy::localMs(double e1_deg) const {
     const double e = e1_deg >= m_cover_deg ? 1e9 : e1_deg;
     const double tris = prefixAt(m_prefix_tris, m_header.ring_deg, e);
     const double pixels = prefixAt(m_prefix_pixels, m_header.ring_deg, e);
+    if (m_config.frame_period_objective)
+        return std::max(0.0, m_local_fit.predict({1.0, tris * 1e-5, pixels * 1e-5}));
     return std::max(0.0,
                     m_gpu_theta[0] + m_gpu_theta[1] * tris * 1e-5 + m_gpu_theta[2] * pixels * 1e-5);
 }
@@ -80,6 +86,95 @@ double LiwcPolicy::remoteMs(const Gaze& gaze, double e1_deg) const {
     const double bits =
         2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
     return m_remote_base_ms + bits / m_throughput_bps * 1000.0;
+}
+
+void LiwcPolicy::setLinkEstimate(double throughput_bps) {
+    if (throughput_bps > 0.0 && std::isfinite(throughput_bps))
+        m_link_bps = throughput_bps;
+}
+
+double LiwcPolicy::peripheryTriangles(double e1_deg) const {
+    const size_t rings = m_prefix_tris.size() - 1;
+    const double total = rings > 0 ? m_prefix_tris[rings] : 0.0;
+    if (e1_deg >= m_cover_deg)
+        return 0.0;
+    return std::max(0.0, total - prefixAt(m_prefix_tris, m_header.ring_deg, e1_deg));
+}
+
+double LiwcPolicy::peripheryPixels(const Gaze& gaze, double e1_deg) const {
+    if (e1_deg >= m_cover_deg)
+        return 0.0;
+    const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
+    return 2.0 * (p.middle_pixels + p.outer_pixels);
+}
+
+double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
+    if (e1_deg >= m_cover_deg)
+        return 0.0;
+    const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
+    const double bits =
+        2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
+    const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
+    return bits / std::max(1.0, bps) * 1000.0;
+}
+
+Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double hi) {
+    // The frame period with frames in flight is set by the slower side: minimise
+    // max(L, R) over a grid of ±max_delta in half degrees, L the headset's busy time, R the
+    // server's render + encode plus the transmission, each with the table's learned offset on R.
+    struct Eval {
+        double e1 = 0.0, local = 0.0, remote = 0.0, period = 0.0, latency = 0.0;
+        double triangles = 0.0, pixels = 0.0;
+    };
+    auto evaluate = [&](double e) {
+        Eval v;
+        v.e1 = e;
+        v.local = localMs(e);
+        v.triangles = peripheryTriangles(e);
+        v.pixels = peripheryPixels(frame.gaze, e);
+        const double server =
+            e >= m_cover_deg
+                ? 0.0
+                : std::max(0.0, m_server_fit.predict({1.0, v.triangles * 1e-5, v.pixels * 1e-5}));
+        const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(e));
+        v.remote = e >= m_cover_deg ? 0.0
+                                    : std::max(0.0, server + transmissionMs(frame.gaze, e) + offset);
+        v.period = std::max(v.local, v.remote);
+        v.latency = v.local + v.remote;
+        return v;
+    };
+    const double step = 0.5;
+    const int steps = 2 * m_config.max_delta_deg * 2;
+    Eval best;
+    bool have = false;
+    for (int k = 0; k <= steps; ++k) {
+        const double e = std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo,
+                                    std::max(lo, hi));
+        const Eval v = evaluate(e);
+        if (!have) {
+            best = v;
+            have = true;
+            continue;
+        }
+        const double tie = m_config.period_tie * std::max(best.period, v.period);
+        if (v.period < best.period - tie ||
+            (std::fabs(v.period - best.period) <= tie && v.latency < best.latency))
+            best = v;
+    }
+    m_e1_deg = best.e1;
+    Decision d;
+    d.e1_deg = best.e1;
+    d.t_local_pred_ms = best.local;
+    d.t_remote_pred_ms = best.remote;
+    remember(d);
+    m_pending.back().periphery_triangles = best.triangles;
+    m_pending.back().periphery_pixels = best.pixels;
+    // Here the table learns what the model (without the offset) mispredicted of T_remote alone:
+    // T_local has its own fit, refreshed every frame, and an offset learned from the imbalance
+    // would move R by L's error, which the period max(L, R) cannot absorb.
+    const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(best.e1));
+    m_pending.back().model_imbalance_ms = best.remote - offset;
+    return d;
 }
 
 double LiwcPolicy::predictLocalMs(const WorkloadFrame& frame, double e1_deg) const {
@@ -100,7 +195,23 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
     m_previous_gaze = frame.gaze;
     m_have_previous = true;
 
-    prepareFrame(frame);
+    if (m_config.reactive) {
+        // Software sees a frame's triangles only once it has rendered: decide with the rings
+        // of the newest observed frame.
+        m_seen.push_back({frame.index, frame.triangles_per_ring, frame.pixels_per_ring});
+        while (m_seen.size() > kMaxPendingDecisions)
+            m_seen.pop_front();
+        if (m_reactive_rings) {
+            WorkloadFrame old = frame;
+            old.triangles_per_ring = m_reactive_rings->triangles_per_ring;
+            old.pixels_per_ring = m_reactive_rings->pixels_per_ring;
+            prepareFrame(old);
+        } else {
+            prepareFrame(frame);
+        }
+    } else {
+        prepareFrame(frame);
+    }
     const double hi = std::min(m_config.e1_max_deg, m_cover_deg);
     const double lo = m_config.e1_min_deg;
     if (m_first_decision) {
@@ -109,8 +220,14 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
         m_e1_deg = std::clamp(m_config.e1_initial_deg, lo, std::max(lo, hi));
         Decision d{m_e1_deg, localMs(m_e1_deg), remoteMs(frame.gaze, m_e1_deg)};
         remember(d);
+        if (m_config.frame_period_objective)
+            m_pending.back().model_imbalance_ms = d.t_remote_pred_ms;
+        m_pending.back().periphery_triangles = peripheryTriangles(m_e1_deg);
+        m_pending.back().periphery_pixels = peripheryPixels(frame.gaze, m_e1_deg);
         return d;
     }
+    if (m_config.frame_period_objective)
+        return decidePeriod(frame, lo, hi);
     // One candidate per delta tag; the table's offset is indexed by the candidate's
     // eccentricity bucket under the current motion.
     int best = 0;
@@ -165,21 +282,46 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // measured imbalance against the one Eq. 2 predicted with the pre-frame estimates. During
     // warm-up the estimates are still far off and their error is not the motion's.
     // Observations arrive in frame order, so this one belongs to the oldest open decision.
+    std::optional<PendingDecision> decided;
     if (!m_pending.empty()) {
         const PendingDecision p = m_pending.front();
+        decided = p;
         m_pending.pop_front();
         if (m_observed >= m_config.table_warmup_frames) {
-            const double delta = (m.t_remote_ms - m.t_local_ms) - p.model_imbalance_ms;
+            const double measured = m_config.frame_period_objective
+                                        ? m.t_remote_ms
+                                        : m.t_remote_ms - m.t_local_ms;
+            const double delta = measured - p.model_imbalance_ms;
             m_table.fold(p.motion, p.bucket, static_cast<float>(delta), m_config.alpha);
+        }
+    }
+    if (m_config.reactive) {
+        while (!m_seen.empty() && m_seen.front().index < m.index)
+            m_seen.pop_front();
+        if (!m_seen.empty() && m_seen.front().index == m.index) {
+            m_reactive_rings = m_seen.front();
+            m_seen.pop_front();
         }
     }
     ++m_observed;
     const double b = m_config.rate_ema;
-    if (m.t_local_ms > 0.0)
-        updateGpuRates(m.triangles_local, m.pixels_local, m.t_local_ms);
+    if (m.t_local_ms > 0.0) {
+        if (m_config.frame_period_objective)
+            m_local_fit.add({1.0, m.triangles_local * 1e-5, m.pixels_local * 1e-5}, m.t_local_ms);
+        else
+            updateGpuRates(m.triangles_local, m.pixels_local, m.t_local_ms);
+    }
     if (m.throughput_bps > 0.0)
         m_throughput_bps = (1.0 - b) * m_throughput_bps + b * m.throughput_bps;
-    if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
+    if (m_config.frame_period_objective && decided && m.t_remote_ms > 0.0) {
+        // What the server took beyond the transmission, against what it had to draw.
+        const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
+        const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
+        const double server_ms = std::max(0.0, m.t_remote_ms - sent_bits / bps * 1000.0);
+        m_server_fit.add(
+            {1.0, decided->periphery_triangles * 1e-5, decided->periphery_pixels * 1e-5},
+            server_ms);
+    } else if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double transmission_ms = sent_bits / m_throughput_bps * 1000.0;
         const double rest = std::max(0.0, m.t_remote_ms - transmission_ms);

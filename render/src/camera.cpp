@@ -2,6 +2,7 @@
 // view and projection matrices.
 #include "qvr/render/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -62,6 +63,19 @@ RenderView layerView(const HmdProfile& profile, const Pose& head, Eye eye, const
     v.projection = regionProjection(profile, x0, y0, x0 + layer.width_px * layer.scale,
                                     y0 + layer.height_px * layer.scale, options);
     return v;
+}
+
+void setSkipCone(RenderView& view, const HmdProfile& profile, const Pose& head, Eye eye,
+                 const Gaze& gaze, double radius_deg, const CameraOptions& options) {
+    if (!(radius_deg > 0.0)) {
+        view.skip_half_angle_rad = 0.0f;
+        return;
+    }
+    const Pose ep = eyePose(head, eye, options.ipd_m);
+    const glm::dvec3 g = EyeGeometry(profile).gazeDirection(gaze);
+    view.skip_apex = ep.position_m;
+    view.skip_axis = glm::normalize(glm::normalize(ep.orientation) * glm::vec3(g));
+    view.skip_half_angle_rad = static_cast<float>(std::min(radius_deg, 89.0) * (M_PI / 180.0));
 }
 
 RenderView fullFrameView(const HmdProfile& profile, const Pose& head, Eye eye,

@@ -212,17 +212,109 @@ void buildLods(DrawList& list, const Scene& scene, const LodOptions& options) {
     }
 }
 
+namespace {
+
+// The coarsest level whose largest vertex move, seen from the eye at the box's nearest point,
+// stays within lod_error_px pixels; -1 for full detail.
+int lodLevelFor(const DrawList& list, const Aabb& bounds, const glm::vec3& eye, float px_per_rad,
+                float lod_error_px) {
+    const glm::vec3 nearest = glm::clamp(eye, bounds.min, bounds.max);
+    const float d = glm::length(nearest - eye);
+    // A vertex moves at most half a cell diagonal: √3/2 · cell.
+    const float max_cell = lod_error_px * d / (0.8660254f * px_per_rad);
+    int level = -1;
+    while (level + 1 < static_cast<int>(list.lods.size()) &&
+           list.lods[static_cast<size_t>(level + 1)].cell_m <= max_cell)
+        ++level;
+    return level;
+}
+
+float pixelsPerRadian(const RenderView& view) {
+    // Pixels per unit of tangent: the projection's scale times half the framebuffer.
+    return std::max(std::fabs(view.projection[0][0]) * 0.5f * float(view.width_px),
+                    std::fabs(view.projection[1][1]) * 0.5f * float(view.height_px));
+}
+
+}  // namespace
+
+void addTrianglesPerRing(const DrawList& list, const RenderView& view, float lod_error_px,
+                         const glm::vec3& axis, double ring_deg, std::vector<double>& rings) {
+    if (rings.empty() || !(ring_deg > 0.0))
+        return;
+    const FrustumPlanes planes = frustumPlanes(view.viewProjection());
+    const glm::vec3 eye = glm::vec3(glm::inverse(view.view)[3]);
+    const bool lod = lod_error_px > 0.0f && !list.lods.empty();
+    const float px_per_rad = pixelsPerRadian(view);
+    const double rad_per_ring = ring_deg * (M_PI / 180.0);
+    const int last = static_cast<int>(rings.size()) - 1;
+    for (size_t ci = 0; ci < list.clusters.size(); ++ci) {
+        const DrawCluster& c = list.clusters[ci];
+        if (!boxMayBeVisible(planes, c.bounds))
+            continue;
+        uint32_t count = c.index_count;
+        if (lod && px_per_rad > 0.0f) {
+            const int level = lodLevelFor(list, c.bounds, eye, px_per_rad, lod_error_px);
+            if (level >= 0)
+                count = list.lods[static_cast<size_t>(level)].index_count[ci];
+        }
+        if (count == 0)
+            continue;
+        const double triangles = count / 3;
+        const glm::vec3 centre = 0.5f * (c.bounds.min + c.bounds.max);
+        const float radius = 0.5f * glm::length(c.bounds.max - c.bounds.min);
+        const glm::vec3 v = centre - eye;
+        const float d = glm::length(v);
+        double lo = 0.0, hi = M_PI;  // the eye inside the sphere: every direction
+        if (d > radius) {
+            const double angle = std::acos(std::clamp(double(glm::dot(v, axis)) / d, -1.0, 1.0));
+            const double spread = std::asin(std::min(1.0, double(radius) / d));
+            lo = std::max(0.0, angle - spread);
+            hi = std::min(M_PI, angle + spread);
+        }
+        // Spread evenly over the rings [lo, hi] spans.
+        const double a = lo / rad_per_ring, b = std::max(a + 1e-9, hi / rad_per_ring);
+        const int k0 = std::min(last, static_cast<int>(a));
+        const int k1 = std::min(last, static_cast<int>(b));
+        // Past the last ring everything falls in it (it is open-ended).
+        if (k0 == k1 || k0 == last) {
+            rings[static_cast<size_t>(k0)] += triangles;
+            continue;
+        }
+        const double per = triangles / (b - a);
+        rings[static_cast<size_t>(k0)] += per * (k0 + 1 - a);
+        for (int k = k0 + 1; k < k1; ++k)
+            rings[static_cast<size_t>(k)] += per;
+        // The last ring also takes the part beyond it.
+        rings[static_cast<size_t>(k1)] += per * (b - k1);
+    }
+}
+
+bool boxInsideCone(const Aabb& box, const glm::vec3& apex, const glm::vec3& axis,
+                   float half_angle_rad) {
+    if (!(half_angle_rad > 0.0f))
+        return false;
+    const glm::vec3 centre = 0.5f * (box.min + box.max);
+    const float radius = 0.5f * glm::length(box.max - box.min);
+    const glm::vec3 v = centre - apex;
+    const float d = glm::length(v);
+    if (d <= radius * 1.0001f + 1e-6f)
+        return false;  // the apex may be inside the sphere
+    const float angle = std::acos(std::clamp(glm::dot(v, axis) / d, -1.0f, 1.0f));
+    const float spread = std::asin(std::min(1.0f, radius / d));
+    // A small absolute slack keeps float rounding on the safe side.
+    return angle + spread + 1e-4f <= half_angle_rad;
+}
+
 DrawSelection selectDraws(const DrawList& list, const RenderView& view, float lod_error_px) {
     DrawSelection s;
     const FrustumPlanes planes = frustumPlanes(view.viewProjection());
     const bool lod = lod_error_px > 0.0f && !list.lods.empty();
+    const bool hole = view.skip_half_angle_rad > 0.0f;
     glm::vec3 eye(0.0f);
     float px_per_rad = 0.0f;
     if (lod) {
         eye = glm::vec3(glm::inverse(view.view)[3]);
-        // Pixels per unit of tangent: the projection's scale times half the framebuffer.
-        px_per_rad = std::max(std::fabs(view.projection[0][0]) * 0.5f * float(view.width_px),
-                              std::fabs(view.projection[1][1]) * 0.5f * float(view.height_px));
+        px_per_rad = pixelsPerRadian(view);
     }
     for (size_t ci = 0; ci < list.clusters.size(); ++ci) {
         const DrawCluster& c = list.clusters[ci];
@@ -230,18 +322,16 @@ DrawSelection selectDraws(const DrawList& list, const RenderView& view, float lo
             ++s.clusters_culled;
             continue;
         }
+        if (hole && boxInsideCone(c.bounds, view.skip_apex, view.skip_axis,
+                                  view.skip_half_angle_rad)) {
+            ++s.clusters_skipped;
+            continue;
+        }
         ++s.clusters_drawn;
         uint32_t first = c.first_index;
         uint32_t count = c.index_count;
         if (lod && px_per_rad > 0.0f) {
-            const glm::vec3 nearest = glm::clamp(eye, c.bounds.min, c.bounds.max);
-            const float d = glm::length(nearest - eye);
-            // A vertex moves at most half a cell diagonal: √3/2 · cell.
-            const float max_cell = lod_error_px * d / (0.8660254f * px_per_rad);
-            int level = -1;
-            while (level + 1 < static_cast<int>(list.lods.size()) &&
-                   list.lods[static_cast<size_t>(level + 1)].cell_m <= max_cell)
-                ++level;
+            const int level = lodLevelFor(list, c.bounds, eye, px_per_rad, lod_error_px);
             if (level >= 0) {
                 const DrawLodLevel& l = list.lods[static_cast<size_t>(level)];
                 first = l.first_index[ci];

@@ -575,6 +575,7 @@ struct GlRenderer::Impl {
         }
         stats.clusters_drawn = selection.clusters_drawn;
         stats.clusters_culled = selection.clusters_culled;
+        stats.clusters_skipped = selection.clusters_skipped;
         stats.draw_calls = static_cast<uint32_t>(selection.draws.size());
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         if (Status s = checkGl("rendering"); !s)

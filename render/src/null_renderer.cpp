@@ -1,5 +1,6 @@
 // The renderer without a device, what tests of frame logic use when they need the counts of a
 // rendering but not its pixels; and the device-independent pieces every renderer shares.
+#include <algorithm>
 #include <vector>
 
 #include "qvr/render/draw_list.h"
@@ -7,15 +8,35 @@
 
 namespace qvr {
 
+double layerHoleDeg(const HmdProfile& profile, const LayerPlan& plan, Eye eye, LayerKind kind,
+                    const LayerHoles& holes) {
+    if (!holes.enabled || kind == LayerKind::kFovea)
+        return 0.0;
+    const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+    const LayerRect& self = layerOf(layers, kind);
+    // The finer layer the hole is taken from must be there.
+    const LayerRect& finer = kind == LayerKind::kMiddle ? layers.fovea : layers.middle;
+    if (self.empty() || finer.empty())
+        return 0.0;
+    const double radius_deg = kind == LayerKind::kMiddle ? plan.e1_deg : plan.e2_deg;
+    const double band_deg =
+        (holes.band_texels + holes.margin_texels) * self.scale * profile.pixelAngleDeg();
+    return std::max(0.0, radius_deg - band_deg);
+}
+
 Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
                                   const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
-                                  ImageRgba8& out, const CameraOptions& options) {
+                                  ImageRgba8& out, const CameraOptions& options,
+                                  const LayerHoles& holes) {
     const LayerRect& layer = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
     if (layer.empty()) {
         out.resize(0, 0);
         return RenderStats{};
     }
-    return renderer.render(layerView(profile, head, eye, layer, options), out);
+    RenderView view = layerView(profile, head, eye, layer, options);
+    setSkipCone(view, profile, head, eye, plan.gaze,
+                layerHoleDeg(profile, plan, eye, kind, holes), options);
+    return renderer.render(view, out);
 }
 
 namespace {
@@ -45,6 +66,7 @@ public:
         stats.primitives_generated = sel.triangles;
         stats.clusters_drawn = sel.clusters_drawn;
         stats.clusters_culled = sel.clusters_culled;
+        stats.clusters_skipped = sel.clusters_skipped;
         stats.draw_calls = static_cast<uint32_t>(sel.draws.size());
         return stats;
     }

@@ -95,10 +95,14 @@ public:
           m_probe(config.profile, std::move(bvh)),
           m_compositor(config.profile, composeOptions()) {}
 
-    static LiwcConfig liwcConfig() {
+    static LiwcConfig liwcConfig(bool reactive) {
         LiwcConfig c;
-        // A real server takes time to render and encode; Eq. 2 alone would not see it.
+        // A real server takes time to render and encode, less the larger the fovea; Eq. 2
+        // alone would not see it. With frames in flight the display's period is the slower
+        // side's, which is what LIWC minimises here (docs/LIWC.md).
         c.learn_remote_base = true;
+        c.frame_period_objective = true;
+        c.reactive = reactive;
         return c;
     }
 
@@ -119,15 +123,28 @@ public:
         m_renderer = std::move(*r);
         if (auto st = m_renderer->upload(*m_scene); !st)
             return makeError("headset: " + st.error());
+        if (m_config.design == RuntimeDesign::kQvr || m_config.design == RuntimeDesign::kSw ||
+            m_config.workload) {
+            // LIWC's rings from the draw clusters (what the fovea submits), not the BVH.
+            auto clusters = std::make_shared<DrawList>(buildDrawList(*m_scene));
+            if (m_config.lod_error_px > 0.0f)
+                buildLods(*clusters, *m_scene);
+            m_probe.useClusters(std::move(clusters), m_config.lod_error_px);
+        }
         switch (m_config.design) {
-            case RuntimeDesign::kQvr:
-                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig());
+            case RuntimeDesign::kQvr: {
+                auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(false));
+                m_liwc = liwc.get();
+                m_policy = std::move(liwc);
                 break;
+            }
             case RuntimeDesign::kSw:
-                m_policy = makeSoftwareReactivePolicy(m_probe.header());
+                // The same model as qvr's, fed as software would be (docs/RUNTIME.md).
+                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(true));
                 break;
             case RuntimeDesign::kFfr:
-                m_policy = std::make_unique<FixedPolicy>(m_config.ffr_e1_deg);
+            case RuntimeDesign::kFixed:
+                m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
                 break;
             default:
                 break;
@@ -181,7 +198,7 @@ public:
         }
         m_stats.core = currentCore();
         result.stats = m_stats;
-        result.summary = summarizeRun(designName(m_config.design), result.frames);
+        result.summary = summarizeRun(designLabel(m_config.design, m_config.fixed_e1_deg), result.frames);
         return result;
     }
 
@@ -364,15 +381,20 @@ private:
         result.frames[ti].connected = connected;
 
         // 2. Decision: e1 before rendering.
-        const bool needs_workload = m_config.design == RuntimeDesign::kQvr || m_config.workload;
+        const bool needs_workload = m_config.design == RuntimeDesign::kQvr ||
+                                    m_config.design == RuntimeDesign::kSw || m_config.workload;
         std::optional<WorkloadFrame> wf;
-        if (needs_workload)
-            // LIWC's candidates reach 5° past the last e1: rings beyond are lumped into the last
-            // counted one (also in the recorded trace: its totals are exact, its far rings not).
-            wf = m_probe.frame(i, content_ms, head, gaze, m_last_e1_deg + 6.0);
+        double probe_ms = 0.0;
+        if (needs_workload) {
+            const int64_t probe_start_ns = m_clock.nowNs();
+            wf = m_probe.frame(i, content_ms, head, gaze);
+            probe_ms = double(m_clock.nowNs() - probe_start_ns) * 1e-6;
+        }
         LayerPlan plan;
         bool decided = false;
         bool fallback = false;
+        double t_local_pred_ms = 0.0;
+        double t_remote_pred_ms = 0.0;
         switch (m_config.design) {
             case RuntimeDesign::kLocal:
                 plan = m_planner.plan(gaze, 180.0);
@@ -395,8 +417,11 @@ private:
                         light.head = head;
                         light.gaze = gaze;
                     }
+                    if (m_liwc)
+                        m_liwc->setLinkEstimate(m_client->throughputBps());
                     const Decision d = m_policy->decide(wf ? *wf : light);
-                    m_last_e1_deg = d.e1_deg;
+                    t_local_pred_ms = d.t_local_pred_ms;
+                    t_remote_pred_ms = d.t_remote_pred_ms;
                     plan = m_planner.plan(gaze, d.e1_deg);
                     decided = true;
                 } else {
@@ -410,6 +435,9 @@ private:
         FrameTelemetry* t = &result.frames[ti];
         t->decision_ns = rel(m_clock.nowNs());
         t->fallback_local = fallback;
+        t->probe_ms = probe_ms;
+        t->t_local_pred_ms = t_local_pred_ms;
+        t->t_remote_pred_ms = t_remote_pred_ms;
         t->e1_deg = m_config.design == RuntimeDesign::kRemote && !fallback ? 0.0
                     : m_config.design == RuntimeDesign::kLocal || fallback ? plan.cover_deg
                                                                            : plan.e1_deg;
@@ -513,9 +541,14 @@ private:
             PendingFrame* p = pendingFor(i);
             t = &result.frames[ti];
             have_current = p && p->complete();
-            const int64_t end_ns = have_current ? m_origin_ns + t->remote_done_ns : m_clock.nowNs();
+            const int64_t now_ns = m_clock.nowNs();
+            const int64_t decoded_ns = have_current ? m_origin_ns + t->remote_done_ns : now_ns;
+            // The last packet's arrival, not its decode: decoding waits while the headset
+            // renders its own fovea on the same core, which is headset time, not the server's.
+            const int64_t rx_ns = have_current && p->last_rx_ns > 0 ? p->last_rx_ns : now_ns;
             const int64_t start_ns = p ? p->service_start_ns : m_origin_ns + t->request_ns;
-            t->t_remote_ms = double(end_ns - std::min(start_ns, end_ns)) * 1e-6;
+            t->t_remote_ms = double(rx_ns - std::min(start_ns, rx_ns)) * 1e-6;
+            t->t_remote_decoded_ms = double(decoded_ns - std::min(start_ns, decoded_ns)) * 1e-6;
             if (!have_current)
                 ++m_stats.late_frames;
         }
@@ -560,7 +593,8 @@ private:
         }
         t->throughput_bps = m_client ? m_client->throughputBps() : 0.0;
         const int64_t vsync_wait_start_ns = m_clock.nowNs();
-        const int64_t display_ns = m_pacer.waitForScanout(uca_end_ns);
+        const int64_t display_ns = m_config.wait_for_vsync ? m_pacer.waitForScanout(uca_end_ns)
+                                                           : m_pacer.queueForScanout(uca_end_ns);
         m_idle_ns += std::max<int64_t>(0, m_clock.nowNs() - vsync_wait_start_ns);
         // Busy time since the previous frame finished: the headset's cost of one frame.
         {
@@ -628,6 +662,7 @@ private:
     Compositor m_compositor;
     std::unique_ptr<Renderer> m_renderer;
     std::unique_ptr<FoveaPolicy> m_policy;
+    LiwcPolicy* m_liwc = nullptr;  // m_policy when it is qvr's LIWC
     std::unique_ptr<net::Client> m_client;
     std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;
     std::array<int64_t, net::kMaxStreams> m_last_key_request_ns{};
@@ -641,7 +676,6 @@ private:
     int64_t m_idle_ns = 0;  // waiting for the network or vsync since the last frame finished
     int64_t m_last_finish_ns = 0;
     size_t m_depth = 1;
-    double m_last_e1_deg = 5.0;
     uint64_t m_proof_failures_seen = 0;
     std::string m_refusal;  // why the server refused our settings, empty while it has not
 

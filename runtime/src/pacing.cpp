@@ -61,4 +61,11 @@ int64_t VsyncPacer::waitForScanout(int64_t ready_ns) {
     return slot;
 }
 
+int64_t VsyncPacer::queueForScanout(int64_t ready_ns) {
+    const int64_t slot = slotAtOrAfter(ready_ns);
+    m_clock.sleepUntilNs(slot - m_period_ns);
+    m_last_scanout_ns = slot;
+    return slot;
+}
+
 }  // namespace qvr::runtime

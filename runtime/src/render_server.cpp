@@ -83,6 +83,7 @@ struct RenderServer::Impl final : net::ServerHandler {
     net::ClientId last_served = 0;
     bool stopping = false;
     RenderServerStats stats;
+    std::deque<ServerFrameRecord> records;  // guarded by mutex
 
     // Start-up handshake with the render thread.
     bool ready = false;
@@ -180,6 +181,12 @@ struct RenderServer::Impl final : net::ServerHandler {
             stamps.start_ns = steadyNs();
             stamps.layers.clear();
             int64_t render_start_ns = 0, render_end_ns = 0;
+            ServerFrameRecord rec;
+            rec.client = id;
+            rec.frame_id = req.frame_id;
+            rec.e1_deg = req.e1_deg;
+            rec.received_ns = queued_ns;
+            rec.start_ns = stamps.start_ns;
             const LayerPlan plan = net::layerPlanOf(req);
             if (!planFits(config.profile, plan)) {
                 std::lock_guard lock(mutex);
@@ -206,15 +213,21 @@ struct RenderServer::Impl final : net::ServerHandler {
                     return;
                 }
                 delta.encode_ms_total += encoded->encode_ms;
+                rec.encode_ms[sid] += encoded->encode_ms;
+                rec.bytes[sid] += static_cast<int64_t>(encoded->bytes.size());
                 const int64_t encode_end_ns = steadyNs();
                 const bool key = encoded->is_keyframe;
                 if (config.on_frame)  // stamped before the transport can deliver it
                     stamps.layers.push_back(
                         {sid, render_start_ns, render_end_ns, encode_end_ns, steadyNs()});
+                const int64_t send_start_ns = steadyNs();
                 if (server->sendStream(id, req.frame_id, sid, key, std::move(encoded->bytes)))
                     ++delta.streams_sent;
                 else
                     ++delta.stream_send_failures;
+                const double send_ms = double(steadyNs() - send_start_ns) * 1e-6;
+                rec.send_ms[sid] += send_ms;
+                delta.send_ms_total += send_ms;
             };
             for (int eye = 0; eye < 2; ++eye) {
                 const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
@@ -229,6 +242,11 @@ struct RenderServer::Impl final : net::ServerHandler {
                         delta.render_failures += 2;
                         continue;
                     }
+                    const uint8_t mid = net::streamId(eye, net::Layer::kMiddle);
+                    rec.render_ms[mid] += rs->render_ms;
+                    rec.readback_ms[mid] += rs->readback_ms;
+                    rec.triangles[mid] += rs->primitives_generated;
+                    delta.readback_ms_total += rs->readback_ms;
                     delta.layers_rendered += 2;
                     ++delta.periphery_passes;
                     send(net::streamId(eye, net::Layer::kMiddle), image);
@@ -243,22 +261,32 @@ struct RenderServer::Impl final : net::ServerHandler {
                     const auto t0 = std::chrono::steady_clock::now();
                     render_start_ns = steadyNs();
                     auto rs = renderLayer(r, config.profile, plan, req.pose, static_cast<Eye>(eye),
-                                          kind, image);
+                                          kind, image, CameraOptions{}, config.holes);
                     delta.render_ms_total += msSince(t0);
                     render_end_ns = steadyNs();
                     if (!rs) {
                         ++delta.render_failures;
                         continue;
                     }
+                    const uint8_t sid = net::streamId(eye, layer);
+                    rec.render_ms[sid] += rs->render_ms;
+                    rec.readback_ms[sid] += rs->readback_ms;
+                    rec.triangles[sid] += rs->primitives_generated;
+                    rec.pixels[sid] = int64_t(image.width()) * image.height();
+                    delta.readback_ms_total += rs->readback_ms;
                     ++delta.layers_rendered;
-                    send(net::streamId(eye, layer), image);
+                    send(sid, image);
                 }
             }
             if (config.on_frame) {
                 stamps.end_ns = steadyNs();
                 config.on_frame(stamps);
             }
+            rec.done_ns = steadyNs();
             std::lock_guard lock(mutex);
+            records.push_back(rec);
+            while (records.size() > RenderServer::kMaxFrameRecords)
+                records.pop_front();
             ++stats.frames_rendered;
             stats.layers_rendered += delta.layers_rendered;
             stats.periphery_passes += delta.periphery_passes;
@@ -268,6 +296,8 @@ struct RenderServer::Impl final : net::ServerHandler {
             stats.encode_failures += delta.encode_failures;
             stats.render_ms_total += delta.render_ms_total;
             stats.encode_ms_total += delta.encode_ms_total;
+            stats.readback_ms_total += delta.readback_ms_total;
+            stats.send_ms_total += delta.send_ms_total;
         }
     }
 };
@@ -342,6 +372,11 @@ RenderServerStats RenderServer::stats() const {
     if (m_impl->server)
         s.net = m_impl->server->stats();
     return s;
+}
+
+std::vector<ServerFrameRecord> RenderServer::frameRecords() const {
+    std::lock_guard lock(m_impl->mutex);
+    return {m_impl->records.begin(), m_impl->records.end()};
 }
 
 size_t RenderServer::clients() const {

@@ -1,7 +1,9 @@
 // Design names for the command line.
 #include "qvr/runtime/runtime_design.h"
 
+#include <cmath>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -19,8 +21,20 @@ const char* designName(RuntimeDesign design) {
             return "sw";
         case RuntimeDesign::kQvr:
             return "qvr";
+        case RuntimeDesign::kFixed:
+            return "fixed";
     }
     return "?";
+}
+
+std::string designLabel(RuntimeDesign design, double fixed_e1_deg) {
+    if (design == RuntimeDesign::kFixed)
+        return fmt::format("fixed:{:g}", fixed_e1_deg);
+    return designName(design);
+}
+
+std::string DesignSpec::label() const {
+    return designLabel(design, fixed_e1_deg);
 }
 
 const std::vector<RuntimeDesign>& allRuntimeDesigns() {
@@ -35,19 +49,47 @@ Expected<RuntimeDesign> runtimeDesignByName(const std::string& name) {
         if (name == designName(d))
             return d;
     return makeError(
-        fmt::format("unknown design '{}': expected local, remote, ffr, sw or qvr", name));
+        fmt::format("unknown design '{}': expected local, remote, ffr, sw, qvr or fixed:E", name));
 }
 
-Expected<std::vector<RuntimeDesign>> parseDesignList(const std::string& list) {
-    std::vector<RuntimeDesign> out;
+Expected<DesignSpec> designSpecByName(const std::string& name) {
+    constexpr std::string_view kFixedPrefix = "fixed:";
+    if (name.rfind(kFixedPrefix, 0) == 0) {
+        const std::string num = name.substr(kFixedPrefix.size());
+        double e1 = 0.0;
+        size_t used = 0;
+        try {
+            e1 = std::stod(num, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (num.empty() || used != num.size() || !std::isfinite(e1) || e1 < kFixedE1MinDeg ||
+            e1 > kFixedE1MaxDeg)
+            return makeError(fmt::format("design '{}': fixed:E needs E in degrees, {:g}…{:g}",
+                                         name, kFixedE1MinDeg, kFixedE1MaxDeg));
+        return DesignSpec{RuntimeDesign::kFixed, e1};
+    }
+    auto d = runtimeDesignByName(name);
+    if (!d)
+        return makeError(d.error());
+    if (*d == RuntimeDesign::kFixed)
+        return makeError("design 'fixed' needs its e1: fixed:E, e.g. fixed:10");
+    return DesignSpec{*d, kFfrE1Deg};
+}
+
+Expected<std::vector<DesignSpec>> parseDesignList(const std::string& list) {
+    std::vector<DesignSpec> out;
     std::stringstream ss(list);
     std::string item;
     while (std::getline(ss, item, ',')) {
         if (item.empty())
             continue;
-        auto d = runtimeDesignByName(item);
+        auto d = designSpecByName(item);
         if (!d)
             return makeError(d.error());
+        for (const DesignSpec& seen : out)
+            if (seen.label() == d->label())
+                return makeError(fmt::format("design '{}' named twice", item));
         out.push_back(*d);
     }
     if (out.empty())

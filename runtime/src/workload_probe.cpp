@@ -25,6 +25,11 @@ WorkloadProbe::WorkloadProbe(const HmdProfile& profile, std::shared_ptr<const Tr
     m_header.scales = {1, 2, 4, 8, 16, 32};
 }
 
+void WorkloadProbe::useClusters(std::shared_ptr<const DrawList> clusters, float lod_error_px) {
+    m_clusters = std::move(clusters);
+    m_lod_error_px = lod_error_px;
+}
+
 void WorkloadProbe::setName(const std::string& name, const std::string& source) {
     m_header.name = name;
     m_header.source = source;
@@ -60,6 +65,15 @@ WorkloadFrame WorkloadProbe::frame(int64_t index, double time_ms, const Pose& he
     const int rings = std::clamp(static_cast<int>(std::ceil(count_to_deg / m_header.ring_deg)) + 1,
                                  1, m_header.rings);
     for (Eye eye : {Eye::kLeft, Eye::kRight}) {
+        if (m_clusters) {
+            const RenderView view = fullFrameView(m_profile, head, eye);
+            const Pose ep = eyePose(head, eye, CameraOptions{}.ipd_m);
+            const glm::vec3 axis =
+                glm::normalize(glm::normalize(ep.orientation) * glm::vec3(gaze_eye));
+            addTrianglesPerRing(*m_clusters, view, m_lod_error_px, axis, m_header.ring_deg,
+                                f.triangles_per_ring);
+            continue;
+        }
         const EyeView view = fullFrameEyeView(m_profile, head, eye);
         const std::vector<uint64_t> per_ring =
             m_bvh->trianglesPerRing(view, gaze_eye, m_header.ring_deg, rings);

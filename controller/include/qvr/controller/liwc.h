@@ -9,11 +9,13 @@
 #include <array>
 #include <deque>
 #include <memory>
+#include <optional>
 
 #include "qvr/controller/liwc_table.h"
 #include "qvr/controller/motion_codec.h"
 #include "qvr/controller/policy.h"
 #include "qvr/controller/remote_size_table.h"
+#include "qvr/controller/windowed_fit.h"
 
 namespace qvr {
 
@@ -41,6 +43,21 @@ struct LiwcConfig {
     // encode time, the decode — as a running mean, and adds it to every candidate (docs/LIWC.md).
     // The runtime sets it; the simulator keeps the paper's Eq. 2.
     bool learn_remote_base = false;
+    // The runtime's objective (docs/LIWC.md "The runtime's objective"): with frames in flight the
+    // display's frame period is the slowest of the headset's busy time L(e1), the server's
+    // render + encode S(e1) and the link's transmission X(e1) — the paper's
+    // FPS = min(1/T_GPU, 1/T_network) — so pick the candidate e1 minimising max(L, S, X), ties
+    // (within period_tie) going to the lower L + S + X (motion-to-photon). S(e1) is learned as a
+    // linear function of the periphery's triangles and pixels (the server draws less when the
+    // fovea grows), not a constant. False keeps Eq. 2's balance |T_remote − T_local| → 0, which
+    // the simulator reproduces.
+    bool frame_period_objective = false;
+    double period_tie = 0.03;  // candidates within 3% of the best period count as equal
+    // The software-reactive variant of the paper (§6.1, "SW"): the same model, but with no
+    // pre-render triangle counts (each decision reads the rings of the newest observed frame)
+    // and no direct view of the acknowledgements (the throughput it uses is that of the newest
+    // observed frame).
+    bool reactive = false;
 };
 
 struct LiwcCandidate {
@@ -59,6 +76,10 @@ public:
     std::string_view name() const override { return "liwc"; }
     Decision decide(const WorkloadFrame& frame) override;
     void observe(const FrameMeasurement& m) override;
+
+    // The link's throughput as the acknowledgements show it now (the hardware monitors them at
+    // decision time, §4.1); ignored by the reactive variant.
+    void setLinkEstimate(double throughput_bps);
 
     // Eq. 2 with the current estimates, without the table's offset.
     double predictLocalMs(const WorkloadFrame& frame, double e1_deg) const;
@@ -81,6 +102,11 @@ private:
     void prepareFrame(const WorkloadFrame& frame) const;
     double localMs(double e1_deg) const;
     double remoteMs(const Gaze& gaze, double e1_deg) const;
+    // frame_period_objective: the server's part and the transmission, separately.
+    double transmissionMs(const Gaze& gaze, double e1_deg) const;
+    double peripheryTriangles(double e1_deg) const;
+    double peripheryPixels(const Gaze& gaze, double e1_deg) const;
+    Decision decidePeriod(const WorkloadFrame& frame, double lo, double hi);
     static double prefixAt(const std::vector<double>& prefix, double ring_deg, double e_deg);
 
     // A cache of the frame being decided, so mutable.
@@ -100,6 +126,21 @@ private:
     double m_log_bits_at_1;         // log of bits per pixel at scale 1
     double m_bits_exponent;         // growth with scale
     double m_remote_base_ms = 0.0;  // learn_remote_base: T_remote beyond the transmission
+    // frame_period_objective: S ≈ σ0 + σ1·periphery triangles + σ2·periphery pixels (1e-5 units),
+    // recursive least squares like the GPU fit.
+    // Both fits over a window (windowed_fit.h): L ≈ λ·[1, fovea triangles, fovea pixels] and
+    // S ≈ σ·[1, periphery triangles, periphery pixels], in units of 1e5.
+    WindowedFit m_local_fit;
+    WindowedFit m_server_fit;
+    double m_link_bps = 0.0;  // setLinkEstimate
+    // reactive: the rings of the newest observed frame, and those of frames not yet observed.
+    struct SeenFrame {
+        int64_t index = 0;
+        std::vector<double> triangles_per_ring;
+        std::vector<double> pixels_per_ring;
+    };
+    std::deque<SeenFrame> m_seen;
+    std::optional<SeenFrame> m_reactive_rings;
     // State between decide() and observe().
     bool m_have_previous = false;
     Pose m_previous_head;
@@ -113,6 +154,8 @@ private:
         uint16_t motion = 0;
         int bucket = 0;
         double model_imbalance_ms = 0.0;
+        double periphery_triangles = 0.0;  // both eyes, beyond e1 (frame_period_objective)
+        double periphery_pixels = 0.0;     // both eyes, middle + outer layer pixels
     };
     std::deque<PendingDecision> m_pending;
     int m_observed = 0;

@@ -53,6 +53,13 @@ struct RenderView {
     glm::mat4 projection{1.0f};
     int width_px = 0;
     int height_px = 0;
+    // A hole: clusters lying wholly inside this cone (world space, apex at the eye) are not
+    // drawn. A periphery layer uses it for the disc the compositor takes from a finer layer
+    // (docs/RENDER.md "Holes"); pixels outside the cone are exactly those of a full draw.
+    // skip_half_angle_rad <= 0: no hole.
+    glm::vec3 skip_apex{0.0f};
+    glm::vec3 skip_axis{0.0f, 0.0f, -1.0f};  // unit length
+    float skip_half_angle_rad = 0.0f;
 
     glm::mat4 viewProjection() const { return projection * view; }
 };
@@ -72,6 +79,10 @@ glm::mat4 regionProjection(const HmdProfile& profile, double x0_px, double y0_px
 // up to one texel past rect when rect's size is not a multiple of the scale.
 RenderView layerView(const HmdProfile& profile, const Pose& head, Eye eye, const LayerRect& layer,
                      const CameraOptions& options = {});
+// Sets view.skip_* to the cone of half-angle radius_deg around the gaze of `eye` at `head`
+// (EyeGeometry's eccentricity: the angle to the gaze direction in the eye's frame).
+void setSkipCone(RenderView& view, const HmdProfile& profile, const Pose& head, Eye eye,
+                 const Gaze& gaze, double radius_deg, const CameraOptions& options = {});
 // The whole eye image at full resolution: the reference each layer is a piece of.
 RenderView fullFrameView(const HmdProfile& profile, const Pose& head, Eye eye,
                          const CameraOptions& options = {});

@@ -75,12 +75,28 @@ struct DrawSelection {
     uint32_t clusters_drawn = 0;
     uint32_t clusters_culled = 0;
     uint32_t clusters_coarsened = 0;  // drawn at a LOD level
+    uint32_t clusters_skipped = 0;    // in the frustum but wholly inside the view's hole
 };
+
+// True when the box lies wholly inside the cone (apex, unit axis, half-angle): its bounding
+// sphere's angular radius seen from the apex plus its centre's angle to the axis fits.
+bool boxInsideCone(const Aabb& box, const glm::vec3& apex, const glm::vec3& axis,
+                   float half_angle_rad);
 
 // The clusters a view may see (conservative plane test on their boxes), merged into draw calls.
 // With lod_error_px > 0 and LOD levels built, each cluster is drawn at the coarsest level whose
 // largest vertex move (half a cell diagonal), seen from the eye at the cluster box's nearest
-// point, stays within lod_error_px of the view's own pixels.
+// point, stays within lod_error_px of the view's own pixels. Clusters wholly inside the view's
+// hole (RenderView::skip_*) are left out.
 DrawSelection selectDraws(const DrawList& list, const RenderView& view, float lod_error_px = 0.0f);
+
+// LIWC's pre-render input (paper §4.1) at the cost of one pass over the clusters: adds to
+// rings[k] the triangles the view would draw within eccentricity [k·ring_deg, (k+1)·ring_deg)
+// of `axis` (world space, unit, from the view's eye). Each cluster in the frustum counts the
+// triangles of the level of detail selectDraws() would pick and spreads them evenly over the
+// rings its bounding sphere spans; the last ring is open-ended. Exact in total, approximate by
+// ring within a cluster's angular size (docs/LIWC.md "Ring counts").
+void addTrianglesPerRing(const DrawList& list, const RenderView& view, float lod_error_px,
+                         const glm::vec3& axis, double ring_deg, std::vector<double>& rings);
 
 }  // namespace qvr

@@ -30,6 +30,7 @@ struct RenderStats {
     uint64_t clipping_output_primitives = 0;
     uint32_t clusters_drawn = 0;  // spatial clusters of the draw list (draw_list.h)
     uint32_t clusters_culled = 0;
+    uint32_t clusters_skipped = 0;  // inside the view's hole
     uint32_t draw_calls = 0;
 };
 
@@ -45,12 +46,29 @@ public:
     virtual Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) = 0;
 };
 
+// Holes in the periphery layers (docs/RENDER.md "Holes"): the middle layer need not draw what
+// the compositor takes from the fovea alone, nor the outer layer what it takes from the middle
+// alone. The compositor blends two layers in a band of band_texels texels of the coarser layer
+// inside the finer layer's edge (ComposeOptions::blend_band_texels); the hole stops
+// margin_texels more texels short of that band.
+struct LayerHoles {
+    bool enabled = false;
+    double band_texels = 2.0;
+    double margin_texels = 1.0;
+};
+
+// The hole's radius for a layer of the plan (0: none): the fovea's e1 for the middle layer, e2
+// for the outer one, less the blend band and the margin, in the coarser layer's texels.
+double layerHoleDeg(const HmdProfile& profile, const LayerPlan& plan, Eye eye, LayerKind kind,
+                    const LayerHoles& holes);
+
 // One layer of a layer plan for one eye: its sub-frustum into an image of the layer's own size
 // (paper §3.2). An empty layer (e.g. no middle layer when the fovea covers the field) gives an
 // empty image and zero stats.
 Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
                                   const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
-                                  ImageRgba8& out, const CameraOptions& options = {});
+                                  ImageRgba8& out, const CameraOptions& options = {},
+                                  const LayerHoles& holes = {});
 
 // Renders nothing: fills the image with the clear colour and reports the triangles of the
 // clusters that survive frustum culling — the same count the OpenGL renderer submits.

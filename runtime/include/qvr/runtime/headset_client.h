@@ -61,12 +61,19 @@ struct HeadsetConfig {
     double remote_timeout_ms = 250.0;
     int connect_timeout_ms = 500;
     int reconnect_interval_ms = 250;
-    double ffr_e1_deg = 5.0;
+    double fixed_e1_deg = kFfrE1Deg;  // kFfr and kFixed
     // Frames in flight (docs/RUNTIME.md): 1 runs each frame to its scan-out before the next
     // frame's pose is sampled; 2 samples frame n+1 and sends its request before frame n's fovea
     // renders, so the server renders n+1 while the headset finishes n (paper Fig. 4's overlap
     // across frames). The policy then decides n+1 before it has observed n.
     int pipeline_depth = 2;
+    // Scan-out: false queues the composed frame for its vsync slot and goes on with the next
+    // (a two-image swapchain, VsyncPacer::queueForScanout); true waits for the slot first, as
+    // until 2026-11-23 (one frame's composition never overlaps the previous one's scan-out).
+    bool wait_for_vsync = false;
+    // The level of detail the fovea is drawn at (its renderer's lod_error_px): LIWC's triangle
+    // rings count what that level draws.
+    float lod_error_px = 1.0f;
     PacingClock* clock = nullptr;  // steady clock when null
     DisplaySink* display = nullptr;
     WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set

@@ -47,6 +47,11 @@ public:
     int64_t slotAtOrAfter(int64_t t_ns) const;
     // Sleeps until the slot for a frame ready at ready_ns and returns that slot's time.
     int64_t waitForScanout(int64_t ready_ns);
+    // Queues a frame ready at ready_ns for its slot and returns the slot's time, without
+    // waiting for it: the display scans it out while the headset works on the next frame, as a
+    // compositor with a two-image swapchain does. Sleeps only while an earlier frame still
+    // holds the other image, i.e. until one period before the new slot.
+    int64_t queueForScanout(int64_t ready_ns);
     int64_t lastScanoutNs() const { return m_last_scanout_ns; }
 
 private:

@@ -4,6 +4,7 @@
 // several headsets from one render thread; each has a bounded request queue and its own encoders.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -58,6 +59,27 @@ struct RenderServerConfig {
     bool one_pass_periphery = false;
     // Called on the render thread after each rendered request (keep it cheap).
     std::function<void(const ServerFrameStamps&)> on_frame;
+    // Leave out of each periphery layer the clusters the compositor takes from a finer layer
+    // only (render/renderer.h LayerHoles): a larger fovea then costs the server less.
+    LayerHoles holes{.enabled = true};
+};
+
+// One served frame, for the per-frame server log (`qvr server --frames-csv`): where the server's
+// time went, layer by layer. Times in ms; index = stream id (eye · 2 + layer).
+struct ServerFrameRecord {
+    uint64_t client = 0;  // the session (one per design in `qvr run`)
+    uint32_t frame_id = 0;
+    double e1_deg = 0.0;
+    int64_t received_ns = 0;  // the request arrived (steady clock)
+    int64_t start_ns = 0;     // the render thread took it
+    int64_t done_ns = 0;      // the last layer was handed to the transport
+    std::array<int64_t, 4> pixels{};
+    std::array<uint64_t, 4> triangles{};  // submitted after culling and LOD
+    std::array<double, 4> render_ms{};    // commands to glFinish
+    std::array<double, 4> readback_ms{};
+    std::array<double, 4> encode_ms{};
+    std::array<double, 4> send_ms{};
+    std::array<int64_t, 4> bytes{};
 };
 
 struct RenderServerStats {
@@ -72,8 +94,10 @@ struct RenderServerStats {
     uint64_t render_failures = 0;
     uint64_t encode_failures = 0;
     uint64_t key_frame_requests = 0;
-    double render_ms_total = 0.0;
+    double render_ms_total = 0.0;  // render + read-back, wall clock
+    double readback_ms_total = 0.0;
     double encode_ms_total = 0.0;
+    double send_ms_total = 0.0;
     net::ServerStats net;
 };
 
@@ -90,6 +114,9 @@ public:
     void stop();
     uint16_t port() const;
     RenderServerStats stats() const;
+    // The newest served frames, oldest first (at most kMaxFrameRecords).
+    std::vector<ServerFrameRecord> frameRecords() const;
+    static constexpr size_t kMaxFrameRecords = 100'000;
     size_t clients() const;
 
     struct Impl;

@@ -36,7 +36,14 @@ struct FrameTelemetry {
     bool connected = false;
     bool fallback_local = false;  // the server was gone: everything rendered locally
     double t_local_ms = 0.0;
+    // From when the server could start on the frame to the last packet of its last stream: the
+    // server's render + encode + the link. Decoding is the headset's work (in its busy time), and
+    // waits while the headset renders its fovea, so it is not part of T_remote.
     double t_remote_ms = 0.0;
+    double t_remote_decoded_ms = 0.0;  // the same, to the last stream decoded
+    double t_local_pred_ms = 0.0;      // the policy's prediction (0 when it made none)
+    double t_remote_pred_ms = 0.0;
+    double probe_ms = 0.0;  // the pre-render triangle-ring count (LIWC's input)
     double uca_ms = 0.0;
     // The headset's busy time for this frame (its decision, fovea, decodes, UCA, bookkeeping:
     // everything but waiting for the network and for vsync). With frames in flight this, not the

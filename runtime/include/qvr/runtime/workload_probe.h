@@ -9,6 +9,7 @@
 
 #include "qvr/core/pose.h"
 #include "qvr/foveation/layer_plan.h"
+#include "qvr/render/draw_list.h"
 #include "qvr/scene/triangle_bvh.h"
 #include "qvr/workload/workload.h"
 
@@ -21,6 +22,11 @@ public:
                   double ring_deg = 1.0, int rings = 120);
 
     const WorkloadHeader& header() const { return m_header; }
+
+    // Count triangles per ring from the renderer's draw clusters at the level of detail a
+    // full-resolution view draws (draw_list.h addTrianglesPerRing) instead of the BVH: what
+    // the fovea will submit, at a cost that does not grow with e1 (docs/LIWC.md "Ring counts").
+    void useClusters(std::shared_ptr<const DrawList> clusters, float lod_error_px);
     void setName(const std::string& name, const std::string& source);
 
     // Triangles are binned in rings up to count_to_deg only; everything beyond falls in the last
@@ -40,6 +46,8 @@ private:
     HmdProfile m_profile;
     EyeGeometry m_geometry;
     std::shared_ptr<const TriangleBvh> m_bvh;
+    std::shared_ptr<const DrawList> m_clusters;
+    float m_lod_error_px = 0.0f;
     WorkloadHeader m_header;
     double m_log_bits_at_1 = 0.0;  // log(bits per pixel at scale 1)
     double m_bits_exponent = 0.7;
