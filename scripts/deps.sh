@@ -8,7 +8,7 @@ QVR_PACKAGES=(
     libfmt-dev libspdlog-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libglm-dev
     libtbb-dev libhwy-dev libpng-dev
     libgtest-dev libgmock-dev libbenchmark-dev
-    gnuplot-nox
+    gnuplot-nox python3  # report figures; python3 for scripts/claim_matrix_table.py
     libasio-dev libsodium-dev  # net: transport (standalone asio), PSK handshake (HMAC-SHA-256)
     # scene: pk3 (zip) archives, glTF/OBJ, JPEG/TGA textures; the OpenArena levels and their
     # textures (assimp-testmodels is listed with trace below)

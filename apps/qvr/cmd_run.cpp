@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -36,6 +37,7 @@
 #include "qvr/report/html_report.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/chrome_trace.h"
+#include "qvr/runtime/cpu_share.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/server_process.h"
@@ -61,7 +63,7 @@ struct RunOptions {
     std::string gaze = "model";
     std::string net = "wifi";
     std::string profile = "default";
-    std::string designs = "local,remote,ffr,sw,qvr";
+    std::string designs = "local,remote,ffr,fixed:10,fixed:20,sw,qvr";
     std::string out = "qvr-run";
     std::string codec = "x264";
     int frames = 150;
@@ -74,6 +76,8 @@ struct RunOptions {
     int quality_every = 15;  // every Nth displayed frame is measured against a full render
     bool one_pass_periphery = false;
     bool no_holes = false;
+    double headset_share = 1.0;
+    std::string ring_counts = "clusters";
     int pipeline_depth = 2;
     float lod_px = 1.0f;
     std::string hardware;      // a calibration (qvr calibrate --out); none: cached or measured
@@ -670,11 +674,31 @@ int runRun(const RunOptions& o) {
         std::fprintf(stderr, "qvr run: %s\n", server.error().c_str());
         return 1;
     }
+    // The headset's share of its core (CFS quota on this process; the server child was made
+    // before, so it keeps its whole core).
+    std::optional<CpuShareGroup> share_group;
+    if (o.headset_share < 1.0) {
+        auto g = CpuShareGroup::create(o.headset_share);
+        Status moved = g ? g->addProcess(getpid()) : Status(makeError(g.error()));
+        if (!moved) {
+            std::fprintf(stderr, "qvr run: --headset-share %g refused: %s\n", o.headset_share,
+                         moved.error().c_str());
+            server->stop();
+            return 2;
+        }
+        share_group = std::move(*g);
+    }
     fmt::print("qvr run: {} ({} triangles), {}x{} per eye at {} Hz, net {}, {} frames per design\n",
                scene->name, scene->triangleCount(), profile->width_px, profile->height_px,
                profile->refresh_hz, o.net, o.frames);
-    fmt::print("  server on 127.0.0.1:{} pinned to core {}, headset pinned to core {} ({} cores)\n",
-               server->port(), server_core, client_core, cores);
+    fmt::print(
+        "  server on 127.0.0.1:{} pinned to core {}, headset pinned to core {} ({} cores){}\n",
+        server->port(), server_core, client_core, cores,
+        share_group
+            ? fmt::format(", headset limited to {:.0f}% of its core (CFS quota "
+                          "{:.1f} ms per 10 ms, {})",
+                          100.0 * o.headset_share, 10.0 * o.headset_share, share_group->path())
+            : std::string());
 
     std::vector<DesignRun> runs;
     std::unique_ptr<Renderer> quality_renderer;
@@ -699,6 +723,8 @@ int runRun(const RunOptions& o) {
         hc.core = client_core;
         hc.remote_timeout_ms = o.remote_timeout_ms;
         hc.pipeline_depth = o.pipeline_depth;
+        hc.lod_error_px = o.lod_px;
+        hc.cluster_ring_counts = o.ring_counts == "clusters";
         GlRendererOptions gl;
         gl.lod_error_px = o.lod_px;
         hc.renderer = glRendererFactory(gl);
@@ -741,9 +767,8 @@ int runRun(const RunOptions& o) {
         std::fflush(stdout);
         for (const FrameTelemetry& t : result->frames)
             all_csv << telemetryCsvRow(label, t);
-        if (auto st =
-                writeTelemetryCsv((out / fmt::format("frames_{}.csv", label)).string(), label,
-                                  result->frames);
+        if (auto st = writeTelemetryCsv((out / fmt::format("frames_{}.csv", label)).string(), label,
+                                        result->frames);
             !st)
             std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
         runs.push_back({spec, std::move(*result)});
@@ -791,7 +816,7 @@ int runRun(const RunOptions& o) {
         std::vector<TraceDesign> tds;
         for (const DesignRun& r : runs)
             tds.push_back(
-                {designName(r.design), r.result.origin_ns, profile->refresh_hz, &r.result.frames});
+                {r.label(), r.result.origin_ns, profile->refresh_hz, &r.result.frames});
         if (auto info = writeChromeTrace((out / "trace.json").string(), tds, stamps)) {
             trace_json = {{"path", "trace.json"},
                           {"events", info->events},
@@ -936,6 +961,14 @@ int runRun(const RunOptions& o) {
                      "on its core; the headset thread of this process is pinned to the other core "
                      "and its threads (llvmpipe, x264, asio) inherit the mask"}};
     j["run_seconds"] = run_s;
+    j["headset_share"] = o.headset_share;
+    if (share_group) {
+        const CpuShareGroup::Throttling th = share_group->throttling();
+        j["headset_throttling"] = {{"periods", th.periods},
+                                   {"throttled_periods", th.throttled_periods},
+                                   {"throttled_ms", th.throttled_ms},
+                                   {"cgroup", share_group->path()}};
+    }
     nlohmann::json dj = nlohmann::json::object();
     const DesignSummary* local = nullptr;
     const DesignSummary* remote = nullptr;
@@ -960,6 +993,23 @@ int runRun(const RunOptions& o) {
             qvr = &r.result.summary;
     }
     j["designs"] = dj;
+    // The fixed designs run (ffr is fixed:5): the best in hindsight, by displayed FPS.
+    const DesignRun* best_fixed = nullptr;
+    for (const DesignRun& r : runs)
+        if ((r.design() == RuntimeDesign::kFixed || r.design() == RuntimeDesign::kFfr) &&
+            (!best_fixed || r.result.summary.fps_mean > best_fixed->result.summary.fps_mean))
+            best_fixed = &r;
+    if (best_fixed) {
+        nlohmann::json bf = {{"design", best_fixed->label()},
+                             {"e1_deg", best_fixed->spec.fixed_e1_deg},
+                             {"fps_mean", best_fixed->result.summary.fps_mean},
+                             {"mtp_ms_p99", best_fixed->result.summary.mtp_ms_p99}};
+        for (const DesignRun& r : runs)
+            if (r.design() == RuntimeDesign::kQvr || r.design() == RuntimeDesign::kSw)
+                bf[std::string(r.label()) + "_fps_over_best_fixed"] =
+                    r.result.summary.fps_mean / std::max(1e-9, best_fixed->result.summary.fps_mean);
+        j["best_fixed"] = bf;
+    }
     nlohmann::json ratios = nlohmann::json::object();
     if (qvr && local && local->fps_mean > 0)
         ratios["qvr_fps_over_local"] = qvr->fps_mean / local->fps_mean;
@@ -1045,6 +1095,9 @@ int runRun(const RunOptions& o) {
 
     // Figures.
     report::Plotter plotter(out, 1000, 420);
+    const std::string kFpsE1Title =
+        "Displayed FPS over the fovea size: the fixed sweep and where qvr (LIWC) and sw run";
+    int fixed_points = 0;
     const std::array<std::pair<std::string, std::string>, 4> kFigureTitles = {{
         {"e1", "Fovea size e1 per frame (deg)"},
         {"mtp", "Motion-to-photon latency per frame (ms)"},
@@ -1067,10 +1120,10 @@ int runRun(const RunOptions& o) {
             const std::string sep = first ? "" : ", ";
             // Columns (1-based, telemetryCsvHeader): 2 frame, 3 e1, 21 display_ns, 22 bytes, 31
             // mtp.
-            e1_plot += fmt::format("{}'{}' every ::1 using 2:3 with lines title '{}'", sep, f,
-                                   r.label());
-            mtp_plot += fmt::format("{}'{}' every ::1 using 2:31 with lines title '{}'", sep, f,
-                                    r.label());
+            e1_plot +=
+                fmt::format("{}'{}' every ::1 using 2:3 with lines title '{}'", sep, f, r.label());
+            mtp_plot +=
+                fmt::format("{}'{}' every ::1 using 2:31 with lines title '{}'", sep, f, r.label());
             bytes_plot +=
                 fmt::format("{}'{}' every ::1 using 2:($22/1000+0.001) with lines title '{}'", sep,
                             f, r.label());
@@ -1083,6 +1136,34 @@ int runRun(const RunOptions& o) {
         plotter.plot("mtp", kFigureTitles[1].second, mtp_plot + "\n");
         plotter.plot("bytes", kFigureTitles[2].second, bytes_plot + "\n");
         plotter.plot("scanout", kFigureTitles[3].second, ft_plot + "\n");
+        // The fixed sweep: displayed FPS over e1, with LIWC's (and sw's) operating point.
+        std::ofstream sweep(out / "fps_vs_e1.csv");
+        sweep << "design,kind,e1_deg,fps,mtp_ms_p99\n";
+        for (const DesignRun& r : runs) {
+            const bool fixed =
+                r.design() == RuntimeDesign::kFixed || r.design() == RuntimeDesign::kFfr;
+            const bool adaptive =
+                r.design() == RuntimeDesign::kQvr || r.design() == RuntimeDesign::kSw;
+            if (!fixed && !adaptive)
+                continue;
+            fixed_points += fixed ? 1 : 0;
+            sweep << fmt::format("{},{},{:.3f},{:.3f},{:.3f}\n", r.label(),
+                                 fixed ? "fixed" : r.label(), r.result.summary.e1_deg_mean,
+                                 r.result.summary.fps_mean, r.result.summary.mtp_ms_p99);
+        }
+        sweep.close();
+        if (fixed_points >= 2)
+            plotter.plot(
+                "fps_e1", kFpsE1Title,
+                common +
+                    "set xlabel 'e1 (deg): fixed designs, and the mean e1 of adaptive ones'\n"
+                    "set ylabel 'displayed FPS'\n"
+                    "plot 'fps_vs_e1.csv' every ::1 using (strcol(2) eq 'fixed' ? $3 : 1/0):4 "
+                    "with linespoints pt 7 title 'fixed e1', "
+                    "'' every ::1 using (strcol(2) eq 'qvr' ? $3 : 1/0):4 with points pt 9 ps 2.5 "
+                    "title 'qvr (LIWC)', "
+                    "'' every ::1 using (strcol(2) eq 'sw' ? $3 : 1/0):4 with points pt 5 ps 2 "
+                    "title 'sw'\n");
     }
     if (!quality.empty()) {
         std::string q_plot =
@@ -1127,6 +1208,18 @@ int runRun(const RunOptions& o) {
                            std::to_string(s.frames_displayed), std::to_string(s.frames_reused)});
     }
     page.table(designs_table);
+    if (j.contains("best_fixed")) {
+        const nlohmann::json& bf = j["best_fixed"];
+        std::string text = fmt::format(
+            "Best fixed fovea in hindsight among those run: {} at {:.1f} FPS (MTP p99 {:.1f} ms).",
+            bf["design"].get<std::string>(), bf["fps_mean"].get<double>(),
+            bf["mtp_ms_p99"].get<double>());
+        for (const char* d : {"qvr", "sw"})
+            if (bf.contains(std::string(d) + "_fps_over_best_fixed"))
+                text += fmt::format(" {} reaches {:.2f}x its FPS.", d,
+                                    bf[std::string(d) + "_fps_over_best_fixed"].get<double>());
+        page.paragraph(text);
+    }
     limitsHtml(page, runs);
     page.html(validationHtml(dj, calibration->note + "; workload: " + trace_source, sim_note));
     page.heading(2, "Against the paper");
@@ -1146,6 +1239,8 @@ int runRun(const RunOptions& o) {
     if (plotter.available())
         for (const auto& [name, title] : kFigureTitles)
             page.figure(out, name, title, 1000);
+    if (plotter.available() && fixed_points >= 2)
+        page.figure(out, "fps_e1", kFpsE1Title, 1000);
     else
         page.paragraph(plotter.note());
     page.heading(2, "Image quality against a full-resolution render");
@@ -1232,7 +1327,9 @@ static Registered registerRun(CLI::App& app) {
                     "Link spec for net's emulator (wifi, lte, 5g, rate:MBPS, trace:...)")
         ->capture_default_str();
     cmd->add_option("--frames", o->frames, "Frames per design")->capture_default_str();
-    cmd->add_option("--designs", o->designs, "Comma-separated: local,remote,ffr,sw,qvr")
+    cmd->add_option("--designs", o->designs,
+                    "Comma-separated: local, remote, ffr (= fixed:5), fixed:E for any e1 E in "
+                    "degrees, sw, qvr")
         ->capture_default_str();
     cmd->add_option(
            "--profile", o->profile,
@@ -1251,6 +1348,16 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_flag("--no-holes", o->no_holes,
                   "Server draws every periphery layer whole, also where the headset's fovea (or "
                   "the middle layer) covers it");
+    cmd->add_option("--headset-share", o->headset_share,
+                    "Fraction of its core the headset process may use (CFS quota per 10 ms, "
+                    "cgroups; needs root): the analogue of Table 4's slower headset GPUs")
+        ->check(CLI::Range(CpuShareGroup::kMinShare + 1e-9, 1.0))
+        ->capture_default_str();
+    cmd->add_option("--ring-counts", o->ring_counts,
+                    "LIWC's triangle rings: clusters (what the fovea draws, cheap) or bvh "
+                    "(every scene triangle, exact, the earlier input)")
+        ->check(CLI::IsMember({"clusters", "bvh"}))
+        ->capture_default_str();
     addLodOption(cmd, o->lod_px);
     cmd->add_option("--pipeline", o->pipeline_depth,
                     "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
@@ -1271,16 +1378,18 @@ static Registered registerRun(CLI::App& app) {
         ->capture_default_str();
     cmd->add_flag("!--no-fovea-border", o->fovea_border,
                   "Do not draw the e1 circle (the fovea layer's edge) in the video");
-    return {cmd, [o] {
-                o->command_line = fmt::format(
-                    "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
-                    "--profile {} --codec {} --seed {} --lod-px {} --pipeline {}{}{}",
-                    o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile,
-                    o->codec, o->seed, o->lod_px, o->pipeline_depth,
-                    o->one_pass_periphery ? " --one-pass-periphery" : "",
-                    o->no_holes ? " --no-holes" : "");
-                return runRun(*o);
-            }};
+    return {
+        cmd, [o] {
+            o->command_line = fmt::format(
+                "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
+                "--profile {} --codec {} --seed {} --lod-px {} --pipeline {} --headset-share {} "
+                "--ring-counts {}{}{}",
+                o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile, o->codec,
+                o->seed, o->lod_px, o->pipeline_depth, o->headset_share, o->ring_counts,
+                o->one_pass_periphery ? " --one-pass-periphery" : "",
+                o->no_holes ? " --no-holes" : "");
+            return runRun(*o);
+        }};
 }
 
 QVR_REGISTER_COMMAND(90, registerRun);

@@ -123,8 +123,9 @@ public:
         m_renderer = std::move(*r);
         if (auto st = m_renderer->upload(*m_scene); !st)
             return makeError("headset: " + st.error());
-        if (m_config.design == RuntimeDesign::kQvr || m_config.design == RuntimeDesign::kSw ||
-            m_config.workload) {
+        if (m_config.cluster_ring_counts &&
+            (m_config.design == RuntimeDesign::kQvr || m_config.design == RuntimeDesign::kSw ||
+             m_config.workload)) {
             // LIWC's rings from the draw clusters (what the fovea submits), not the BVH.
             auto clusters = std::make_shared<DrawList>(buildDrawList(*m_scene));
             if (m_config.lod_error_px > 0.0f)
@@ -198,7 +199,8 @@ public:
         }
         m_stats.core = currentCore();
         result.stats = m_stats;
-        result.summary = summarizeRun(designLabel(m_config.design, m_config.fixed_e1_deg), result.frames);
+        result.summary =
+            summarizeRun(designLabel(m_config.design, m_config.fixed_e1_deg), result.frames);
         return result;
     }
 
@@ -387,7 +389,11 @@ private:
         double probe_ms = 0.0;
         if (needs_workload) {
             const int64_t probe_start_ns = m_clock.nowNs();
-            wf = m_probe.frame(i, content_ms, head, gaze);
+            // With the BVH, rings past the last e1 + 6° are lumped into the last counted one
+            // (totals stay exact); the clusters' count costs the same for every ring.
+            wf = m_config.cluster_ring_counts
+                     ? m_probe.frame(i, content_ms, head, gaze)
+                     : m_probe.frame(i, content_ms, head, gaze, m_last_e1_deg + 6.0);
             probe_ms = double(m_clock.nowNs() - probe_start_ns) * 1e-6;
         }
         LayerPlan plan;
@@ -420,6 +426,7 @@ private:
                     if (m_liwc)
                         m_liwc->setLinkEstimate(m_client->throughputBps());
                     const Decision d = m_policy->decide(wf ? *wf : light);
+                    m_last_e1_deg = d.e1_deg;
                     t_local_pred_ms = d.t_local_pred_ms;
                     t_remote_pred_ms = d.t_remote_pred_ms;
                     plan = m_planner.plan(gaze, d.e1_deg);
@@ -663,6 +670,7 @@ private:
     std::unique_ptr<Renderer> m_renderer;
     std::unique_ptr<FoveaPolicy> m_policy;
     LiwcPolicy* m_liwc = nullptr;  // m_policy when it is qvr's LIWC
+    double m_last_e1_deg = kFfrE1Deg;
     std::unique_ptr<net::Client> m_client;
     std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;
     std::array<int64_t, net::kMaxStreams> m_last_key_request_ns{};

@@ -74,6 +74,9 @@ struct HeadsetConfig {
     // The level of detail the fovea is drawn at (its renderer's lod_error_px): LIWC's triangle
     // rings count what that level draws.
     float lod_error_px = 1.0f;
+    // LIWC's triangle rings from the draw clusters at that level of detail (cheap, what is
+    // drawn) or, when false, from the scene's BVH (every triangle, cost growing with e1).
+    bool cluster_ring_counts = true;
     PacingClock* clock = nullptr;  // steady clock when null
     DisplaySink* display = nullptr;
     WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Reads claim_matrix.sh's runs and writes matrix.md / matrix.json: per condition the median
+(and min-max) over three runs of displayed FPS and MTP p99 for ffr, sw, qvr and the best fixed
+e1 (chosen from run 1's sweep), and the ratios issue 15 asks for."""
+import json
+import os
+import statistics
+import sys
+
+out = sys.argv[1]
+rows = []
+for name in sorted(os.listdir(out)):
+    cdir = os.path.join(out, name)
+    if not os.path.isdir(cdir):
+        continue
+    runs = []
+    for rep in (1, 2, 3):
+        p = os.path.join(cdir, f"run{rep}", "summary.json")
+        if os.path.exists(p):
+            runs.append(json.load(open(p)))
+    if not runs:
+        continue
+    first = runs[0]
+    best = first["best_fixed"]["design"]
+    sweep = {d: v["fps_mean"] for d, v in first["designs"].items() if d.startswith("fixed:")}
+
+    def fps_series(design):
+        out_vals = []
+        for r in runs:
+            d = r["designs"]
+            if design in d:
+                out_vals.append(d[design])
+            elif design == "fixed:5" and "ffr" in d:
+                out_vals.append(d["ffr"])
+        return out_vals
+
+    entry = {"condition": name, "command": first["command"], "best_fixed": best, "sweep_fps": sweep}
+    for design in ("ffr", "sw", "qvr", best):
+        series = fps_series(design)
+        if design == "ffr":
+            series = [r["designs"]["ffr"] for r in runs if "ffr" in r["designs"]] + \
+                     ([first["designs"]["fixed:5"]] if "fixed:5" in first["designs"] else [])
+        fps = [s["fps_mean"] for s in series]
+        p99 = [s["mtp_ms_p99"] for s in series]
+        reused = [s["frames_reused"] / max(1, s["frames"]) for s in series]
+        entry[design] = {"fps": fps, "mtp_p99": p99, "reused": reused,
+                         "fps_median": statistics.median(fps) if fps else None,
+                         "mtp_p99_median": statistics.median(p99) if p99 else None}
+    q, f, b, s = entry["qvr"], entry["ffr"], entry[best], entry["sw"]
+    entry["qvr_over_ffr"] = q["fps_median"] / f["fps_median"]
+    entry["qvr_over_best"] = q["fps_median"] / b["fps_median"]
+    entry["qvr_over_sw"] = q["fps_median"] / s["fps_median"]
+    entry["p99_qvr_over_best"] = q["mtp_p99_median"] / b["mtp_p99_median"]
+    entry["holds"] = (entry["qvr_over_best"] >= 0.95 and entry["qvr_over_sw"] >= 1.0 and
+                      entry["p99_qvr_over_best"] <= 1.05)
+    rows.append(entry)
+
+json.dump(rows, open(os.path.join(out, "matrix.json"), "w"), indent=2)
+
+
+def span(v):
+    return f"{statistics.median(v):.1f} ({min(v):.1f}–{max(v):.1f})"
+
+
+lines = ["| condition | best fixed | ffr FPS | sw FPS | qvr FPS | best-fixed FPS | qvr/ffr | qvr/best | "
+         "qvr/sw | MTP p99 qvr / best (ms) | holds |",
+         "|---|---|---|---|---|---|---|---|---|---|---|"]
+for e in rows:
+    b = e["best_fixed"]
+    lines.append(
+        f"| {e['condition']} | {b} | {span(e['ffr']['fps'])} | {span(e['sw']['fps'])} | "
+        f"{span(e['qvr']['fps'])} | {span(e[b]['fps'])} | {e['qvr_over_ffr']:.2f} | "
+        f"{e['qvr_over_best']:.2f} | {e['qvr_over_sw']:.2f} | "
+        f"{e['qvr']['mtp_p99_median']:.0f} / {e[b]['mtp_p99_median']:.0f} | "
+        f"{'yes' if e['holds'] else 'no'} |")
+lines.append("")
+lines.append("Fixed sweep (run 1, FPS): " + "; ".join(
+    e["condition"] + ": " + ", ".join(f"{d.split(':')[1]}°={v:.1f}" for d, v in
+                                     sorted(e["sweep_fps"].items(), key=lambda kv: float(kv[0].split(':')[1])))
+    for e in rows))
+open(os.path.join(out, "matrix.md"), "w").write("\n".join(lines) + "\n")
+print("\n".join(lines))
