@@ -19,8 +19,8 @@ LiwcPolicy::LiwcPolicy(const WorkloadHeader& header, LiwcConfig config)
       m_throughput_bps(config.throughput_bps_initial),
       m_log_bits_at_1(std::log(config.bits_per_pixel_initial)),
       m_bits_exponent(config.bits_scale_exponent_initial),
-      m_local_fit({0.0, 1e5 / config.gpu_triangles_per_ms_initial,
-                   1e5 / config.gpu_pixels_per_ms_initial}),
+      m_local_fit(
+          {0.0, 1e5 / config.gpu_triangles_per_ms_initial, 1e5 / config.gpu_pixels_per_ms_initial}),
       m_server_fit({0.0, 0.0, 0.0}),
       m_e1_deg(config.e1_initial_deg) {
     QVR_CHECK(config.max_delta_deg == 5);  // the table's tags are −5…+5
@@ -137,8 +137,8 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
                 ? 0.0
                 : std::max(0.0, m_server_fit.predict({1.0, v.triangles * 1e-5, v.pixels * 1e-5}));
         const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(e));
-        v.remote = e >= m_cover_deg ? 0.0
-                                    : std::max(0.0, server + transmissionMs(frame.gaze, e) + offset);
+        v.remote =
+            e >= m_cover_deg ? 0.0 : std::max(0.0, server + transmissionMs(frame.gaze, e) + offset);
         v.period = std::max(v.local, v.remote);
         v.latency = v.local + v.remote;
         return v;
@@ -148,8 +148,8 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     Eval best;
     bool have = false;
     for (int k = 0; k <= steps; ++k) {
-        const double e = std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo,
-                                    std::max(lo, hi));
+        const double e =
+            std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo, std::max(lo, hi));
         const Eval v = evaluate(e);
         if (!have) {
             best = v;
@@ -288,9 +288,8 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         decided = p;
         m_pending.pop_front();
         if (m_observed >= m_config.table_warmup_frames) {
-            const double measured = m_config.frame_period_objective
-                                        ? m.t_remote_ms
-                                        : m.t_remote_ms - m.t_local_ms;
+            const double measured =
+                m_config.frame_period_objective ? m.t_remote_ms : m.t_remote_ms - m.t_local_ms;
             const double delta = measured - p.model_imbalance_ms;
             m_table.fold(p.motion, p.bucket, static_cast<float>(delta), m_config.alpha);
         }

@@ -322,8 +322,8 @@ DrawSelection selectDraws(const DrawList& list, const RenderView& view, float lo
             ++s.clusters_culled;
             continue;
         }
-        if (hole && boxInsideCone(c.bounds, view.skip_apex, view.skip_axis,
-                                  view.skip_half_angle_rad)) {
+        if (hole &&
+            boxInsideCone(c.bounds, view.skip_apex, view.skip_axis, view.skip_half_angle_rad)) {
             ++s.clusters_skipped;
             continue;
         }

@@ -34,8 +34,8 @@ Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
         return RenderStats{};
     }
     RenderView view = layerView(profile, head, eye, layer, options);
-    setSkipCone(view, profile, head, eye, plan.gaze,
-                layerHoleDeg(profile, plan, eye, kind, holes), options);
+    setSkipCone(view, profile, head, eye, plan.gaze, layerHoleDeg(profile, plan, eye, kind, holes),
+                options);
     return renderer.render(view, out);
 }
 

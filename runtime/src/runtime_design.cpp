@@ -65,8 +65,8 @@ Expected<DesignSpec> designSpecByName(const std::string& name) {
         }
         if (num.empty() || used != num.size() || !std::isfinite(e1) || e1 < kFixedE1MinDeg ||
             e1 > kFixedE1MaxDeg)
-            return makeError(fmt::format("design '{}': fixed:E needs E in degrees, {:g}…{:g}",
-                                         name, kFixedE1MinDeg, kFixedE1MaxDeg));
+            return makeError(fmt::format("design '{}': fixed:E needs E in degrees, {:g}…{:g}", name,
+                                         kFixedE1MinDeg, kFixedE1MaxDeg));
         return DesignSpec{RuntimeDesign::kFixed, e1};
     }
     auto d = runtimeDesignByName(name);
