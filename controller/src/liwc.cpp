@@ -143,22 +143,20 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         v.latency = v.local + v.remote;
         return v;
     };
+    // Start from staying where we are: another candidate must shorten the period, or at an
+    // equal period the latency, by more than period_tie to move e1 (hysteresis against the
+    // frame-to-frame noise of the measurements).
     const double step = 0.5;
     const int steps = 2 * m_config.max_delta_deg * 2;
-    Eval best;
-    bool have = false;
+    Eval best = evaluate(std::clamp(m_e1_deg, lo, std::max(lo, hi)));
     for (int k = 0; k <= steps; ++k) {
         const double e =
             std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo, std::max(lo, hi));
         const Eval v = evaluate(e);
-        if (!have) {
-            best = v;
-            have = true;
-            continue;
-        }
         const double tie = m_config.period_tie * std::max(best.period, v.period);
         if (v.period < best.period - tie ||
-            (std::fabs(v.period - best.period) <= tie && v.latency < best.latency))
+            (std::fabs(v.period - best.period) <= tie &&
+             v.latency < best.latency - m_config.period_tie * best.latency))
             best = v;
     }
     m_e1_deg = best.e1;
