@@ -1,0 +1,265 @@
+// LIWC's runtime objective (LiwcConfig::frame_period_objective, docs/LIWC.md "The runtime's
+// objective"): with frames in flight the display's period is max(T_local, T_remote), so LIWC
+// picks the e1 that minimises it, learning T_local and the server's part of T_remote as linear
+// fits. And its software-reactive twin (LiwcConfig::reactive), which decides with the rings of
+// the newest observed frame instead of the current one.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "qvr/controller/liwc.h"
+#include "qvr/foveation/layer_plan.h"
+#include "qvr/workload/workload.h"
+
+namespace qvr {
+namespace {
+
+constexpr double kRingDeg = 1.0;
+
+WorkloadHeader header() {
+    WorkloadHeader h;
+    h.profile = defaultHmdProfile();
+    h.ring_deg = kRingDeg;
+    h.rings = 100;
+    h.scales = {1, 2, 4, 8, 16, 32};
+    return h;
+}
+
+// A frame whose first 60 rings hold `triangles_per_ring` triangles each (nothing beyond) and
+// every ring 30 000 pixels.
+WorkloadFrame frame(int64_t index, double triangles_per_ring) {
+    WorkloadFrame f;
+    f.index = index;
+    f.head.orientation = quatFromEulerDeg({10, 0, 0});
+    f.gaze = {0, 0};
+    for (int k = 0; k < 100; ++k) {
+        f.triangles_per_ring.push_back(k < 60 ? triangles_per_ring : 0.0);
+        f.pixels_per_ring.push_back(30000.0);
+    }
+    f.bits_per_pixel = {0.6, 1.0, 1.6, 2.6, 4.2, 6.8};
+    return f;
+}
+
+// A made-up machine: the headset's busy time, the server's render + encode, and a link. Layers
+// are coded at 0.4·s^0.9 bits per pixel (both eyes' layers sent).
+struct Truth {
+    double local_fixed_ms = 1.0;
+    double local_triangles_per_ms = 40'000.0;
+    double local_pixels_per_ms = 150'000.0;
+    // T_remote = server + bytes / throughput; server = fixed + periphery triangles / rate, or a
+    // constant when remote_constant_ms > 0 (the whole T_remote then, whatever e1).
+    double server_fixed_ms = 2.0;
+    double server_triangles_per_ms = 50'000.0;
+    double remote_constant_ms = 0.0;
+    double throughput_bps = 200e6;
+    double noise = 0.0;  // relative, uniform ±
+
+    static double bitsPerPixel(double s) { return 0.4 * std::pow(s, 0.9); }
+
+    double localMs(const WorkloadFrame& f, double e1) const {
+        return local_fixed_ms +
+               sumWithinDeg(f.triangles_per_ring, kRingDeg, e1) / local_triangles_per_ms +
+               sumWithinDeg(f.pixels_per_ring, kRingDeg, e1) / local_pixels_per_ms;
+    }
+    double transmissionMs(const LayerPlan& plan) const {
+        const double bits = 2.0 * (plan.middle_pixels * bitsPerPixel(plan.s1) +
+                                   plan.outer_pixels * bitsPerPixel(plan.s2));
+        return bits / throughput_bps * 1000.0;
+    }
+    double remoteMs(const WorkloadFrame& f, const LayerPlan& plan) const {
+        if (!plan.hasRemote())
+            return 0.0;
+        if (remote_constant_ms > 0.0)
+            return remote_constant_ms;
+        const double periphery = sumTotal(f.triangles_per_ring) -
+                                 sumWithinDeg(f.triangles_per_ring, kRingDeg, plan.e1_deg);
+        return server_fixed_ms + periphery / server_triangles_per_ms + transmissionMs(plan);
+    }
+
+    // What the headset measures of frame f run at d.e1_deg.
+    FrameMeasurement measure(const LayerPlanner& planner, const WorkloadFrame& f, const Decision& d,
+                             std::mt19937& rng) const {
+        std::uniform_real_distribution<double> u(1.0 - noise, 1.0 + noise);
+        const LayerPlan plan = planner.plan(f.gaze, d.e1_deg);
+        FrameMeasurement m;
+        m.index = f.index;
+        m.e1_deg = d.e1_deg;
+        m.t_local_ms = localMs(f, d.e1_deg) * u(rng);
+        m.t_remote_ms = remoteMs(f, plan) * u(rng);
+        m.triangles_local = sumWithinDeg(f.triangles_per_ring, kRingDeg, d.e1_deg);
+        m.pixels_local = sumWithinDeg(f.pixels_per_ring, kRingDeg, d.e1_deg);
+        m.middle_pixels = 2.0 * plan.middle_pixels;
+        m.outer_pixels = 2.0 * plan.outer_pixels;
+        m.s1 = plan.s1;
+        m.s2 = plan.s2;
+        m.middle_bytes = m.middle_pixels * bitsPerPixel(plan.s1) / 8.0;
+        m.outer_bytes = m.outer_pixels * bitsPerPixel(plan.s2) / 8.0;
+        m.throughput_bps = plan.hasRemote() ? throughput_bps : 0.0;
+        return m;
+    }
+};
+
+LiwcConfig periodConfig() {
+    LiwcConfig c;
+    c.frame_period_objective = true;
+    return c;
+}
+
+// Runs `frames` frames of f through the policy, `depth` frames in flight (the runtime's
+// pipeline: frame n + depth − 1 is decided before frame n is observed); returns the decisions.
+std::vector<Decision> run(LiwcPolicy& liwc, const Truth& truth, const LayerPlanner& planner,
+                          const WorkloadFrame& f, int frames, int depth, uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::vector<Decision> decided;
+    std::vector<WorkloadFrame> shown;
+    int observed = 0;
+    for (int i = 0; i < frames; ++i) {
+        WorkloadFrame fi = f;
+        fi.index = i;
+        decided.push_back(liwc.decide(fi));
+        shown.push_back(fi);
+        if (i + 1 - observed >= depth) {
+            liwc.observe(truth.measure(planner, shown[static_cast<size_t>(observed)],
+                                       decided[static_cast<size_t>(observed)], rng));
+            ++observed;
+        }
+    }
+    return decided;
+}
+
+// T_remote that does not fall with e1 (the server's fixed cost dominates): a larger fovea only
+// lengthens the headset's busy time, so every e1 with T_local below T_remote gives the same
+// period and the lower motion-to-photon latency wins — LIWC walks down to e1_min.
+TEST(LiwcPeriodObjective, DriftsToTheSmallestFoveaWhenTRemoteDoesNotFallWithE1) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.remote_constant_ms = 40.0;
+    truth.throughput_bps = 2e9;
+    truth.noise = 0.05;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    // T_local at 25° is ~17 ms: far below T_remote, so nothing but latency separates the e1.
+    ASSERT_LT(truth.localMs(f, 25.0), 20.0);
+    for (int depth : {1, 2}) {
+        for (double start : {5.0, 25.0}) {
+            LiwcConfig c = periodConfig();
+            c.e1_initial_deg = start;
+            LiwcPolicy liwc(h, c);
+            const std::vector<Decision> d = run(liwc, truth, planner, f, 120, depth, 31);
+            // At the bottom after a few tens of frames (the cold-start fits may first move it
+            // either way).
+            for (size_t i = 0; i < d.size(); ++i) {
+                if (i >= 80) {
+                    EXPECT_LE(d[i].e1_deg, c.e1_min_deg + 1.0)
+                        << "depth " << depth << " start " << start << " frame " << i;
+                }
+                EXPECT_GE(d[i].e1_deg, c.e1_min_deg);
+                EXPECT_TRUE(std::isfinite(d[i].t_local_pred_ms));
+                EXPECT_TRUE(std::isfinite(d[i].t_remote_pred_ms));
+            }
+            // What it predicts for T_remote has learned the flat 40 ms (within the noise).
+            EXPECT_NEAR(d.back().t_remote_pred_ms, 40.0, 4.0)
+                << "depth " << depth << " start " << start;
+        }
+    }
+}
+
+// T_local rises and T_remote falls with e1: the period max(T_local, T_remote) is smallest where
+// they cross. The crossing is computed here from the made-up machine on a fine grid.
+TEST(LiwcPeriodObjective, SettlesNearTheCrossingWhenLocalRisesAndRemoteFalls) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.noise = 0.03;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    auto periodAt = [&](double e1) {
+        return std::max(truth.localMs(f, e1), truth.remoteMs(f, planner.plan(f.gaze, e1)));
+    };
+    double crossing = -1.0, best_period = INFINITY;
+    for (double e = 2.0; e <= 50.0; e += 0.1) {
+        const LayerPlan plan = planner.plan(f.gaze, e);
+        if (crossing < 0.0 && truth.localMs(f, e) >= truth.remoteMs(f, plan))
+            crossing = e;
+        best_period = std::min(best_period, periodAt(e));
+    }
+    // The made-up machine crosses well inside LIWC's range, with both sides moving there.
+    ASSERT_GT(crossing, 12.0);
+    ASSERT_LT(crossing, 40.0);
+    ASSERT_GT(truth.remoteMs(f, planner.plan(f.gaze, 5.0)),
+              1.2 * truth.remoteMs(f, planner.plan(f.gaze, crossing)));
+    for (int depth : {1, 2}) {
+        for (double start : {5.0, 45.0}) {
+            LiwcConfig c = periodConfig();
+            c.e1_initial_deg = start;
+            LiwcPolicy liwc(h, c);
+            const std::vector<Decision> d = run(liwc, truth, planner, f, 150, depth, 7);
+            for (size_t i = 100; i < d.size(); ++i) {
+                EXPECT_NEAR(d[i].e1_deg, crossing, 2.0)
+                    << "depth " << depth << " start " << start << " frame " << i;
+                // The period it runs at is within 5% of the best one.
+                EXPECT_LE(periodAt(d[i].e1_deg), 1.05 * best_period)
+                    << "depth " << depth << " start " << start << " frame " << i;
+            }
+        }
+    }
+}
+
+// The reactive variant sees the current frame's rings only once that frame has been observed.
+// A sudden jump of the fovea's triangles (a dense object comes into view) moves LIWC's decision
+// on that very frame; the reactive one decides as before, and moves one frame later.
+TEST(LiwcPeriodObjective, ReactiveDecidesWithTheRingsOfTheNewestObservedFrame) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    const Truth truth;  // noiseless, so both settle on a fixed point
+    LiwcConfig c = periodConfig();
+    c.e1_initial_deg = 20.0;
+    LiwcPolicy qvr(h, c);
+    c.reactive = true;
+    LiwcPolicy sw(h, c);
+    std::mt19937 rng(1);
+    const WorkloadFrame steady = frame(0, 20'000.0);
+    // The jump: the central 30 rings hold four times the triangles.
+    WorkloadFrame dense = steady;
+    for (int k = 0; k < 30; ++k)
+        dense.triangles_per_ring[static_cast<size_t>(k)] *= 4.0;
+    const int kJump = 120;
+    for (int i = 0; i < kJump; ++i) {
+        WorkloadFrame fi = steady;
+        fi.index = i;
+        const Decision a = qvr.decide(fi);
+        const Decision b = sw.decide(fi);
+        // The same frames, the same measurements: the same decisions.
+        ASSERT_DOUBLE_EQ(a.e1_deg, b.e1_deg) << "frame " << i;
+        qvr.observe(truth.measure(planner, fi, a, rng));
+        sw.observe(truth.measure(planner, fi, b, rng));
+    }
+    // Frame kJump is dense. Twins of both policies see the steady frame instead.
+    LiwcPolicy qvr_steady = qvr, sw_steady = sw;
+    WorkloadFrame jump = dense, calm = steady;
+    jump.index = calm.index = kJump;
+    const Decision q = qvr.decide(jump), q_calm = qvr_steady.decide(calm);
+    const Decision s = sw.decide(jump), s_calm = sw_steady.decide(calm);
+    // LIWC shrinks the fovea on the dense frame itself.
+    EXPECT_LE(q.e1_deg, q_calm.e1_deg - 1.0);
+    EXPECT_GT(q.t_local_pred_ms, q_calm.t_local_pred_ms);
+    // The reactive one decides the dense frame with the steady frame's rings: as if it were
+    // steady.
+    EXPECT_DOUBLE_EQ(s.e1_deg, s_calm.e1_deg);
+    EXPECT_DOUBLE_EQ(s.t_local_pred_ms, s_calm.t_local_pred_ms);
+    EXPECT_DOUBLE_EQ(s.t_remote_pred_ms, s_calm.t_remote_pred_ms);
+    // Having observed the dense frame (at the e1 it chose), it moves on the next one; its twin,
+    // which observed the steady frame at the same e1, does not.
+    sw.observe(truth.measure(planner, jump, s, rng));
+    sw_steady.observe(truth.measure(planner, calm, s_calm, rng));
+    WorkloadFrame next_dense = dense, next_calm = steady;
+    next_dense.index = next_calm.index = kJump + 1;
+    const Decision s1 = sw.decide(next_dense), s1_calm = sw_steady.decide(next_calm);
+    EXPECT_LE(s1.e1_deg, s1_calm.e1_deg - 1.0);
+    EXPECT_GT(s1.t_local_pred_ms, s1_calm.t_local_pred_ms);
+}
+
+}  // namespace
+}  // namespace qvr
