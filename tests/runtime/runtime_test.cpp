@@ -115,9 +115,14 @@ TEST(VsyncPacer, ScansOutAtTheFirstSlotAfterReadyAndNeverTwiceInOne) {
 }
 
 TEST(RuntimeDesigns, ParseListsAndRejectUnknownNames) {
-    auto d = parseDesignList("local,qvr");
-    ASSERT_TRUE(d.ok());
-    EXPECT_EQ(d->size(), 2u);
+    auto d = parseDesignList("local,qvr,fixed:12");
+    ASSERT_TRUE(d.ok()) << d.error();
+    ASSERT_EQ(d->size(), 3u);
+    EXPECT_EQ((*d)[0].design, RuntimeDesign::kLocal);
+    EXPECT_EQ((*d)[1].design, RuntimeDesign::kQvr);
+    EXPECT_EQ((*d)[2].design, RuntimeDesign::kFixed);
+    EXPECT_DOUBLE_EQ((*d)[2].fixed_e1_deg, 12.0);
+    EXPECT_EQ((*d)[2].label(), "fixed:12");
     EXPECT_FALSE(parseDesignList("local,dfr").ok());
     EXPECT_FALSE(parseDesignList("").ok());
 }
