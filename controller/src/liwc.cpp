@@ -126,6 +126,12 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         double e1 = 0.0, local = 0.0, remote = 0.0, period = 0.0, latency = 0.0;
         double triangles = 0.0, pixels = 0.0;
     };
+    // The table's offset for R is read at the bucket of the current e1 for every candidate: that
+    // cell is refreshed by every observation, while the cells of buckets e1 passed through
+    // early keep the cold start's errors and, added to lower candidates, pinned e1 high when R
+    // does not fall with it (tests/controller: DriftsToTheSmallestFovea...). What the table
+    // then carries is R's motion-correlated error near the operating point.
+    const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(m_e1_deg));
     auto evaluate = [&](double e) {
         Eval v;
         v.e1 = e;
@@ -136,7 +142,6 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
             e >= m_cover_deg
                 ? 0.0
                 : std::max(0.0, m_server_fit.predict({1.0, v.triangles * 1e-5, v.pixels * 1e-5}));
-        const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(e));
         v.remote =
             e >= m_cover_deg ? 0.0 : std::max(0.0, server + transmissionMs(frame.gaze, e) + offset);
         v.period = std::max(v.local, v.remote);
@@ -170,7 +175,6 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // Here the table learns what the model (without the offset) mispredicted of T_remote alone:
     // T_local has its own fit, refreshed every frame, and an offset learned from the imbalance
     // would move R by L's error, which the period max(L, R) cannot absorb.
-    const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(best.e1));
     m_pending.back().model_imbalance_ms = best.remote - offset;
     return d;
 }

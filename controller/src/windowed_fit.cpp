@@ -45,7 +45,10 @@ bool solve(std::array<double, 9> a, std::array<double, 3> b, const std::array<bo
             a[i * 3 + i] = 1.0;
             b[i] = 0.0;
         }
-    // Gaussian elimination with partial pivoting.
+    // Gaussian elimination with partial pivoting; a pivot is zero relative to the matrix's size.
+    double norm = 0.0;
+    for (double v : a)
+        norm = std::max(norm, std::fabs(v));
     std::array<size_t, 3> row{0, 1, 2};
     for (size_t c = 0; c < 3; ++c) {
         size_t p = c;
@@ -54,7 +57,7 @@ bool solve(std::array<double, 9> a, std::array<double, 3> b, const std::array<bo
                 p = r;
         std::swap(row[c], row[p]);
         const double piv = a[row[c] * 3 + c];
-        if (std::fabs(piv) < 1e-12)
+        if (!(std::fabs(piv) > 1e-12 * norm))
             return false;
         for (size_t r = c + 1; r < 3; ++r) {
             const double f = a[row[r] * 3 + c] / piv;
@@ -95,7 +98,14 @@ void WindowedFit::refit() {
         a[i * 3 + i] += m_ridge * scale[i];
         b[i] += m_ridge * scale[i] * m_theta[i];
     }
+    // An input that was 0 in every observation says nothing about its coefficient: keep it.
     std::array<bool, 3> use{true, true, true};
+    std::array<bool, 3> silent{};
+    for (size_t i = 0; i < 3; ++i)
+        silent[i] = scale[i] <= 1e-12;
+    for (size_t i = 0; i < 3; ++i)
+        if (silent[i])
+            use[i] = false;
     for (int round = 0; round < 3; ++round) {
         std::array<double, 3> t{};
         if (!solve(a, b, use, t))
@@ -107,7 +117,8 @@ void WindowedFit::refit() {
                 ok = false;
             }
         if (ok) {
-            m_theta = t;
+            for (size_t i = 0; i < 3; ++i)
+                m_theta[i] = silent[i] ? m_theta[i] : t[i];
             return;
         }
     }
