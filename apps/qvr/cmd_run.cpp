@@ -383,10 +383,9 @@ void limitsHtml(report::HtmlReport& page, const std::vector<DesignRun>& runs) {
                                              : "the decision (BVH ring counts)";
             limit = fmt::format("headset: busiest stage {}", stage);
         }
-        table.row({r.label(), fmt::format("{:.1f}", busy),
-                   fmt::format("{:.1f}", decision), fmt::format("{:.1f}", local),
-                   fmt::format("{:.1f}", uca), fmt::format("{:.1f}", remote),
-                   report::Cell(limit, "", true)});
+        table.row({r.label(), fmt::format("{:.1f}", busy), fmt::format("{:.1f}", decision),
+                   fmt::format("{:.1f}", local), fmt::format("{:.1f}", uca),
+                   fmt::format("{:.1f}", remote), report::Cell(limit, "", true)});
     }
     page.table(table);
     page.paragraph(
@@ -815,8 +814,7 @@ int runRun(const RunOptions& o) {
             trace_note = "no server stages: " + read.error();
         std::vector<TraceDesign> tds;
         for (const DesignRun& r : runs)
-            tds.push_back(
-                {r.label(), r.result.origin_ns, profile->refresh_hz, &r.result.frames});
+            tds.push_back({r.label(), r.result.origin_ns, profile->refresh_hz, &r.result.frames});
         if (auto info = writeChromeTrace((out / "trace.json").string(), tds, stamps)) {
             trace_json = {{"path", "trace.json"},
                           {"events", info->events},

@@ -208,13 +208,14 @@ int runServer(const ServerCmdOptions& o) {
         std::ofstream f(o.frames_csv);
         f << "client,frame,e1_deg,received_ns,start_ns,done_ns";
         for (int sid = 0; sid < 4; ++sid)
-            f << fmt::format(",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
-                             "send_ms{0},bytes{0}",
-                             sid);
+            f << fmt::format(
+                ",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
+                "send_ms{0},bytes{0}",
+                sid);
         f << "\n";
         for (const ServerFrameRecord& r : frame_records) {
-            f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg,
-                             r.received_ns, r.start_ns, r.done_ns);
+            f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg, r.received_ns,
+                             r.start_ns, r.done_ns);
             for (size_t sid = 0; sid < 4; ++sid)
                 f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{}", r.pixels[sid],
                                  r.triangles[sid], r.render_ms[sid], r.readback_ms[sid],
