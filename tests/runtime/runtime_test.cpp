@@ -278,7 +278,7 @@ double meanE1(const HeadsetResult& r, size_t from) {
     return s / double(r.frames.size() - from);
 }
 
-TEST(Runtime, LteChoosesALargerMeanFoveaThan5g) {
+TEST(Runtime, ASlowLinkChoosesALargerMeanFoveaThan5g) {
     if (!glAvailable())
         GTEST_SKIP() << "no EGL/OpenGL 4.5 here";
     // The raw codec makes the periphery heavy enough (4 bytes a pixel) that the link decides
@@ -296,11 +296,14 @@ TEST(Runtime, LteChoosesALargerMeanFoveaThan5g) {
         EXPECT_EQ(r.summary.frames_displayed, 90);
         return meanE1(r, 30);
     };
-    const double e1_lte = run("lte");
+    // 5 Mbit/s: at this small profile even the lte preset (100 Mbit/s) carries the raw periphery
+    // faster than the headset renders, and LIWC's frame-period objective then rightly keeps the
+    // fovea at its floor on both links; the link must be the bottleneck for e1 to grow.
+    const double e1_lte = run("rate:5");
     const double e1_5g = run("5g");
     RecordProperty("e1_lte_deg", std::to_string(e1_lte));
     RecordProperty("e1_5g_deg", std::to_string(e1_5g));
-    EXPECT_GT(e1_lte, e1_5g + 1.0) << "lte " << e1_lte << " vs 5g " << e1_5g;
+    EXPECT_GT(e1_lte, e1_5g + 1.0) << "5 Mbit/s " << e1_lte << " vs 5g " << e1_5g;
 }
 
 // ---- media-level faults -------------------------------------------------------------------
