@@ -746,7 +746,7 @@ int runRun(const RunOptions& o) {
         }
         std::unique_ptr<ProgressDisplay> progress;
         if (!o.quiet && isatty(STDERR_FILENO)) {
-            progress = std::make_unique<ProgressDisplay>(designName(d), o.frames, hc.display);
+            progress = std::make_unique<ProgressDisplay>(label, o.frames, hc.display);
             hc.display = progress.get();
         }
         Expected<HeadsetResult> result = makeError("not run");
