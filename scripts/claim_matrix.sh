@@ -50,7 +50,8 @@ for c in "${conditions[@]}"; do
     IFS='|' read -r scene link share <<<"$c"
     name=$(echo "${scene}_${link##*/}_${share}" | tr ':/' '__')
     echo "== $scene $link share $share"
-    common=(--scene "$scene" --net "$link" --headset-share "$share" --frames "$frames" --no-video)
+    common=(--scene "$scene" --net "$link" --headset-share "$share" --frames "$frames" --no-video
+        --quality-every 0 --quiet)
     "$qvr" run "${common[@]}" --designs "$sweep,sw,qvr" --out "$out/$name/run1" | grep -E '^  [a-z]'
     best=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['best_fixed']['design'])" \
         "$out/$name/run1/summary.json")
