@@ -114,8 +114,8 @@ TEST(ComposeQualityBands, SplitsThePixelsByBandAndFoveaBeatsOuterOnAFoveatedFram
     const ImageRgbD truth = groundTruthWarp(profile, full, render, render);
     const BandQuality q = measureQualityBands(profile, plan, render, render, display[0], truth);
     std::printf("fovea %.2f dB %.4f  blend %.2f dB  middle %.2f dB  outer %.2f dB %.4f\n",
-                q.fovea.psnr_db, q.fovea.ssim, q.blend.psnr_db, q.middle.psnr_db,
-                q.outer.psnr_db, q.outer.ssim);
+                q.fovea.psnr_db, q.fovea.ssim, q.blend.psnr_db, q.middle.psnr_db, q.outer.psnr_db,
+                q.outer.ssim);
     for (const RegionQuality* r : {&q.fovea, &q.blend, &q.middle, &q.outer})
         EXPECT_GT(r->pixels, 1000);
     EXPECT_EQ(q.fovea.pixels + q.blend.pixels + q.middle.pixels + q.outer.pixels, q.all.pixels);
