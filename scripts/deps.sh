@@ -10,6 +10,7 @@ QVR_PACKAGES=(
     libgtest-dev libgmock-dev libbenchmark-dev
     gnuplot-nox python3  # report figures; python3 for scripts/claim_matrix_table.py
     libasio-dev libsodium-dev  # net: transport (standalone asio), PSK handshake (HMAC-SHA-256)
+    libisal-dev  # net: Reed-Solomon FEC on the media streams (Intel ISA-L)
     # scene: pk3 (zip) archives, glTF/OBJ, JPEG/TGA textures; the OpenArena levels and their
     # textures (assimp-testmodels is listed with trace below)
     libzip-dev libassimp-dev libstb-dev

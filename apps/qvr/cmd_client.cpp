@@ -157,6 +157,10 @@ int runClient(const ClientCmdOptions& o) {
                         {"nacks_sent", st.net.assembler.nacks},
                         {"packets_nacked", st.net.assembler.packets_nacked},
                         {"packets_recovered", st.net.assembler.packets_recovered},
+                        {"fec_recoveries", st.net.assembler.fec_recoveries},
+                        {"fec_packets_recovered", st.net.assembler.fec_packets_recovered},
+                        {"fec_parity_received", st.net.assembler.fec_parity_received},
+                        {"fec_parity_unused", st.net.assembler.fec_parity_unused},
                         {"streams_lost", st.streams_lost}};
     // trace.json: the headset's stages, and the server's when its stamps file is given (a server
     // on this machine: qvr server --stamps-csv F; read after the server has stopped or flushed).

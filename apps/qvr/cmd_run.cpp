@@ -331,6 +331,8 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
             {"decode_failures", st.decode_failures},
             {"late_frames", st.late_frames},
             {"key_frame_requests", st.key_frame_requests + st.net.key_frame_requests_sent},
+            {"fec_recoveries", st.net.assembler.fec_recoveries},
+            {"fec_packets_recovered", st.net.assembler.fec_packets_recovered},
             {"client_core", st.core}};
 }
 

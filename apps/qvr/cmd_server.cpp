@@ -195,6 +195,10 @@ int runServer(const ServerCmdOptions& o) {
                                   {"packets_retransmitted", s.net.packets_retransmitted},
                                   {"bytes_retransmitted", s.net.bytes_retransmitted},
                                   {"retransmissions_refused", s.net.retransmissions_refused},
+                                  {"fec_frames", s.net.fec_frames},
+                                  {"fec_parity_packets", s.net.fec_parity_packets},
+                                  {"fec_parity_bytes", s.net.fec_parity_bytes},
+                                  {"client_loss_ppm", s.net.client_loss_ppm},
                                   {"control_drops", s.net.control_drops.total()},
                                   {"core", o.core}};
         std::ofstream f(o.stats_json);

@@ -4,6 +4,7 @@
 #include "qvr/net/client.h"
 
 #include <asio.hpp>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <limits>
@@ -32,6 +33,11 @@ void add(AssemblerStats& a, const AssemblerStats& b) {
     a.nacks += b.nacks;
     a.packets_nacked += b.packets_nacked;
     a.packets_recovered += b.packets_recovered;
+    a.fec_packets_recovered += b.fec_packets_recovered;
+    a.fec_recoveries += b.fec_recoveries;
+    a.fec_parity_received += b.fec_parity_received;
+    a.fec_parity_unused += b.fec_parity_unused;
+    a.fec_failures += b.fec_failures;
 }
 
 const char* byeText(ByeReason r) {
@@ -403,17 +409,19 @@ void Client::Impl::handleAssembler(Connection& c, int64_t now_ns) {
     uint8_t need_key = c.assembler.takeLossMask();
     uint32_t trigger_frame = 0;
     std::vector<MediaAck> acks;
+    const auto loss_ppm = static_cast<uint32_t>(std::lround(c.assembler.lossRate() * 1e6));
     const std::vector<LostStream> lost_now = c.assembler.takeLost();
     for (const LostStream& l : lost_now) {
         acks.push_back({l.frame_id, l.stream_id, false, l.packets_received, l.bytes_received,
-                        static_cast<uint64_t>(l.first_rx_ns), static_cast<uint64_t>(l.last_rx_ns)});
+                        static_cast<uint64_t>(l.first_rx_ns), static_cast<uint64_t>(l.last_rx_ns),
+                        loss_ppm});
         trigger_frame = l.frame_id;
     }
     auto completed = c.assembler.takeCompleted();
     for (const CompletedStream& s : completed) {
         acks.push_back({s.frame_id, s.stream_id, true, s.packets,
                         static_cast<uint32_t>(s.bytes.size()), static_cast<uint64_t>(s.first_rx_ns),
-                        static_cast<uint64_t>(s.last_rx_ns)});
+                        static_cast<uint64_t>(s.last_rx_ns), loss_ppm});
         if (!s.decodable) {
             // Still waiting for the key frame: the request or the key frame itself was lost.
             need_key |= static_cast<uint8_t>(1u << s.stream_id);

@@ -11,6 +11,7 @@
 
 #include "bytes.h"
 #include "qvr/core/check.h"
+#include "qvr/net/fec.h"
 
 namespace qvr::net {
 namespace {
@@ -23,6 +24,7 @@ constexpr uint8_t kControlMagic1 = 'C';
 constexpr uint8_t kMediaMagic0 = 'Q';
 constexpr uint8_t kMediaMagic1 = 'M';
 constexpr uint8_t kFlagKeyFrame = 0x01;
+constexpr uint8_t kFlagParity = 0x02;
 
 constexpr size_t kLayerGeometryBytes = 4 * 4 + 4 + 4 + 4;  // rect, scale, width, height
 constexpr size_t kFrameRequestBytes = 4 + 8 + 7 * 4 + 2 * 4 + 4 * 4 + 2 * 3 * kLayerGeometryBytes;
@@ -43,7 +45,7 @@ size_t payloadBytesOf(ControlType type) {
         case ControlType::kFrameRequest:
             return kFrameRequestBytes;
         case ControlType::kMediaAck:
-            return 4 + 1 + 1 + 2 + 4 + 8 + 8;
+            return 4 + 1 + 1 + 2 + 4 + 8 + 8 + 4;
         case ControlType::kKeyFrameRequest:
             return 1 + 4 + 1;
         case ControlType::kThroughputReport:
@@ -135,6 +137,7 @@ struct Encoder {
         w.u32(m.bytes_received);
         w.u64(m.first_rx_ns);
         w.u64(m.last_rx_ns);
+        w.u32(m.loss_ppm);
     }
     void operator()(const KeyFrameRequest& m) {
         w.u8(m.stream_mask);
@@ -484,10 +487,12 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
             m.bytes_received = r.u32();
             m.first_rx_ns = r.u64();
             m.last_rx_ns = r.u64();
+            m.loss_ppm = r.u32();
             m.complete = complete == 1;
             if (m.stream_id >= kMaxStreams || complete > 1 ||
                 m.packets_received > kMaxPacketsPerFrame ||
-                m.bytes_received > kMaxStreamFrameBytes || m.last_rx_ns < m.first_rx_ns) {
+                m.bytes_received > kMaxStreamFrameBytes || m.last_rx_ns < m.first_rx_ns ||
+                m.loss_ppm > 1'000'000) {
                 return WireError::kBadField;
             }
             out = m;
@@ -574,7 +579,7 @@ WireError decodeMediaPacket(std::span<const uint8_t> datagram, MediaPacketView& 
     h.seq = r.u32();
     h.frame_id = r.u32();
     h.stream_id = r.u8();
-    const uint8_t reserved = r.u8();
+    h.fec_parity = r.u8();
     h.packet_index = r.u16();
     h.packet_count = r.u16();
     h.payload_bytes = r.u16();
@@ -597,13 +602,22 @@ WireError decodeMediaPacket(std::span<const uint8_t> datagram, MediaPacketView& 
         return WireError::kTrailingBytes;
     }
     h.key_frame = (flags & kFlagKeyFrame) != 0;
+    h.parity = (flags & kFlagParity) != 0;
+    const bool frame_ok = (flags & ~(kFlagKeyFrame | kFlagParity)) == 0 &&
+                          h.fec_parity <= kFecMaxParity && h.stream_id < kMaxStreams &&
+                          h.session_id != 0 && h.frame_bytes > 0 &&
+                          h.packet_count == packetCountFor(h.frame_bytes);
+    // A parity packet carries a full shard; a data packet its part of the frame.
     const bool consistent =
-        (flags & ~kFlagKeyFrame) == 0 && reserved == 0 && h.stream_id < kMaxStreams &&
-        h.session_id != 0 && h.frame_bytes > 0 && h.packet_count == packetCountFor(h.frame_bytes) &&
-        h.packet_index < h.packet_count &&
-        h.payload_bytes == (h.packet_index + 1u < h.packet_count
-                                ? kMediaChunkBytes
-                                : h.frame_bytes - (h.packet_count - 1u) * kMediaChunkBytes);
+        frame_ok &&
+        (h.parity ? h.fec_parity > 0 &&
+                        h.packet_index < parityPacketsFor(h.packet_count, h.fec_parity) &&
+                        h.payload_bytes == kMediaChunkBytes
+                  : h.packet_index < h.packet_count &&
+                        h.payload_bytes ==
+                            (h.packet_index + 1u < h.packet_count
+                                 ? kMediaChunkBytes
+                                 : h.frame_bytes - (h.packet_count - 1u) * kMediaChunkBytes));
     if (!consistent) {
         return WireError::kBadField;
     }
@@ -621,12 +635,12 @@ void encodeMediaPacket(const MediaHeader& h, std::span<const uint8_t> payload,
     w.u8(kMediaMagic0);
     w.u8(kMediaMagic1);
     w.u8(kProtocolVersion);
-    w.u8(h.key_frame ? kFlagKeyFrame : 0);
+    w.u8(static_cast<uint8_t>((h.key_frame ? kFlagKeyFrame : 0) | (h.parity ? kFlagParity : 0)));
     w.u64(h.session_id);
     w.u32(h.seq);
     w.u32(h.frame_id);
     w.u8(h.stream_id);
-    w.u8(0);
+    w.u8(h.fec_parity);
     w.u16(h.packet_index);
     w.u16(h.packet_count);
     w.u16(h.payload_bytes);
@@ -636,12 +650,14 @@ void encodeMediaPacket(const MediaHeader& h, std::span<const uint8_t> payload,
 
 std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t& seq,
                                                   uint32_t frame_id, uint8_t stream_id,
-                                                  bool key_frame, std::span<const uint8_t> bytes) {
+                                                  bool key_frame, std::span<const uint8_t> bytes,
+                                                  uint8_t fec_parity) {
     QVR_CHECK(!bytes.empty() && bytes.size() <= kMaxStreamFrameBytes);
-    QVR_CHECK(stream_id < kMaxStreams);
+    QVR_CHECK(stream_id < kMaxStreams && fec_parity <= kFecMaxParity);
     const uint32_t frame_bytes = static_cast<uint32_t>(bytes.size());
     const uint32_t count = packetCountFor(frame_bytes);
-    std::vector<std::vector<uint8_t>> packets(count);
+    const uint32_t parity_count = parityPacketsFor(static_cast<uint16_t>(count), fec_parity);
+    std::vector<std::vector<uint8_t>> packets(count + parity_count);
     for (uint32_t i = 0; i < count; ++i) {
         const size_t offset = static_cast<size_t>(i) * kMediaChunkBytes;
         const size_t n = std::min(kMediaChunkBytes, bytes.size() - offset);
@@ -655,9 +671,57 @@ std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t&
         h.packet_count = static_cast<uint16_t>(count);
         h.payload_bytes = static_cast<uint16_t>(n);
         h.frame_bytes = frame_bytes;
+        h.fec_parity = fec_parity;
         encodeMediaPacket(h, bytes.subspan(offset, n), packets[i]);
     }
+    if (parity_count == 0) {
+        return packets;
+    }
+    // The code works on whole shards: the frame's last data packet is zero-padded.
+    std::vector<uint8_t> padded(static_cast<size_t>(count) * kMediaChunkBytes, 0);
+    std::copy(bytes.begin(), bytes.end(), padded.begin());
+    std::vector<uint8_t> parity(static_cast<size_t>(parity_count) * kMediaChunkBytes);
+    const int k = static_cast<int>(count);
+    for (int b = 0; b < fecBlockCount(k); ++b) {
+        std::vector<const uint8_t*> data;
+        for (int i = 0; i < fecBlockSize(k, b); ++i) {
+            data.push_back(padded.data() +
+                           static_cast<size_t>(fecBlockFirst(b) + i) * kMediaChunkBytes);
+        }
+        std::vector<uint8_t*> out;
+        for (int j = 0; j < fec_parity; ++j) {
+            out.push_back(parity.data() +
+                          static_cast<size_t>(b * fec_parity + j) * kMediaChunkBytes);
+        }
+        fecEncode(static_cast<int>(kMediaChunkBytes), data, out);
+    }
+    for (uint32_t j = 0; j < parity_count; ++j) {
+        MediaHeader h;
+        h.key_frame = key_frame;
+        h.session_id = session_id;
+        h.seq = seq++;
+        h.frame_id = frame_id;
+        h.stream_id = stream_id;
+        h.packet_index = static_cast<uint16_t>(j);
+        h.packet_count = static_cast<uint16_t>(count);
+        h.payload_bytes = static_cast<uint16_t>(kMediaChunkBytes);
+        h.frame_bytes = frame_bytes;
+        h.fec_parity = fec_parity;
+        h.parity = true;
+        encodeMediaPacket(h,
+                          std::span<const uint8_t>(parity).subspan(
+                              static_cast<size_t>(j) * kMediaChunkBytes, kMediaChunkBytes),
+                          packets[count + j]);
+    }
     return packets;
+}
+
+uint32_t parityPacketsFor(uint16_t packet_count, uint8_t fec_parity) {
+    return static_cast<uint32_t>(fecBlockCount(packet_count)) * fec_parity;
+}
+
+uint32_t frameFirstSeq(const MediaHeader& h) {
+    return h.seq - h.packet_index - (h.parity ? h.packet_count : 0u);
 }
 
 namespace {

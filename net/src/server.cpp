@@ -286,6 +286,8 @@ struct Session : std::enable_shared_from_this<Session> {
         } else if (const auto* ack = std::get_if<MediaAck>(&m)) {
             count([](ServerStats& st) { ++st.acks; });
             estimator.onAck(ack->frame_id, ack->bytes_received, SteadyClock::instance().nowNs());
+            loss_rate = static_cast<double>(ack->loss_ppm) * 1e-6;
+            count([&](ServerStats& st) { st.client_loss_ppm = ack->loss_ppm; });
             throughput_bps = estimator.throughputBps();
             if (estimator.samples() > 0) {
                 return send(ThroughputReport{static_cast<uint64_t>(estimator.throughputBps()),
@@ -366,13 +368,24 @@ struct Session : std::enable_shared_from_this<Session> {
         const int64_t now_ns = SteadyClock::instance().nowNs();
         // A sequence number must never repeat under one key (it is the AEAD nonce): a session
         // about to wrap a stream's 32-bit counter (≈ 5 TB) ends, and the client reconnects.
-        if (seq[stream_id] > std::numeric_limits<uint32_t>::max() -
-                                 packetCountFor(static_cast<uint32_t>(bytes.size()))) {
+        const uint32_t data_packets = packetCountFor(static_cast<uint32_t>(bytes.size()));
+        // Parity per block, for the largest block and the loss the client last reported.
+        const auto fec_parity = static_cast<uint8_t>(
+            fecParityFor(std::min<int>(static_cast<int>(data_packets), kFecBlockData), loss_rate,
+                         server.options.fec));
+        const uint32_t parity_packets =
+            parityPacketsFor(static_cast<uint16_t>(data_packets), fec_parity);
+        if (seq[stream_id] >
+            std::numeric_limits<uint32_t>::max() - (data_packets + parity_packets)) {
             refuse(ByeReason::kNormal);
             return;
         }
-        auto packets =
-            packetizeStream(session_id, seq[stream_id], frame_id, stream_id, key_frame, bytes);
+        auto packets = packetizeStream(session_id, seq[stream_id], frame_id, stream_id, key_frame,
+                                       bytes, fec_parity);
+        uint64_t parity_bytes = 0;
+        for (size_t i = data_packets; i < packets.size(); ++i) {
+            parity_bytes += packets[i].size() + kMediaTagBytes;
+        }
         for (auto& p : packets) {
             sealMediaPacket(p, media_key);
         }
@@ -391,7 +404,12 @@ struct Session : std::enable_shared_from_this<Session> {
             }
             link.send(std::move(p), now_ns);  // the link counts its own drops
         }
-        count([&](ServerStats& st) { ++st.streams_sent; });
+        count([&](ServerStats& st) {
+            ++st.streams_sent;
+            st.fec_frames += parity_packets > 0 ? 1 : 0;
+            st.fec_parity_packets += parity_packets;
+            st.fec_parity_bytes += parity_bytes;
+        });
         flush();
     }
 
@@ -498,6 +516,7 @@ struct Session : std::enable_shared_from_this<Session> {
     std::vector<std::vector<uint8_t>> out;
     std::atomic<int64_t> queued_bytes{0};
     std::atomic<double> throughput_bps{0.0};
+    double loss_rate = 0.0;  // from the client's acks; sizes the FEC parity
 };
 
 void Server::Impl::accept() {

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "qvr/core/check.h"
+#include "qvr/net/fec.h"
 
 namespace qvr::net {
 namespace {
@@ -24,15 +25,88 @@ StreamAssembler::StreamAssembler(AssemblerLimits limits) : m_limits(limits) {
 }
 
 bool StreamAssembler::isFinished(const Stream& s, uint32_t frame_id) const {
-    return std::find(s.finished.begin(), s.finished.end(), frame_id) != s.finished.end();
+    return std::any_of(s.finished.begin(), s.finished.end(),
+                       [&](const Finished& f) { return f.frame_id == frame_id; });
 }
 
-void StreamAssembler::finish(uint8_t stream_id, uint32_t frame_id) {
+void StreamAssembler::finish(uint8_t stream_id, uint32_t frame_id, const Partial& p) {
     Stream& s = m_streams[stream_id];
-    s.finished.push_back(frame_id);
+    s.finished.push_back({frame_id, p.first_seq, p.last_seq});
     if (s.finished.size() > kFinishedMemory) {
         s.finished.pop_front();
     }
+    // Nothing more to ask for in a frame completed or given up.
+    std::erase_if(s.missing, [&](const Missing& m) {
+        return seqAfter(m.seq, p.first_seq) >= 0 && seqAfter(m.seq, p.last_seq) <= 0;
+    });
+}
+
+bool StreamAssembler::coveredElsewhere(const Stream& s, uint32_t seq) const {
+    const auto in = [seq](uint32_t first, uint32_t last) {
+        return seqAfter(seq, first) >= 0 && seqAfter(seq, last) <= 0;
+    };
+    for (const auto& [id, p] : s.partials) {
+        if (p.fec_parity > 0 && in(p.first_seq, p.last_seq)) {
+            return true;
+        }
+    }
+    return std::any_of(s.finished.begin(), s.finished.end(),
+                       [&](const Finished& f) { return in(f.first_seq, f.last_seq); });
+}
+
+void StreamAssembler::nackMissingData(Stream& s, const Partial& p, int64_t now_ns) {
+    for (uint32_t i = 0; i < p.packet_count; ++i) {
+        const uint32_t want = p.first_seq + i;
+        if (p.have[i] || static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream ||
+            std::any_of(s.missing.begin(), s.missing.end(),
+                        [&](const Missing& m) { return m.seq == want; })) {
+            continue;
+        }
+        s.missing.push_back({want, now_ns, 1});
+        s.nack_now.push_back(want);
+    }
+}
+
+// Rebuilds a block's missing data packets once it holds as many shards as it has data packets.
+void StreamAssembler::tryFec(Partial& p, int block) {
+    const int k = fecBlockSize(p.packet_count, block);
+    const int first = fecBlockFirst(block);
+    const int m = p.fec_parity;
+    std::vector<bool> have_data(static_cast<size_t>(k)), have_parity(static_cast<size_t>(m));
+    int data = 0, parity = 0;
+    for (int i = 0; i < k; ++i) {
+        have_data[static_cast<size_t>(i)] = p.have[static_cast<size_t>(first + i)];
+        data += have_data[static_cast<size_t>(i)] ? 1 : 0;
+    }
+    for (int j = 0; j < m; ++j) {
+        have_parity[static_cast<size_t>(j)] = p.have_parity[static_cast<size_t>(block * m + j)];
+        parity += have_parity[static_cast<size_t>(j)] ? 1 : 0;
+    }
+    if (data == k || data + parity < k) {
+        return;
+    }
+    std::vector<uint8_t*> data_ptrs;
+    for (int i = 0; i < k; ++i) {
+        data_ptrs.push_back(p.bytes.data() + static_cast<size_t>(first + i) * kMediaChunkBytes);
+    }
+    std::vector<const uint8_t*> parity_ptrs;
+    for (int j = 0; j < m; ++j) {
+        parity_ptrs.push_back(p.parity.data() +
+                              static_cast<size_t>(block * m + j) * kMediaChunkBytes);
+    }
+    if (!fecReconstruct(static_cast<int>(kMediaChunkBytes), data_ptrs, have_data, parity_ptrs,
+                        have_parity)) {
+        ++m_stats.fec_failures;
+        return;
+    }
+    for (int i = 0; i < k; ++i) {
+        if (!p.have[static_cast<size_t>(first + i)]) {
+            p.have[static_cast<size_t>(first + i)] = true;
+            ++p.data_have;
+            ++m_stats.fec_packets_recovered;
+        }
+    }
+    p.fec_used = true;
 }
 
 void StreamAssembler::declareLost(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it) {
@@ -41,15 +115,10 @@ void StreamAssembler::declareLost(uint8_t stream_id, std::map<uint32_t, Partial>
     m_lost.push_back({it->first, stream_id, p.received, p.packet_count, p.bytes_received,
                       p.first_rx_ns, p.last_rx_ns});
     ++m_stats.streams_lost;
-    m_buffered_bytes -= static_cast<int64_t>(p.bytes.size());
+    m_buffered_bytes -= p.allocated;
     s.awaiting_key = true;
     m_loss_mask |= static_cast<uint8_t>(1u << stream_id);
-    // Nothing more to ask for in a frame given up.
-    const uint32_t first_seq = p.last_seq - (p.packet_count - 1u);
-    std::erase_if(s.missing, [&](const Missing& m) {
-        return seqAfter(m.seq, first_seq) >= 0 && seqAfter(m.seq, p.last_seq) <= 0;
-    });
-    finish(stream_id, it->first);
+    finish(stream_id, it->first, p);
     s.partials.erase(it);
 }
 
@@ -57,38 +126,57 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
     const MediaHeader& h = packet.header;
     QVR_CHECK(h.stream_id < kMaxStreams);
     Stream& s = m_streams[h.stream_id];
+    const uint32_t h_first = frameFirstSeq(h);
 
     // Sequence gaps: packets that never came. A late packet (negative distance) fills no gap
     // count back in; reordering on the emulated link cannot happen (it keeps order).
     if (!s.has_seq) {
         s.has_seq = true;
         s.next_seq = h.seq + 1;
+        m_window_expected += 1;
     } else {
         const int64_t d = seqAfter(h.seq, s.next_seq);
         if (d >= 0) {
+            m_window_expected += static_cast<uint32_t>(d) + 1;
+            m_window_lost += static_cast<uint32_t>(d);
             if (d > 0) {
                 m_stats.seq_gap_packets += static_cast<uint64_t>(d);
-                if (m_limits.retransmit) {
-                    // Ask for the gap instead of giving up on it; a gap larger than what is
-                    // tracked is left to the loss timeout.
-                    for (uint32_t k = 0; k < d && static_cast<int>(s.missing.size()) <
-                                                      m_limits.max_missing_per_stream;
-                         ++k) {
-                        const uint32_t want = s.next_seq + k;
-                        // A stalled tail may have been asked for already.
-                        if (std::none_of(s.missing.begin(), s.missing.end(),
-                                         [&](const Missing& m) { return m.seq == want; })) {
-                            s.missing.push_back({want, now_ns, 1});
-                            s.nack_now.push_back(want);
-                        }
-                    }
-                } else {
+            }
+            for (uint32_t k = 0; k < d; ++k) {
+                const uint32_t want = s.next_seq + k;
+                // A frame with parity may still rebuild what it lost (it NACKs its data
+                // packets itself once it cannot), and a finished frame needs nothing.
+                if ((h.fec_parity > 0 && seqAfter(want, h_first) >= 0) ||
+                    coveredElsewhere(s, want)) {
+                    continue;
+                }
+                if (!m_limits.retransmit) {
                     s.awaiting_key = true;
                     m_loss_mask |= static_cast<uint8_t>(1u << h.stream_id);
+                    break;
+                }
+                // Ask for the gap instead of giving up on it; a gap larger than what is
+                // tracked is left to the loss timeout.
+                if (static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream) {
+                    break;
+                }
+                // A stalled tail may have been asked for already.
+                if (std::none_of(s.missing.begin(), s.missing.end(),
+                                 [&](const Missing& m) { return m.seq == want; })) {
+                    s.missing.push_back({want, now_ns, 1});
+                    s.nack_now.push_back(want);
                 }
             }
             s.next_seq = h.seq + 1;
         }
+    }
+    if (m_window_expected >= kLossWindowPackets) {
+        const double sample =
+            static_cast<double>(m_window_lost) / static_cast<double>(m_window_expected);
+        m_loss_rate = m_loss_sampled ? 0.75 * m_loss_rate + 0.25 * sample : sample;
+        m_loss_sampled = true;
+        m_window_expected = 0;
+        m_window_lost = 0;
     }
     if (m_limits.retransmit && !s.missing.empty()) {
         // An answer to a NACK: a gap packet (behind next_seq) or a lost tail (at or past it).
@@ -98,31 +186,41 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
     }
 
     // Frames whose last packet is well behind the newest sequence number will not complete
-    // (without retransmission: with it, the late packets may still come).
-    if (!m_limits.retransmit) {
-        for (auto it = s.partials.begin(); it != s.partials.end();) {
-            const auto next = std::next(it);
+    // (without retransmission: with it, the late packets may still come). With retransmission,
+    // a frame with parity whose every packet was sent (the stream moved past its end) and
+    // that is still incomplete cannot rebuild itself: its missing data packets are NACKed.
+    for (auto it = s.partials.begin(); it != s.partials.end();) {
+        const auto next = std::next(it);
+        if (!m_limits.retransmit) {
             if (seqAfter(h.seq, it->second.last_seq) > m_limits.reorder_window_packets) {
                 declareLost(h.stream_id, it);
             }
-            it = next;
+        } else if (it->second.fec_parity > 0 && seqAfter(h.seq, it->second.last_seq) > 0) {
+            nackMissingData(s, it->second, now_ns);
         }
+        it = next;
     }
 
     if (isFinished(s, h.frame_id)) {
-        ++m_stats.packets_late;
+        ++(h.parity ? m_stats.fec_parity_unused : m_stats.packets_late);
         return;
     }
     auto it = s.partials.find(h.frame_id);
+    const uint32_t parity_count = parityPacketsFor(h.packet_count, h.fec_parity);
     if (it == s.partials.end()) {
         // Allocate only what the validated header allows, within the budget: make room by
-        // giving up the oldest partial frames first.
+        // giving up the oldest partial frames first. With parity the data is kept as whole
+        // shards for the code.
+        const int64_t need = h.fec_parity == 0
+                                 ? static_cast<int64_t>(h.frame_bytes)
+                                 : static_cast<int64_t>(h.packet_count + parity_count) *
+                                       static_cast<int64_t>(kMediaChunkBytes);
         while (!s.partials.empty() &&
                (static_cast<int>(s.partials.size()) >= m_limits.max_partial_frames_per_stream ||
-                m_buffered_bytes + h.frame_bytes > m_limits.max_buffered_bytes)) {
+                m_buffered_bytes + need > m_limits.max_buffered_bytes)) {
             declareLost(h.stream_id, s.partials.begin());
         }
-        if (m_buffered_bytes + h.frame_bytes > m_limits.max_buffered_bytes) {
+        if (m_buffered_bytes + need > m_limits.max_buffered_bytes) {
             ++m_stats.packets_over_budget;
             return;
         }
@@ -130,38 +228,63 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
         p.key_frame = h.key_frame;
         p.packet_count = h.packet_count;
         p.frame_bytes = h.frame_bytes;
-        p.last_seq = h.seq - h.packet_index + (h.packet_count - 1u);
+        p.fec_parity = h.fec_parity;
+        p.first_seq = h_first;
+        p.last_seq = h_first + h.packet_count + parity_count - 1u;
         p.first_rx_ns = now_ns;
-        p.bytes.resize(h.frame_bytes);
+        if (h.fec_parity == 0) {
+            p.bytes.resize(h.frame_bytes);
+        } else {
+            p.bytes.assign(static_cast<size_t>(h.packet_count) * kMediaChunkBytes, 0);
+            p.parity.resize(static_cast<size_t>(parity_count) * kMediaChunkBytes);
+            p.have_parity.assign(parity_count, false);
+        }
+        p.allocated = need;
         p.have.assign(h.packet_count, false);
-        m_buffered_bytes += h.frame_bytes;
+        m_buffered_bytes += need;
         it = s.partials.emplace(h.frame_id, std::move(p)).first;
     }
     Partial& p = it->second;
     if (p.packet_count != h.packet_count || p.frame_bytes != h.frame_bytes ||
-        p.key_frame != h.key_frame ||
-        p.last_seq != h.seq - h.packet_index + (h.packet_count - 1u)) {
+        p.key_frame != h.key_frame || p.fec_parity != h.fec_parity || p.first_seq != h_first) {
         ++m_stats.packets_inconsistent;
         return;
     }
-    if (p.have[h.packet_index]) {
+    if (h.parity ? p.have_parity[h.packet_index] : p.have[h.packet_index]) {
         ++m_stats.packets_duplicate;
         return;
     }
-    // decodeMediaPacket guaranteed the payload fits: index·chunk + payload ≤ frame_bytes.
-    std::memcpy(p.bytes.data() + static_cast<size_t>(h.packet_index) * kMediaChunkBytes,
-                packet.payload.data(), packet.payload.size());
-    p.have[h.packet_index] = true;
+    if (h.parity) {
+        // decodeMediaPacket guaranteed a full shard and index < the frame's parity count.
+        std::memcpy(p.parity.data() + static_cast<size_t>(h.packet_index) * kMediaChunkBytes,
+                    packet.payload.data(), packet.payload.size());
+        p.have_parity[h.packet_index] = true;
+        ++m_stats.fec_parity_received;
+    } else {
+        // decodeMediaPacket guaranteed the payload fits: index·chunk + payload ≤ frame_bytes.
+        std::memcpy(p.bytes.data() + static_cast<size_t>(h.packet_index) * kMediaChunkBytes,
+                    packet.payload.data(), packet.payload.size());
+        p.have[h.packet_index] = true;
+        ++p.data_have;
+        p.bytes_received += h.payload_bytes;
+    }
     ++p.received;
-    p.bytes_received += h.payload_bytes;
     p.last_rx_ns = now_ns;
     ++m_stats.packets_accepted;
-    if (p.received < p.packet_count) {
-        return;
+    if (p.fec_parity > 0 && p.data_have < p.packet_count) {
+        tryFec(p, h.parity ? h.packet_index / p.fec_parity : h.packet_index / kFecBlockData);
     }
+    if (p.data_have == p.packet_count) {
+        complete(h.stream_id, it);
+    }
+}
+
+void StreamAssembler::complete(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it) {
+    Stream& s = m_streams[stream_id];
+    Partial& p = it->second;
     CompletedStream done;
-    done.frame_id = h.frame_id;
-    done.stream_id = h.stream_id;
+    done.frame_id = it->first;
+    done.stream_id = stream_id;
     done.key_frame = p.key_frame;
     if (p.key_frame) {
         s.awaiting_key = false;
@@ -170,14 +293,18 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
     if (!done.decodable) {
         ++m_stats.streams_undecodable;
     }
+    if (p.fec_used) {
+        ++m_stats.fec_recoveries;
+    }
     done.packets = p.packet_count;
     done.first_rx_ns = p.first_rx_ns;
     done.last_rx_ns = p.last_rx_ns;
     done.bytes = std::move(p.bytes);
-    m_buffered_bytes -= static_cast<int64_t>(done.bytes.size());
+    done.bytes.resize(p.frame_bytes);  // drops the code's padding
+    m_buffered_bytes -= p.allocated;
     ++m_stats.streams_completed;
     m_completed.push_back(std::move(done));
-    finish(h.stream_id, h.frame_id);
+    finish(stream_id, it->first, p);
     s.partials.erase(it);
 }
 
@@ -201,20 +328,8 @@ void StreamAssembler::expire(int64_t now_ns) {
         }
         // A stalled partial frame: its tail was lost, and nothing after it shows the gap.
         for (const auto& [frame_id, p] : partials) {
-            if (now_ns - std::max(p.first_rx_ns, p.last_rx_ns) < m_limits.tail_nack_ns) {
-                continue;
-            }
-            const uint32_t first_seq = p.last_seq - (p.packet_count - 1u);
-            for (uint32_t i = 0; i < p.packet_count; ++i) {
-                const uint32_t want = first_seq + i;
-                if (p.have[i] ||
-                    static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream ||
-                    std::any_of(s.missing.begin(), s.missing.end(),
-                                [&](const Missing& m) { return m.seq == want; })) {
-                    continue;
-                }
-                s.missing.push_back({want, now_ns, 1});
-                s.nack_now.push_back(want);
+            if (now_ns - std::max(p.first_rx_ns, p.last_rx_ns) >= m_limits.tail_nack_ns) {
+                nackMissingData(s, p, now_ns);
             }
         }
         // Ask again for what a retransmission did not bring; give up after the last try.

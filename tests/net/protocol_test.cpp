@@ -9,6 +9,7 @@
 #include <random>
 
 #include "qvr/foveation/hmd_profile.h"
+#include "qvr/net/fec.h"
 
 namespace qvr::net {
 namespace {
@@ -46,7 +47,7 @@ std::vector<ControlMessage> everyMessage() {
             auth,
             Welcome{42, 50000},
             sampleRequest(),
-            MediaAck{9, 3, true, 17, 20000, 100, 900},
+            MediaAck{9, 3, true, 17, 20000, 100, 900, 20'000},
             KeyFrameRequest{0b0101, 12, KeyFrameReason::kPacketLoss},
             ThroughputReport{187'000'000, 30},
             Bye{ByeReason::kAuthFailed},
@@ -237,6 +238,8 @@ TEST(NetProtocol, OutOfRangeFieldsAreRejected) {
               WireError::kBadField);
     EXPECT_EQ(decodeControl(encodeControl(MediaAck{1, 0, true, 1, 1, 10, 5}), out),
               WireError::kBadField);
+    EXPECT_EQ(decodeControl(encodeControl(MediaAck{1, 0, true, 1, 1, 0, 0, 1'000'001}), out),
+              WireError::kBadField);  // loss above 100 %
     EXPECT_EQ(decodeControl(encodeControl(KeyFrameRequest{0, 1, KeyFrameReason::kStart}), out),
               WireError::kBadField);
     EXPECT_EQ(decodeControl(encodeControl(KeyFrameRequest{0x10, 1, KeyFrameReason::kStart}), out),
@@ -290,10 +293,11 @@ TEST(NetProtocol, MalformedMediaPacketsAreRejected) {
     };
     EXPECT_EQ(edit(first, 0, 'Z'), WireError::kBadMagic);
     EXPECT_EQ(edit(first, 2, 9), WireError::kWrongVersion);
-    EXPECT_EQ(edit(first, 3, 0x80), WireError::kBadField);          // unknown flag
-    EXPECT_EQ(edit(first, 20, kMaxStreams), WireError::kBadField);  // stream id
-    EXPECT_EQ(edit(first, 21, 1), WireError::kBadField);            // reserved byte
-    EXPECT_EQ(edit(first, 22, 3), WireError::kBadField);            // index ≥ count
+    EXPECT_EQ(edit(first, 3, 0x80), WireError::kBadField);                // unknown flag
+    EXPECT_EQ(edit(first, 20, kMaxStreams), WireError::kBadField);        // stream id
+    EXPECT_EQ(edit(first, 21, kFecMaxParity + 1), WireError::kBadField);  // FEC parity count
+    EXPECT_EQ(edit(first, 3, 0x02), WireError::kBadField);    // parity flag, no parity count
+    EXPECT_EQ(edit(first, 22, 3), WireError::kBadField);      // index ≥ count
     EXPECT_EQ(edit(first, 24, 2), WireError::kBadField);      // count disagrees with frame_bytes
     EXPECT_EQ(edit(first, 25, 0xFF), WireError::kOversized);  // count above the limit
     EXPECT_EQ(edit(first, 31, 0xFF), WireError::kOversized);  // frame_bytes ~4 GB

@@ -677,6 +677,7 @@ TEST(NetTransport, FivePercentLossKeepsFramesComingWithKeyFrameRequests) {
     auto link = parseLinkSpec("wifi,loss=0.05,seed=5");
     ASSERT_TRUE(link) << link.error();
     o.link = link.value();
+    o.fec.enabled = false;  // key frames alone; FEC: FecAloneCompletesStreamsAtFivePercentLoss
     auto server = startServer(handler, o);
     ClientOptions co = clientOptions();
     co.retransmit = false;  // this test is about recovery by key frames alone
@@ -735,6 +736,67 @@ TEST(NetTransport, FivePercentLossKeepsFramesComingWithKeyFrameRequests) {
               static_cast<uint64_t>(total.streams));
 }
 
+// The same 5% loss and 4-packet streams as FivePercentLossKeepsFramesComingWithKeyFrameRequests,
+// retransmission still off, but the server adds Reed-Solomon parity sized from the loss the
+// client reports: once the first report arrived (256 sequence numbers), a stream frame is lost
+// only when more than its m parity packets are (m = 2 at 5%: P = 0.2%). Without FEC that test
+// completes ≈ 0.95^4 = 81% of the streams and keeps ~55% decodable.
+TEST(NetTransport, FecAloneCompletesStreamsAtFivePercentLoss) {
+    const size_t stream_bytes = 4 * kMediaChunkBytes;
+    EchoServer handler(stream_bytes);
+    ServerOptions o;
+    o.link = parseLinkSpec("wifi,loss=0.05,seed=5").value();
+    auto server = startServer(handler, o);
+    ClientOptions co = clientOptions();
+    co.retransmit = false;  // FEC alone
+    co.key_frame_retry_ms = 5;
+    co.assembler.frame_timeout_ns = 30'000'000;
+    Client client(co);
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok()) << client.lastError().error();
+    const ClientId id = server->clients()[0];
+    const int frames = 300;
+    Received total;
+    for (uint32_t f = 1; f <= frames; ++f) {
+        ASSERT_TRUE(client.sendFrameRequest(request(f)).ok());
+        std::this_thread::sleep_for(2ms);
+        while (true) {
+            auto s = client.nextStream(0);
+            ASSERT_TRUE(s.ok()) << s.error();
+            if (!s->has_value()) {
+                break;
+            }
+            ++total.streams;
+            total.decodable += (*s)->decodable ? 1 : 0;
+            total.corrupt +=
+                (*s)->bytes != streamBytes(id, (*s)->frame_id, (*s)->stream_id, stream_bytes);
+        }
+    }
+    const Received tail = receive(client, id, stream_bytes, 1 << 20, 300ms);
+    total.streams += tail.streams;
+    total.decodable += tail.decodable;
+    total.corrupt += tail.corrupt;
+    const LinkStats ls = server->linkStats(id);
+    const ClientStats cs = client.stats();
+    const ServerStats ss = server->stats();
+    const double loss = static_cast<double>(ls.dropped_loss) / static_cast<double>(ls.packets_in);
+    RecordProperty("streams_complete", total.streams);
+    RecordProperty("streams_decodable", total.decodable);
+    RecordProperty("fec_recoveries", static_cast<int>(cs.assembler.fec_recoveries));
+    RecordProperty("fec_parity_bytes", static_cast<int>(ss.fec_parity_bytes));
+    RecordProperty("key_frame_requests", static_cast<int>(cs.key_frame_requests_sent));
+    EXPECT_NEAR(loss, 0.05, 0.02);
+    EXPECT_EQ(total.corrupt, 0);  // rebuilt bytes are the bytes sent
+    EXPECT_NEAR(ss.client_loss_ppm, 50'000, 30'000);
+    // Stated bound: ≥ 95% complete and ≥ 90% decodable (without FEC: > 70% and > 35%).
+    EXPECT_GE(total.streams, 1200 * 95 / 100);
+    EXPECT_GE(total.decodable, 1200 * 90 / 100);
+    EXPECT_GT(cs.assembler.fec_recoveries, 50u);  // ≈ 18% of ~1100 stream frames lost a packet
+    EXPECT_GE(cs.assembler.fec_packets_recovered, cs.assembler.fec_recoveries);
+    EXPECT_GT(ss.fec_parity_packets, 1000u);
+    EXPECT_GT(ss.fec_parity_bytes, ss.fec_parity_packets * kMediaChunkBytes);
+    EXPECT_EQ(cs.assembler.fec_failures, 0u);
+}
+
 // With selective retransmission a frame of realistic size survives 5% loss: a 48 KB layer is
 // 40 packets, complete without help only 0.95^40 = 13% of the time; one NACK round leaves a
 // packet missing with probability 0.05² and two rounds 0.05³.
@@ -743,6 +805,7 @@ TEST(NetTransport, RetransmissionCompletesRealisticFramesAtFivePercentLoss) {
     EchoServer handler(stream_bytes);
     ServerOptions o;
     o.link = parseLinkSpec("wifi,delay_ms=2,loss=0.05,seed=9").value();
+    o.fec.enabled = false;  // NACKs alone
     auto server = startServer(handler, o);
     Client client(clientOptions());  // retransmit is on by default
     ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok()) << client.lastError().error();

@@ -19,7 +19,7 @@ namespace qvr::net {
 
 // 2: the ClientHello carries the session settings (codec, display profile) and the server
 // refuses a mismatch with a named Bye reason.
-inline constexpr uint8_t kProtocolVersion = 2;
+inline constexpr uint8_t kProtocolVersion = 3;
 
 // Limits a decoder enforces before it trusts any length a peer sent.
 inline constexpr size_t kControlHeaderBytes = 8;
@@ -165,6 +165,9 @@ struct MediaAck {
     uint32_t bytes_received = 0;
     uint64_t first_rx_ns = 0;  // client clock: first and last packet of the stream's frame
     uint64_t last_rx_ns = 0;
+    // The client's recent packet loss rate on the media streams, parts per million (≤ 10⁶),
+    // from sequence gaps: the server sizes its FEC parity from it.
+    uint32_t loss_ppm = 0;
 };
 
 enum class KeyFrameReason : uint8_t { kPacketLoss = 1, kDecoderError = 2, kStart = 3 };
@@ -226,11 +229,19 @@ struct MediaHeader {
     uint32_t seq = 0;  // per stream, +1 per packet across frames: gaps reveal loss
     uint32_t frame_id = 0;
     uint8_t stream_id = 0;
-    uint16_t packet_index = 0;
-    uint16_t packet_count = 0;
+    uint16_t packet_index = 0;  // data: < packet_count; parity: < blocks · fec_parity
+    uint16_t packet_count = 0;  // data packets of the frame
     uint16_t payload_bytes = 0;
     uint32_t frame_bytes = 0;  // the stream's encoded size for this frame
+    // Forward error correction (fec.h): parity packets per block of this frame (0: none),
+    // the same in all its packets; a parity packet has the flag and a full-size payload.
+    uint8_t fec_parity = 0;
+    bool parity = false;
 };
+// Parity packets a frame of packet_count data packets carries (every block gets fec_parity).
+uint32_t parityPacketsFor(uint16_t packet_count, uint8_t fec_parity);
+// The sequence number of the frame's first data packet (data, then parity, consecutively).
+uint32_t frameFirstSeq(const MediaHeader& h);
 struct MediaPacketView {
     MediaHeader header;
     std::span<const uint8_t> payload;  // into the datagram
@@ -268,10 +279,13 @@ private:
     void set(uint32_t seq) { m_seen[(seq % kBits) / 64] |= uint64_t{1} << (seq % 64); }
     void clear(uint32_t seq) { m_seen[(seq % kBits) / 64] &= ~(uint64_t{1} << (seq % 64)); }
 };
-// Splits one stream's frame into datagrams; seq advances by the packet count.
-// Precondition: 0 < bytes.size() ≤ kMaxStreamFrameBytes, stream_id < kMaxStreams.
+// Splits one stream's frame into datagrams, then fec_parity Reed-Solomon parity packets per
+// block of kFecBlockData data packets (fec.h); seq advances by the packet count.
+// Precondition: 0 < bytes.size() ≤ kMaxStreamFrameBytes, stream_id < kMaxStreams,
+// fec_parity ≤ kFecMaxParity.
 std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t& seq,
                                                   uint32_t frame_id, uint8_t stream_id,
-                                                  bool key_frame, std::span<const uint8_t> bytes);
+                                                  bool key_frame, std::span<const uint8_t> bytes,
+                                                  uint8_t fec_parity = 0);
 
 }  // namespace qvr::net

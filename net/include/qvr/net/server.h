@@ -11,6 +11,7 @@
 
 #include "qvr/core/expected.h"
 #include "qvr/net/auth.h"
+#include "qvr/net/fec.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/net/protocol.h"
 
@@ -44,6 +45,9 @@ struct ServerOptions {
     // bytes it first sent: a key holder's NACKs draw at most (1 + ratio) × the media.
     int max_retransmissions_per_packet = 2;
     double retransmit_budget_ratio = 1.0;
+    // Reed-Solomon parity on every stream frame, sized from the loss rate the client reports
+    // in its acks (fec.h, docs/PROTOCOL.md §Forward error correction); none before a report.
+    FecPolicy fec;
     // What a client's ClientHello must carry (codec, display profile); an authenticated client
     // with other settings is refused with Bye(codec / profile mismatch).
     SessionSettings settings;
@@ -87,6 +91,10 @@ struct ServerStats {
     uint64_t packets_not_in_history = 0;   // asked for too late (or never sent)
     uint64_t retransmissions_refused = 0;  // NACKed again after its retransmission budget
     uint64_t bytes_retransmitted = 0;
+    uint64_t fec_frames = 0;          // stream frames sent with parity
+    uint64_t fec_parity_packets = 0;  // parity datagrams sent (first transmissions)
+    uint64_t fec_parity_bytes = 0;    // their bytes on the wire
+    uint32_t client_loss_ppm = 0;     // the latest loss rate a client reported
 };
 
 class Server {

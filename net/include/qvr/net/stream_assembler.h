@@ -67,6 +67,15 @@ struct AssemblerStats {
     uint64_t nacks = 0;                // NACK messages produced
     uint64_t packets_nacked = 0;       // sequence numbers asked for (tries counted)
     uint64_t packets_recovered = 0;    // gap packets that arrived after all
+    // Forward error correction (fec.h): data packets rebuilt from parity, the stream frames
+    // that completed only thanks to them, parity packets taken, and parity that came after
+    // its frame was already complete (unneeded). Malformed parity never gets here: the
+    // decoder drops and counts it.
+    uint64_t fec_packets_recovered = 0;
+    uint64_t fec_recoveries = 0;
+    uint64_t fec_parity_received = 0;
+    uint64_t fec_parity_unused = 0;
+    uint64_t fec_failures = 0;  // a block with enough shards that did not decode (never seen)
 };
 
 class StreamAssembler {
@@ -85,6 +94,10 @@ public:
     // Retransmission requests due (retransmit mode), grouped by 64 sequence numbers.
     std::vector<Nack> takeNacks();
     bool awaitingKeyFrame(uint8_t stream_id) const { return m_streams[stream_id].awaiting_key; }
+    // Recent packet loss on all streams, from sequence gaps (parity included): an EWMA over
+    // windows of kLossWindowPackets sequence numbers; what the client reports for FEC sizing.
+    double lossRate() const { return m_loss_rate; }
+    static constexpr uint32_t kLossWindowPackets = 256;
     const AssemblerStats& stats() const { return m_stats; }
     int64_t bufferedBytes() const { return m_buffered_bytes; }
 
@@ -93,13 +106,25 @@ private:
         bool key_frame = false;
         uint16_t packet_count = 0;
         uint32_t frame_bytes = 0;
-        uint32_t last_seq = 0;
-        uint16_t received = 0;
+        uint8_t fec_parity = 0;  // parity packets per block
+        uint32_t first_seq = 0;
+        uint32_t last_seq = 0;  // of the last parity packet when there is parity
+        uint16_t received = 0;  // data and parity
+        uint16_t data_have = 0;
         uint32_t bytes_received = 0;
         int64_t first_rx_ns = 0;
         int64_t last_rx_ns = 0;
-        std::vector<uint8_t> bytes;
+        int64_t allocated = 0;
+        bool fec_used = false;
+        std::vector<uint8_t> bytes;   // data (whole shards when there is parity)
+        std::vector<uint8_t> parity;  // parity shards
         std::vector<bool> have;
+        std::vector<bool> have_parity;
+    };
+    struct Finished {
+        uint32_t frame_id;
+        uint32_t first_seq;
+        uint32_t last_seq;
     };
     struct Missing {
         uint32_t seq;
@@ -113,10 +138,15 @@ private:
         uint32_t next_seq = 0;
         bool awaiting_key = true;  // the first decodable frame is a key frame
         std::map<uint32_t, Partial> partials;
-        std::deque<uint32_t> finished;  // recently completed or lost frame ids
+        std::deque<Finished> finished;  // recently completed or lost frames
     };
 
-    void finish(uint8_t stream_id, uint32_t frame_id);
+    void finish(uint8_t stream_id, uint32_t frame_id, const Partial& p);
+    void complete(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
+    void tryFec(Partial& p, int block);
+    // Gap sequence numbers a frame with parity may still make good, or a finished frame's.
+    bool coveredElsewhere(const Stream& s, uint32_t seq) const;
+    void nackMissingData(Stream& s, const Partial& p, int64_t now_ns);
     void declareLost(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
     bool isFinished(const Stream& s, uint32_t frame_id) const;
 
@@ -127,6 +157,10 @@ private:
     std::vector<LostStream> m_lost;
     uint8_t m_loss_mask = 0;
     AssemblerStats m_stats;
+    uint32_t m_window_expected = 0;
+    uint32_t m_window_lost = 0;
+    bool m_loss_sampled = false;
+    double m_loss_rate = 0.0;
 };
 
 }  // namespace qvr::net
