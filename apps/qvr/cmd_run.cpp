@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -85,42 +86,71 @@ struct RunOptions {
     std::string command_line;
 };
 
-// Keeps what the headset scanned out, both eyes side by side at half resolution, in memory;
-// encoded after the run so the video costs the measured run nothing.
+// Keeps what the headset scanned out, both eyes side by side at a quarter of the resolution
+// on each axis, in memory; encoded after the run. The recording runs inside the headset's loop
+// (on its one core) and only the qvr design records, so it must cost that loop next to nothing:
+// - every frame's buffer is allocated and touched by reserve(), before the run — on these KVM
+//   guests the first touch of fresh memory costs ~25 us a page, and an 8 MB image allocated
+//   per frame cost the qvr headset ~45 ms a frame;
+// - each output pixel averages a horizontal pair of one source row in four (a quarter of the
+//   display's memory is read: ~1 ms a frame; a full 2×2 box at half resolution read all of it,
+//   3.6 ms even vectorised, 16 ms as it was written). recordMsPerFrame() reports what it took.
 class ScanoutRecorder final : public DisplaySink {
 public:
+    static constexpr int kScale = 4;
     ScanoutRecorder(const HmdProfile& profile, int max_frames, bool fovea_border)
         : m_profile(profile), m_max_frames(max_frames), m_fovea_border(fovea_border) {}
+    // Buffers for the next `frames` scan-outs (at most max_frames in all), off the clock.
+    void reserve(int frames) {
+        const int w = m_profile.width_px / kScale, h = (m_profile.height_px / kScale) & ~1;
+        const int want = std::min(frames, m_max_frames - static_cast<int>(m_frames.size()));
+        while (static_cast<int>(m_pool.size()) < want)
+            m_pool.emplace_back(2 * w, h);  // zero-filled: every page touched now
+    }
     void onScanout(const FrameTelemetry&, const LayerPlan& plan,
                    const std::array<ImageRgba8, 2>& eyes) override {
-        if (static_cast<int>(m_frames.size()) >= m_max_frames || eyes[0].empty())
+        if (static_cast<int>(m_frames.size()) >= m_max_frames || eyes[0].empty() || m_pool.empty())
             return;
-        // Even sides: the MP4 is 4:2:0.
-        const int w = eyes[0].width() / 2, h = (eyes[0].height() / 2) & ~1;
-        ImageRgba8 img(2 * w, h);
+        const auto t0 = std::chrono::steady_clock::now();
+        ImageRgba8 img = std::move(m_pool.back());
+        m_pool.pop_back();
+        const int w = std::min(eyes[0].width() / kScale, img.width() / 2);
+        const int h = std::min(eyes[0].height() / kScale, img.height());
+        // Per byte (p + q) / 2 rounded down, on four channels at once.
+        auto avg = [](uint32_t p, uint32_t q) { return (p & q) + (((p ^ q) & 0xFEFEFEFEu) >> 1); };
         for (int e = 0; e < 2; ++e)
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x)
-                    for (int c = 0; c < 4; ++c) {
-                        const int sum =
-                            eyes[e].at(2 * x, 2 * y, c) + eyes[e].at(2 * x + 1, 2 * y, c) +
-                            eyes[e].at(2 * x, 2 * y + 1, c) + eyes[e].at(2 * x + 1, 2 * y + 1, c);
-                        img.at(e * w + x, y, c) = static_cast<uint8_t>((sum + 2) / 4);
-                    }
+            for (int y = 0; y < h; ++y) {
+                const uint8_t* src = eyes[e].row(kScale * y + kScale / 2);
+                uint8_t* dst = img.row(y) + static_cast<size_t>(e) * w * 4;
+                for (int x = 0; x < w; ++x) {
+                    uint32_t p, q;
+                    std::memcpy(&p, src + 4 * (kScale * x + 1), 4);
+                    std::memcpy(&q, src + 4 * (kScale * x + 2), 4);
+                    const uint32_t v = avg(p, q);
+                    std::memcpy(dst + 4 * x, &v, 4);
+                }
+            }
         m_frames.push_back(std::move(img));
         const bool has_fovea = !plan.eyes[0].fovea.empty() && plan.e1_deg < plan.cover_deg;
         m_foveae.push_back({plan.gaze, has_fovea ? plan.e1_deg : -1.0});
+        m_record_ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count();
+    }
+    // Time the recording took inside the headset's loop, per recorded frame.
+    double recordMsPerFrame() const {
+        return m_frames.empty() ? 0.0 : m_record_ms / static_cast<double>(m_frames.size());
     }
     // The e1 circle of the shown frame, through the lens map (display pose = render pose, so
     // it ignores the few tenths of a degree of timewarp): where the fovea layer ends.
     void drawFoveaBorder(ImageRgba8& img, const Gaze& gaze, double e1_deg) const {
         const EyeWarp warp(m_profile, glm::quat(1, 0, 0, 0), glm::quat(1, 0, 0, 0));
         const EyeGeometry geometry(m_profile);
-        const double band_deg = 1.5 * m_profile.pixelAngleDeg();
+        const double band_deg = 0.75 * kScale * m_profile.pixelAngleDeg();
         const int w = img.width() / 2;
         for (int y = 0; y < img.height(); ++y)
             for (int x = 0; x < w; ++x) {
-                const WarpSample s = warp.map(2.0 * x + 1.0, 2.0 * y + 1.0);
+                const WarpSample s = warp.map(kScale * (x + 0.5), kScale * (y + 0.5));
                 if (!s.inside)
                     continue;
                 if (std::fabs(geometry.eccentricityDeg(gaze, s.px, s.py) - e1_deg) > band_deg)
@@ -170,7 +200,9 @@ private:
     int m_max_frames;
     bool m_fovea_border;
     std::vector<ImageRgba8> m_frames;
+    std::vector<ImageRgba8> m_pool;  // reserved, not yet used
     std::vector<Fovea> m_foveae;
+    double m_record_ms = 0.0;
 };
 
 // Progress on a terminal while a design runs (design, frame k of N, FPS so far), redrawn at
@@ -219,24 +251,39 @@ public:
         LayerPlan plan;
         ImageRgba8 left;
     };
-    QualitySampler(int every, size_t max_samples, DisplaySink* inner)
-        : m_every(every), m_max(max_samples), m_inner(inner) {}
+    // The samples' images come from `pool` (allocated and touched before the run, returned by
+    // recycle()): a fresh 16 MB allocation inside the headset's loop cost every sampled frame
+    // 40–90 ms on these KVM guests (first-touch page faults), for every design alike.
+    QualitySampler(int every, size_t max_samples, DisplaySink* inner, std::vector<ImageRgba8>& pool)
+        : m_every(every), m_max(max_samples), m_inner(inner), m_pool(pool) {}
     void onScanout(const FrameTelemetry& t, const LayerPlan& plan,
                    const std::array<ImageRgba8, 2>& eyes) override {
         if (m_inner)
             m_inner->onScanout(t, plan, eyes);
         if ((t.frame + 1) % m_every != 0 || m_samples.size() >= m_max || eyes[0].empty() ||
-            t.pose_ns < 0 || t.uca_start_ns < 0)
+            t.pose_ns < 0 || t.uca_start_ns < 0 || m_pool.empty())
             return;
+        ImageRgba8 left = std::move(m_pool.back());
+        m_pool.pop_back();
+        if (left.width() != eyes[0].width() || left.height() != eyes[0].height())
+            left.resize(eyes[0].width(), eyes[0].height());
+        std::memcpy(left.data(), eyes[0].data(), eyes[0].sizeBytes());
         m_samples.push_back({t.frame, t.shown_frame >= 0 ? t.shown_frame : t.frame, t.pose_ns,
-                             t.uca_start_ns, plan, eyes[0]});
+                             t.uca_start_ns, plan, std::move(left)});
     }
     const std::vector<Sample>& samples() const { return m_samples; }
+    // Gives the images back to the pool for the next design.
+    void recycle() {
+        for (Sample& s : m_samples)
+            m_pool.push_back(std::move(s.left));
+        m_samples.clear();
+    }
 
 private:
     int m_every;
     size_t m_max;
     DisplaySink* m_inner;
+    std::vector<ImageRgba8>& m_pool;
     std::vector<Sample> m_samples;
 };
 
@@ -706,6 +753,12 @@ int runRun(const RunOptions& o) {
     std::vector<std::pair<std::string, DesignQuality>> quality;
     std::string quality_note;
     ScanoutRecorder recorder(*profile, o.video_max_frames, o.fovea_border);
+    // The quality samples' display images, allocated (and touched) once, before any run.
+    constexpr size_t kQualitySamples = 12;
+    std::vector<ImageRgba8> quality_pool;
+    if (o.quality_every > 0)
+        for (size_t k = 0; k < kQualitySamples; ++k)
+            quality_pool.emplace_back(profile->width_px, profile->height_px);
     const fs::path workload_path = out / "workload.jsonl";
     bool recorded_workload = false;
     std::ofstream all_csv(out / "telemetry.csv");
@@ -732,8 +785,10 @@ int runRun(const RunOptions& o) {
         std::ofstream workload_out;
         std::unique_ptr<WorkloadTraceWriter> writer;
         if (d == RuntimeDesign::kQvr) {
-            if (o.video)
+            if (o.video) {
+                recorder.reserve(o.frames);
                 hc.display = &recorder;
+            }
             workload_out.open(workload_path);
             if (workload_out) {
                 writer = std::make_unique<WorkloadTraceWriter>(workload_out);
@@ -743,7 +798,8 @@ int runRun(const RunOptions& o) {
         }
         std::unique_ptr<QualitySampler> sampler;
         if (o.quality_every > 0) {
-            sampler = std::make_unique<QualitySampler>(o.quality_every, 12, hc.display);
+            sampler = std::make_unique<QualitySampler>(o.quality_every, kQualitySamples, hc.display,
+                                                       quality_pool);
             hc.display = sampler.get();
         }
         std::unique_ptr<ProgressDisplay> progress;
@@ -793,6 +849,8 @@ int runRun(const RunOptions& o) {
                     quality_note = q.error();
             }
         }
+        if (sampler)
+            sampler->recycle();
         // Let the server finish the last session before the next one starts.
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
@@ -1070,10 +1128,11 @@ int runRun(const RunOptions& o) {
         const fs::path video = out / "qvr_display.mp4";
         if (auto st = recorder.writeMp4(video.string()); st)
             video_note = fmt::format(
-                "qvr_display.mp4: {} frames, both eyes side by side at half "
-                "resolution{}, H.264 in MP4 at {} fps",
+                "qvr_display.mp4: {} frames, both eyes side by side at a quarter of "
+                "the resolution{}, H.264 in MP4 at {} fps; recording cost the qvr headset "
+                "{:.2f} ms a frame (buffers reserved before the run, encoded after it)",
                 recorder.frames(), o.fovea_border ? ", fovea edge (e1) drawn in yellow" : "",
-                profile->refresh_hz);
+                profile->refresh_hz, recorder.recordMsPerFrame());
         else
             video_note = "video failed: " + st.error();
         // The middle frame as a still beside it.
