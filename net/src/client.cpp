@@ -30,6 +30,9 @@ void add(AssemblerStats& a, const AssemblerStats& b) {
     a.streams_completed += b.streams_completed;
     a.streams_lost += b.streams_lost;
     a.streams_undecodable += b.streams_undecodable;
+    a.streams_held += b.streams_held;
+    a.streams_stale += b.streams_stale;
+    a.streams_released_early += b.streams_released_early;
     a.nacks += b.nacks;
     a.packets_nacked += b.packets_nacked;
     a.packets_recovered += b.packets_recovered;

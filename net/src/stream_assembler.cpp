@@ -120,11 +120,17 @@ void StreamAssembler::declareLost(uint8_t stream_id, std::map<uint32_t, Partial>
     m_loss_mask |= static_cast<uint8_t>(1u << stream_id);
     finish(stream_id, it->first, p);
     s.partials.erase(it);
+    release(stream_id);
 }
 
 void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
+    QVR_CHECK(packet.header.stream_id < kMaxStreams);
+    accept(packet, now_ns);
+    release(packet.header.stream_id);  // an answered NACK may unblock held frames
+}
+
+void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
     const MediaHeader& h = packet.header;
-    QVR_CHECK(h.stream_id < kMaxStreams);
     Stream& s = m_streams[h.stream_id];
     const uint32_t h_first = frameFirstSeq(h);
 
@@ -286,13 +292,6 @@ void StreamAssembler::complete(uint8_t stream_id, std::map<uint32_t, Partial>::i
     done.frame_id = it->first;
     done.stream_id = stream_id;
     done.key_frame = p.key_frame;
-    if (p.key_frame) {
-        s.awaiting_key = false;
-    }
-    done.decodable = !s.awaiting_key;
-    if (!done.decodable) {
-        ++m_stats.streams_undecodable;
-    }
     if (p.fec_used) {
         ++m_stats.fec_recoveries;
     }
@@ -303,9 +302,55 @@ void StreamAssembler::complete(uint8_t stream_id, std::map<uint32_t, Partial>::i
     done.bytes.resize(p.frame_bytes);  // drops the code's padding
     m_buffered_bytes -= p.allocated;
     ++m_stats.streams_completed;
-    m_completed.push_back(std::move(done));
+    const uint32_t first_seq = p.first_seq;
     finish(stream_id, it->first, p);
     s.partials.erase(it);
+    if (s.has_released && seqAfter(first_seq, s.released_first_seq) < 0) {
+        ++m_stats.streams_stale;  // a later frame already went to the decoder
+        return;
+    }
+    auto pos = std::find_if(s.held.begin(), s.held.end(),
+                            [&](const Held& h) { return seqAfter(h.first_seq, first_seq) > 0; });
+    s.held.insert(pos, Held{first_seq, std::move(done)});
+    release(stream_id);
+}
+
+void StreamAssembler::release(uint8_t stream_id) {
+    Stream& s = m_streams[stream_id];
+    while (!s.held.empty()) {
+        const uint32_t first_seq = s.held.front().first_seq;
+        // Only retransmission brings an earlier frame's packets after later ones (the link keeps
+        // order); without it the earlier frame is lost and the held one leaves undecodable.
+        const bool blocked =
+            m_limits.retransmit &&
+            (std::any_of(
+                 s.partials.begin(), s.partials.end(),
+                 [&](const auto& kv) { return seqAfter(first_seq, kv.second.first_seq) > 0; }) ||
+             std::any_of(s.missing.begin(), s.missing.end(),
+                         [&](const Missing& m) { return seqAfter(first_seq, m.seq) > 0; }));
+        if (blocked) {
+            if (s.held.size() <= kMaxHeldPerStream) {
+                ++m_stats.streams_held;
+                return;
+            }
+            // Memory stays bounded: skip what is still missing, as a loss.
+            ++m_stats.streams_released_early;
+            s.awaiting_key = true;
+            m_loss_mask |= static_cast<uint8_t>(1u << stream_id);
+        }
+        CompletedStream done = std::move(s.held.front().stream);
+        s.held.erase(s.held.begin());
+        if (done.key_frame) {
+            s.awaiting_key = false;
+        }
+        done.decodable = !s.awaiting_key;
+        if (!done.decodable) {
+            ++m_stats.streams_undecodable;
+        }
+        s.has_released = true;
+        s.released_first_seq = first_seq;
+        m_completed.push_back(std::move(done));
+    }
 }
 
 void StreamAssembler::expire(int64_t now_ns) {
@@ -341,10 +386,24 @@ void StreamAssembler::expire(int64_t now_ns) {
                 s.nack_now.push_back(m.seq);
             }
         }
+        const auto before = s.missing.size();
         std::erase_if(s.missing, [&](const Missing& m) {
-            return m.tries >= m_limits.max_nack_tries &&
-                   now_ns - m.last_nack_ns >= m_limits.nack_retry_ns;
+            const bool give_up = m.tries >= m_limits.max_nack_tries &&
+                                 now_ns - m.last_nack_ns >= m_limits.nack_retry_ns;
+            // A packet of no frame we know of: a whole frame is gone, and no timeout will say
+            // so (a partial frame is declared lost by its own timeout).
+            if (give_up && !std::any_of(partials.begin(), partials.end(), [&](const auto& kv) {
+                    return seqAfter(m.seq, kv.second.first_seq) >= 0 &&
+                           seqAfter(m.seq, kv.second.last_seq) <= 0;
+                })) {
+                s.awaiting_key = true;
+                m_loss_mask |= static_cast<uint8_t>(1u << id);
+            }
+            return give_up;
         });
+        if (s.missing.size() != before) {
+            release(id);
+        }
     }
 }
 

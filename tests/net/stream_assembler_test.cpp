@@ -245,5 +245,91 @@ TEST(NetThroughputEstimator, ForgetsFramesBeyondItsWindow) {
     EXPECT_DOUBLE_EQ(est.throughputBps(), 8000.0 / 1e-3);
 }
 
+// With retransmission an earlier frame can complete after a later one; an inter-coded decoder
+// (and the codec's reference tracker: consecutive frame ids) must see them in order, so the
+// later frame waits for the earlier one, or leaves undecodable once the earlier is lost.
+TEST(NetStreamAssembler, RetransmitModeHandsOutFramesInStreamOrder) {
+    AssemblerLimits limits;
+    limits.retransmit = true;
+    StreamAssembler a(limits);
+    uint32_t seq = 0;
+    const auto b1 = frameBytes(3 * kMediaChunkBytes, 1);
+    const auto f1 = packetizeStream(1, seq, 1, 0, true, b1);                    // seqs 0..2
+    const auto f2 = packetizeStream(1, seq, 2, 0, false, frameBytes(2000, 2));  // 3..4
+    const auto f3 = packetizeStream(1, seq, 3, 0, false, frameBytes(2000, 3));  // 5..6
+    feed(a, f1[0], 0);
+    feed(a, f1[2], 1);  // seq 1 missing: NACKed
+    for (const auto& p : f2) {
+        feed(a, p, 2);
+    }
+    EXPECT_EQ(a.takeNacks().size(), 1u);
+    EXPECT_TRUE(a.takeCompleted().empty());  // frame 2 is complete but waits for frame 1
+    EXPECT_GE(a.stats().streams_held, 1u);
+    feed(a, f1[1], 3);  // the retransmission
+    auto done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 2u);
+    EXPECT_EQ(done[0].frame_id, 1u);
+    EXPECT_EQ(done[1].frame_id, 2u);
+    EXPECT_TRUE(done[0].decodable);
+    EXPECT_TRUE(done[1].decodable);
+    EXPECT_EQ(done[0].bytes, b1);
+
+    // Frame 4 loses a packet for good: frame 5 leaves once frame 4 is declared lost, and
+    // cannot be decoded without it.
+    const auto f4 = packetizeStream(1, seq, 4, 0, false, frameBytes(3 * kMediaChunkBytes, 4));
+    const auto f5 = packetizeStream(1, seq, 5, 0, false, frameBytes(2000, 5));
+    for (const auto& p : f3) {
+        feed(a, p, 10);
+    }
+    feed(a, f4[0], 10);
+    feed(a, f4[2], 10);
+    for (const auto& p : f5) {
+        feed(a, p, 11);
+    }
+    done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);  // frame 3
+    EXPECT_EQ(done[0].frame_id, 3u);
+    a.expire(200'000'000);  // past the loss timeout
+    ASSERT_EQ(a.takeLost().size(), 1u);
+    done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);
+    EXPECT_EQ(done[0].frame_id, 5u);
+    EXPECT_FALSE(done[0].decodable);
+    EXPECT_TRUE(a.awaitingKeyFrame(0));
+}
+
+// A whole frame whose NACKs went unanswered is a loss too (no partial frame's timeout would
+// say so), and an earlier frame completing after a later one left is dropped, not handed out.
+TEST(NetStreamAssembler, RetransmitModeWholeFrameLossAndStaleFrames) {
+    AssemblerLimits limits;
+    limits.retransmit = true;
+    limits.nack_retry_ns = 10'000'000;
+    StreamAssembler a(limits);
+    uint32_t seq = 0;
+    const auto f1 = packetizeStream(1, seq, 1, 0, true, frameBytes(2000, 1));   // 0..1
+    const auto f2 = packetizeStream(1, seq, 2, 0, false, frameBytes(2000, 2));  // 2..3
+    const auto f3 = packetizeStream(1, seq, 3, 0, false, frameBytes(2000, 3));  // 4..5
+    for (const auto& p : f1) {
+        feed(a, p, 0);
+    }
+    for (const auto& p : f3) {  // frame 2 entirely missing
+        feed(a, p, 1);
+    }
+    EXPECT_EQ(a.takeCompleted().size(), 1u);  // frame 1; frame 3 waits for the NACKed 2..3
+    a.expire(15'000'000);
+    a.expire(30'000'000);  // out of tries: frame 2 is gone
+    EXPECT_TRUE(a.awaitingKeyFrame(0));
+    EXPECT_NE(a.takeLossMask(), 0);
+    auto done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);
+    EXPECT_EQ(done[0].frame_id, 3u);
+    EXPECT_FALSE(done[0].decodable);
+    // Frame 2's packets come after all: too late, frame 3 already left.
+    feed(a, f2[0], 40'000'000);
+    feed(a, f2[1], 40'000'000);
+    EXPECT_TRUE(a.takeCompleted().empty());
+    EXPECT_EQ(a.stats().streams_stale, 1u);
+}
+
 }  // namespace
 }  // namespace qvr::net

@@ -64,9 +64,15 @@ struct AssemblerStats {
     uint64_t streams_completed = 0;
     uint64_t streams_lost = 0;
     uint64_t streams_undecodable = 0;  // completed while waiting for a key frame
-    uint64_t nacks = 0;                // NACK messages produced
-    uint64_t packets_nacked = 0;       // sequence numbers asked for (tries counted)
-    uint64_t packets_recovered = 0;    // gap packets that arrived after all
+    // Completed behind an earlier frame of the stream that may still come (a NACK in flight):
+    // held so frames leave in stream order (an inter-coded decoder must see them so), and
+    // completed after a later frame already left: dropped, it would break the decoder's chain.
+    uint64_t streams_held = 0;
+    uint64_t streams_stale = 0;
+    uint64_t streams_released_early = 0;  // held too long (kMaxHeldPerStream): earlier skipped
+    uint64_t nacks = 0;                   // NACK messages produced
+    uint64_t packets_nacked = 0;          // sequence numbers asked for (tries counted)
+    uint64_t packets_recovered = 0;       // gap packets that arrived after all
     // Forward error correction (fec.h): data packets rebuilt from parity, the stream frames
     // that completed only thanks to them, parity packets taken, and parity that came after
     // its frame was already complete (unneeded). Malformed parity never gets here: the
@@ -126,6 +132,10 @@ private:
         uint32_t first_seq;
         uint32_t last_seq;
     };
+    struct Held {
+        uint32_t first_seq;
+        CompletedStream stream;
+    };
     struct Missing {
         uint32_t seq;
         int64_t last_nack_ns;
@@ -139,14 +149,21 @@ private:
         bool awaiting_key = true;  // the first decodable frame is a key frame
         std::map<uint32_t, Partial> partials;
         std::deque<Finished> finished;  // recently completed or lost frames
+        std::vector<Held> held;         // complete, waiting for an earlier frame (seq order)
+        bool has_released = false;
+        uint32_t released_first_seq = 0;  // the newest frame handed out
     };
+    static constexpr size_t kMaxHeldPerStream = 16;
 
+    void accept(const MediaPacketView& packet, int64_t now_ns);
     void finish(uint8_t stream_id, uint32_t frame_id, const Partial& p);
     void complete(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
     void tryFec(Partial& p, int block);
     // Gap sequence numbers a frame with parity may still make good, or a finished frame's.
     bool coveredElsewhere(const Stream& s, uint32_t seq) const;
     void nackMissingData(Stream& s, const Partial& p, int64_t now_ns);
+    // Hands out held frames that no earlier partial frame or NACKed packet precedes.
+    void release(uint8_t stream_id);
     void declareLost(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
     bool isFinished(const Stream& s, uint32_t frame_id) const;
 
