@@ -80,6 +80,7 @@ struct RunOptions {
     double headset_share = 1.0;
     std::string ring_counts = "clusters";
     int pipeline_depth = 2;
+    int warmup_frames = 10;  // each design's first frames: start-up, outside the statistics
     float lod_px = 1.0f;
     std::string hardware;      // a calibration (qvr calibrate --out); none: cached or measured
     bool recalibrate = false;  // measure even when a cached calibration exists
@@ -98,12 +99,18 @@ struct RunOptions {
 class ScanoutRecorder final : public DisplaySink {
 public:
     static constexpr int kScale = 4;
-    ScanoutRecorder(const HmdProfile& profile, int max_frames, bool fovea_border)
-        : m_profile(profile), m_max_frames(max_frames), m_fovea_border(fovea_border) {}
+    // keep = false: a stand-in for the designs that are not recorded, doing the same work per
+    // frame into one scratch buffer, so that every design's headset pays the same for the video.
+    ScanoutRecorder(const HmdProfile& profile, int max_frames, bool fovea_border, bool keep = true)
+        : m_profile(profile),
+          m_max_frames(max_frames),
+          m_fovea_border(fovea_border),
+          m_keep(keep) {}
     // Buffers for the next `frames` scan-outs (at most max_frames in all), off the clock.
     void reserve(int frames) {
         const int w = m_profile.width_px / kScale, h = (m_profile.height_px / kScale) & ~1;
-        const int want = std::min(frames, m_max_frames - static_cast<int>(m_frames.size()));
+        const int want =
+            m_keep ? std::min(frames, m_max_frames - static_cast<int>(m_frames.size())) : 1;
         while (static_cast<int>(m_pool.size()) < want)
             m_pool.emplace_back(2 * w, h);  // zero-filled: every page touched now
     }
@@ -130,16 +137,21 @@ public:
                     std::memcpy(dst + 4 * x, &v, 4);
                 }
             }
-        m_frames.push_back(std::move(img));
-        const bool has_fovea = !plan.eyes[0].fovea.empty() && plan.e1_deg < plan.cover_deg;
-        m_foveae.push_back({plan.gaze, has_fovea ? plan.e1_deg : -1.0});
         m_record_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                 .count();
+        ++m_recorded;
+        if (!m_keep) {
+            m_pool.push_back(std::move(img));
+            return;
+        }
+        m_frames.push_back(std::move(img));
+        const bool has_fovea = !plan.eyes[0].fovea.empty() && plan.e1_deg < plan.cover_deg;
+        m_foveae.push_back({plan.gaze, has_fovea ? plan.e1_deg : -1.0});
     }
     // Time the recording took inside the headset's loop, per recorded frame.
     double recordMsPerFrame() const {
-        return m_frames.empty() ? 0.0 : m_record_ms / static_cast<double>(m_frames.size());
+        return m_recorded == 0 ? 0.0 : m_record_ms / static_cast<double>(m_recorded);
     }
     // The e1 circle of the shown frame, through the lens map (display pose = render pose, so
     // it ignores the few tenths of a degree of timewarp): where the fovea layer ends.
@@ -202,7 +214,9 @@ private:
     std::vector<ImageRgba8> m_frames;
     std::vector<ImageRgba8> m_pool;  // reserved, not yet used
     std::vector<Fovea> m_foveae;
+    bool m_keep;
     double m_record_ms = 0.0;
+    int m_recorded = 0;
 };
 
 // Progress on a terminal while a design runs (design, frame k of N, FPS so far), redrawn at
@@ -373,6 +387,8 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
             {"t_remote_ms_mean", s.t_remote_ms_mean},
             {"uca_ms_mean", s.uca_ms_mean},
             {"wall_s", s.wall_s},
+            {"warmup_frames", s.warmup_frames},
+            {"startup_mtp_ms_max", s.startup_mtp_ms_max},
             {"streams_decoded", st.streams_decoded},
             {"streams_lost", st.streams_lost},
             {"decode_failures", st.decode_failures},
@@ -622,6 +638,11 @@ int runRun(const RunOptions& o) {
         std::fprintf(stderr, "qvr run: --frames must be within 2..100000, got %d\n", o.frames);
         return 2;
     }
+    if (o.warmup_frames < 0 || o.warmup_frames > o.frames - 2) {
+        std::fprintf(stderr, "qvr run: --warmup-frames must be within 0..frames-2 (%d), got %d\n",
+                     o.frames - 2, o.warmup_frames);
+        return 2;
+    }
     auto link = net::parseLinkSpec(o.net);
     if (!link) {
         std::fprintf(stderr, "qvr run: --net: %s\n", link.error().c_str());
@@ -736,9 +757,11 @@ int runRun(const RunOptions& o) {
         }
         share_group = std::move(*g);
     }
-    fmt::print("qvr run: {} ({} triangles), {}x{} per eye at {} Hz, net {}, {} frames per design\n",
-               scene->name, scene->triangleCount(), profile->width_px, profile->height_px,
-               profile->refresh_hz, o.net, o.frames);
+    fmt::print(
+        "qvr run: {} ({} triangles), {}x{} per eye at {} Hz, net {}, {} frames per design (the "
+        "first {} start-up, outside the statistics)\n",
+        scene->name, scene->triangleCount(), profile->width_px, profile->height_px,
+        profile->refresh_hz, o.net, o.frames, o.warmup_frames);
     fmt::print(
         "  server on 127.0.0.1:{} pinned to core {}, headset pinned to core {} ({} cores){}\n",
         server->port(), server_core, client_core, cores,
@@ -753,6 +776,7 @@ int runRun(const RunOptions& o) {
     std::vector<std::pair<std::string, DesignQuality>> quality;
     std::string quality_note;
     ScanoutRecorder recorder(*profile, o.video_max_frames, o.fovea_border);
+    ScanoutRecorder stand_in(*profile, o.video_max_frames, false, /*keep=*/false);
     // The quality samples' display images, allocated (and touched) once, before any run.
     constexpr size_t kQualitySamples = 12;
     std::vector<ImageRgba8> quality_pool;
@@ -777,6 +801,7 @@ int runRun(const RunOptions& o) {
         hc.core = client_core;
         hc.remote_timeout_ms = o.remote_timeout_ms;
         hc.pipeline_depth = o.pipeline_depth;
+        hc.warmup_frames = o.warmup_frames;
         hc.lod_error_px = o.lod_px;
         hc.cluster_ring_counts = o.ring_counts == "clusters";
         GlRendererOptions gl;
@@ -789,6 +814,9 @@ int runRun(const RunOptions& o) {
                 recorder.reserve(o.frames);
                 hc.display = &recorder;
             }
+        } else if (o.video) {
+            stand_in.reserve(1);
+            hc.display = &stand_in;
             workload_out.open(workload_path);
             if (workload_out) {
                 writer = std::make_unique<WorkloadTraceWriter>(workload_out);
@@ -1130,7 +1158,8 @@ int runRun(const RunOptions& o) {
             video_note = fmt::format(
                 "qvr_display.mp4: {} frames, both eyes side by side at a quarter of "
                 "the resolution{}, H.264 in MP4 at {} fps; recording cost the qvr headset "
-                "{:.2f} ms a frame (buffers reserved before the run, encoded after it)",
+                "{:.2f} ms a frame, and every other design the same for a stand-in (buffers "
+                "reserved before the run, encoded after it)",
                 recorder.frames(), o.fovea_border ? ", fovea edge (e1) drawn in yellow" : "",
                 profile->refresh_hz, recorder.recordMsPerFrame());
         else
@@ -1250,21 +1279,26 @@ int runRun(const RunOptions& o) {
     page.html(fmt::format(
         "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
         "the "
-        "server's egress), {} frames per design. The headset (this process) is pinned to core {}, "
+        "server's egress), {} frames per design, of which the first {} are each session's "
+        "start-up (connection, first renders, key frames, the policy's first decisions): logged, "
+        "but outside every statistic below (their worst MTP is <code>startup_mtp_ms_max</code> "
+        "in summary.json and the table's last column). The headset (this process) is "
+        "pinned to core {}, "
         "the server (a child <code>qvr server</code> process) to core {}. Motion-to-photon is pose "
         "sample → UCA output complete on the headset's "
         "steady clock.</p>\n",
         report::htmlEscape(scene->name), profile->width_px, profile->height_px, profile->refresh_hz,
-        report::htmlEscape(o.net), o.frames, client_core, server_core));
+        report::htmlEscape(o.net), o.frames, o.warmup_frames, client_core, server_core));
     report::Table designs_table({"design", "FPS", "MTP mean ms", "MTP p99 ms", "KB/frame",
                                  "e1 mean °", "T_local ms", "T_remote ms", "UCA ms", "displayed",
-                                 "reused"});
+                                 "reused", "start-up MTP max ms"});
     for (const DesignRun& r : runs) {
         const DesignSummary& s = r.result.summary;
         designs_table.row({s.design, num(s.fps_mean), num(s.mtp_ms_mean), num(s.mtp_ms_p99),
                            num(s.bytes_per_frame_mean / 1e3), num(s.e1_deg_mean),
                            num(s.t_local_ms_mean), num(s.t_remote_ms_mean), num(s.uca_ms_mean),
-                           std::to_string(s.frames_displayed), std::to_string(s.frames_reused)});
+                           std::to_string(s.frames_displayed), std::to_string(s.frames_reused),
+                           num(s.startup_mtp_ms_max)});
     }
     page.table(designs_table);
     if (j.contains("best_fixed")) {
@@ -1418,6 +1452,11 @@ static Registered registerRun(CLI::App& app) {
         ->check(CLI::IsMember({"clusters", "bvh"}))
         ->capture_default_str();
     addLodOption(cmd, o->lod_px);
+    cmd->add_option("--warmup-frames", o->warmup_frames,
+                    "Each design's first frames are its session's start-up (connection, first "
+                    "renders, key frames, the policy's first decisions): run and logged, but left "
+                    "out of FPS, MTP, bytes and e1; their worst MTP is reported apart")
+        ->capture_default_str();
     cmd->add_option("--pipeline", o->pipeline_depth,
                     "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
                     "finishing n)")

@@ -199,8 +199,8 @@ public:
         }
         m_stats.core = currentCore();
         result.stats = m_stats;
-        result.summary =
-            summarizeRun(designLabel(m_config.design, m_config.fixed_e1_deg), result.frames);
+        result.summary = summarizeRun(designLabel(m_config.design, m_config.fixed_e1_deg),
+                                      result.frames, m_config.warmup_frames);
         return result;
     }
 
@@ -630,6 +630,14 @@ private:
             m.t_local_ms =
                 m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
             m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
+            if (i < static_cast<int64_t>(m_depth)) {
+                // The frames requested before any completed are the session's start-up (the
+                // server's first renders and key frames, first use of every code path), not
+                // what the next frames will cost: no timing from them reaches the policy's
+                // fits (one 80–140 ms start-up frame biased LIWC's 32-frame window by ~15 ms).
+                m.t_local_ms = 0.0;
+                m.t_remote_ms = 0.0;
+            }
             if (wf) {
                 m.triangles_local =
                     sumWithinDeg(wf->triangles_per_ring, m_probe.header().ring_deg, plan.e1_deg);

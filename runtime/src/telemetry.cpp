@@ -19,9 +19,18 @@ double percentile(std::vector<double> values, double p) {
     return values[idx];
 }
 
-DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& frames) {
+DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& all,
+                           int warmup_frames) {
     DesignSummary s;
     s.design = design;
+    const size_t skip = warmup_frames > 0 && all.size() > static_cast<size_t>(warmup_frames)
+                            ? static_cast<size_t>(warmup_frames)
+                            : 0;
+    s.warmup_frames = static_cast<int>(skip);
+    for (size_t k = 0; k < skip; ++k)
+        s.startup_mtp_ms_max = std::max(s.startup_mtp_ms_max, all[k].mtp_ms);
+    const std::vector<FrameTelemetry> frames(all.begin() + static_cast<std::ptrdiff_t>(skip),
+                                             all.end());
     s.frames = static_cast<int>(frames.size());
     std::vector<double> mtp;
     double bytes = 0, e1 = 0, t_local = 0, t_remote = 0, uca = 0;

@@ -67,6 +67,10 @@ struct HeadsetConfig {
     // renders, so the server renders n+1 while the headset finishes n (paper Fig. 4's overlap
     // across frames). The policy then decides n+1 before it has observed n.
     int pipeline_depth = 2;
+    // The first frames are left out of the summary's statistics (telemetry.h DesignSummary):
+    // the session's start-up and the policy's first decisions. (Timings of the first
+    // pipeline_depth frames, requested before any completed, never reach the policy's fits.)
+    int warmup_frames = 0;
     // Scan-out: false queues the composed frame for its vsync slot and goes on with the next
     // (a two-image swapchain, VsyncPacer::queueForScanout); true waits for the slot first, as
     // until 2026-11-23 (one frame's composition never overlaps the previous one's scan-out).

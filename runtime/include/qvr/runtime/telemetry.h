@@ -70,9 +70,17 @@ struct DesignSummary {
     double uca_ms_mean = 0.0;
     double frames_fallback_local = 0;
     double wall_s = 0.0;
+    // The session's first frames (connection, the server's first render and key frame, first
+    // use of every code path) are its start-up, not its steady state: they are left out of
+    // every statistic above (with 150 frames the MTP p99 is the second-worst frame, which was
+    // always frame 0 or 1 for every design) and their worst MTP is reported on its own.
+    int warmup_frames = 0;
+    double startup_mtp_ms_max = 0.0;
 };
 
-DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& frames);
+// Statistics over frames[warmup_frames…] (all frames when there are no more than that).
+DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& frames,
+                           int warmup_frames = 0);
 // Nearest-rank percentile (p in (0, 100]) of a non-empty sample; 0 when empty.
 double percentile(std::vector<double> values, double p);
 std::string telemetryCsvHeader();
