@@ -2,12 +2,14 @@
 // media; net/src/client.cpp readMedia): open → decode → session check → replay window →
 // reassembler, over a sequence of records. Each record is [op][len lo][len hi][bytes]:
 //   op % 3 == 0  the bytes arrive as a datagram from an attacker (no key): never opens;
-//   op % 3 == 1  the bytes are a frame the server sends: packetized, sealed with the session key
-//                and delivered in order; op bit 2 delivers one datagram twice (replayed);
+//   op % 3 == 1  the bytes are a frame the server sends: packetized with 0–3 FEC parity packets
+//                per block (op bits 4–5), sealed with the session key and delivered in order;
+//                op bit 2 delivers the first datagram twice (replayed), op bit 6 loses one
+//                datagram on the way (FEC or the reassembler's loss handling takes over);
 //   op % 3 == 2  as 1, with one bit flipped at a fuzz-chosen place in one datagram: that one
 //                never opens, the others do.
 // Checks: only sealed-and-untouched datagrams open, each is accepted once, the reassembler
-// stays inside its limits and completes only streams that exist.
+// (and its FEC decoder) stays inside its limits and completes only streams that exist.
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -85,12 +87,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const uint32_t frame_id = bytes[1] | (bytes[2] << 8);
         const uint32_t flip = bytes[3] | (bytes[4] << 8);
         const auto payload = bytes.subspan(5);
-        auto datagrams =
-            packetizeStream(kSession, seq[stream], frame_id, stream, (op & 8) != 0, payload);
+        const auto fec_parity = static_cast<uint8_t>((op >> 4) & 3);
+        auto datagrams = packetizeStream(kSession, seq[stream], frame_id, stream, (op & 8) != 0,
+                                         payload, fec_parity);
         for (auto& d : datagrams)
             sealMediaPacket(d, rx.key);
         const size_t flipped = op % 3 == 2 ? flip % datagrams.size() : datagrams.size();
+        const size_t lost = (op & 0x40) ? (flip >> 3) % datagrams.size() : datagrams.size();
         for (size_t i = 0; i < datagrams.size(); ++i) {
+            if (i == lost && i != flipped)
+                continue;
             std::vector<uint8_t> d = datagrams[i];
             if (i == flipped) {
                 const uint32_t bit = (flip >> 1) % (d.size() * 8);
