@@ -23,6 +23,18 @@ WorkloadProbe::WorkloadProbe(const HmdProfile& profile, std::shared_ptr<const Tr
     m_header.ring_deg = ring_deg;
     m_header.rings = rings;
     m_header.scales = {1, 2, 4, 8, 16, 32};
+    const int w = m_geometry.width(), h = m_geometry.height();
+    const int step_x = std::max(1, (w + kMaxPixelSamplesPerSide - 1) / kMaxPixelSamplesPerSide);
+    const int step_y = std::max(1, (h + kMaxPixelSamplesPerSide - 1) / kMaxPixelSamplesPerSide);
+    for (int y0 = 0; y0 < h; y0 += step_y) {
+        const int bh = std::min(step_y, h - y0);
+        for (int x0 = 0; x0 < w; x0 += step_x) {
+            const int bw = std::min(step_x, w - x0);
+            // Both eyes share the gaze, hence 2×.
+            m_pixel_samples.push_back(
+                {m_geometry.directionAt(x0 + 0.5 * bw, y0 + 0.5 * bh), 2.0 * bw * bh});
+        }
+    }
 }
 
 void WorkloadProbe::useClusters(std::shared_ptr<const DrawList> clusters, float lod_error_px) {
@@ -36,19 +48,14 @@ void WorkloadProbe::setName(const std::string& name, const std::string& source) 
 }
 
 std::vector<double> WorkloadProbe::pixelsPerRing(const Gaze& gaze) const {
+    // The same eccentricity as EyeGeometry::eccentricityDeg, the gaze's direction computed once.
     std::vector<double> rings(static_cast<size_t>(m_header.rings), 0.0);
-    const int w = m_geometry.width(), h = m_geometry.height();
-    const int step_x = std::max(1, (w + kMaxPixelSamplesPerSide - 1) / kMaxPixelSamplesPerSide);
-    const int step_y = std::max(1, (h + kMaxPixelSamplesPerSide - 1) / kMaxPixelSamplesPerSide);
-    for (int y0 = 0; y0 < h; y0 += step_y) {
-        const int bh = std::min(step_y, h - y0);
-        for (int x0 = 0; x0 < w; x0 += step_x) {
-            const int bw = std::min(step_x, w - x0);
-            const double e = m_geometry.eccentricityDeg(gaze, x0 + 0.5 * bw, y0 + 0.5 * bh);
-            const int k =
-                std::clamp(static_cast<int>(e / m_header.ring_deg), 0, m_header.rings - 1);
-            rings[static_cast<size_t>(k)] += 2.0 * bw * bh;  // both eyes share the gaze
-        }
+    const glm::dvec3 g = m_geometry.gazeDirection(gaze);
+    constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
+    for (const PixelSample& s : m_pixel_samples) {
+        const double e = std::acos(std::clamp(glm::dot(g, s.direction), -1.0, 1.0)) * kDegPerRad;
+        const int k = std::clamp(static_cast<int>(e / m_header.ring_deg), 0, m_header.rings - 1);
+        rings[static_cast<size_t>(k)] += s.pixels;
     }
     return rings;
 }

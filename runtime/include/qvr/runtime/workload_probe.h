@@ -40,11 +40,19 @@ public:
     void observeBits(double middle_bytes, double middle_pixels, double s1, double outer_bytes,
                      double outer_pixels, double s2);
 
-private:
+    // Pixels of both eyes per ring of eccentricity around the gaze (a grid of ≤ 128² samples).
     std::vector<double> pixelsPerRing(const Gaze& gaze) const;
 
+private:
     HmdProfile m_profile;
     EyeGeometry m_geometry;
+    // The pixel-ring grid's view directions and the pixels each stands for, fixed by the
+    // profile: computed once, so a frame's pixel rings cost one dot product and one acos a sample.
+    struct PixelSample {
+        glm::dvec3 direction;
+        double pixels = 0.0;
+    };
+    std::vector<PixelSample> m_pixel_samples;
     std::shared_ptr<const TriangleBvh> m_bvh;
     std::shared_ptr<const DrawList> m_clusters;
     float m_lod_error_px = 0.0f;
