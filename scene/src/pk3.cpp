@@ -119,19 +119,25 @@ Expected<std::vector<uint8_t>> Pk3Archive::read(size_t i) const {
     if (f == nullptr)
         return makeError(
             fmt::format("{}: cannot open {}: {}", m_label, m_names[i], zip_strerror(z)));
-    std::vector<uint8_t> out(static_cast<size_t>(st.size));
+    // The size is what the archive claims: grow the buffer as bytes really arrive (doubling from
+    // 64 KB) rather than allocating the claim up front, so a few hundred bytes of hostile zip
+    // cannot make every read allocate and zero 256 MB before it turns out to be corrupt.
+    const auto want = static_cast<size_t>(st.size);
+    std::vector<uint8_t> out;
     size_t got = 0;
-    while (got < out.size()) {
+    while (got < want) {
+        out.resize(std::min(want, std::max<size_t>(got * 2, size_t{64} << 10)));
         const zip_int64_t r = zip_fread(f, out.data() + got, out.size() - got);
         if (r <= 0)
             break;
         got += static_cast<size_t>(r);
     }
-    std::string err = got == out.size() ? std::string() : zip_file_strerror(f);
+    out.resize(got);
+    std::string err = got == want ? std::string() : zip_file_strerror(f);
     zip_fclose(f);
-    if (got != out.size())
+    if (got != want)
         return makeError(fmt::format("{}: {} is corrupt ({} of {} bytes read: {})", m_label,
-                                     m_names[i], got, out.size(), err));
+                                     m_names[i], got, want, err));
     return out;
 }
 
