@@ -86,14 +86,36 @@ Expected<HmdProfile> hmdProfileByName(const std::string& name_or_path) {
     return loadHmdProfile(name_or_path);
 }
 
+namespace {
+
+// A TOML basic string's body: quote, backslash and control characters escaped (found by
+// toml_fuzz: a name holding a backslash was written raw and did not read back).
+std::string tomlEscaped(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+        const auto u = static_cast<unsigned char>(c);
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (u < 0x20 || u == 0x7f) {
+            out += fmt::format("\\u{:04X}", u);
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
 std::string hmdProfileToToml(const HmdProfile& p) {
     return fmt::format(
         "name = \"{}\"\n\n[display]\nwidth_px = {}\nheight_px = {}\nrefresh_hz = {}\n\n"
         "[fov]\nhorizontal_deg = {}\nvertical_deg = {}\n\n[lens]\nk1 = {}\nk2 = {}\n"
         "chroma_red_scale = {}\nchroma_blue_scale = {}\n\n[acuity]\nomega0_deg = {}\nslope = {}\n",
-        p.name, p.width_px, p.height_px, p.refresh_hz, p.fov_h_deg, p.fov_v_deg, p.lens.k1,
-        p.lens.k2, p.lens.chroma_red_scale, p.lens.chroma_blue_scale, p.acuity.omega0_deg,
-        p.acuity.slope);
+        tomlEscaped(p.name), p.width_px, p.height_px, p.refresh_hz, p.fov_h_deg, p.fov_v_deg,
+        p.lens.k1, p.lens.k2, p.lens.chroma_red_scale, p.lens.chroma_blue_scale,
+        p.acuity.omega0_deg, p.acuity.slope);
 }
 
 }  // namespace qvr

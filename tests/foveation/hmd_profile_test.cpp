@@ -91,6 +91,13 @@ TEST(ParseHmdProfile, RoundTripsWhenWrittenByHmdProfileToToml) {
     EXPECT_DOUBLE_EQ(q->lens.chroma_blue_scale, p->lens.chroma_blue_scale);
     EXPECT_DOUBLE_EQ(q->acuity.omega0_deg, p->acuity.omega0_deg);
     EXPECT_DOUBLE_EQ(q->acuity.slope, p->acuity.slope);
+    // A name with quotes, backslashes and control characters is escaped, not written raw (found
+    // by toml_fuzz).
+    HmdProfile odd = *p;
+    odd.name = "a\\b \"q\" \\e-6\ttab\nline\x7f";
+    auto back = parseHmdProfile(hmdProfileToToml(odd), "odd.toml");
+    ASSERT_TRUE(back.ok()) << back.error();
+    EXPECT_EQ(back->name, odd.name);
     // The low-res profile survives the same trip.
     auto low = parseHmdProfile(hmdProfileToToml(lowResHmdProfile()), "low.toml");
     ASSERT_TRUE(low.ok()) << low.error();
