@@ -5,8 +5,10 @@
 // workload recorded during the run.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -628,6 +630,17 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
     return h;
 }
 
+// Set by SIGINT/SIGTERM once the designs start: the current design ends at its next frame
+// boundary, no further design starts, the server child is stopped (SIGTERM, so it writes its
+// stats), and everything measured so far is written: summary.json, telemetry.csv, frames_*.csv,
+// trace.json and the report for the designs run. The exit status is then 130.
+std::atomic<bool> g_run_stop{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+void onRunSignal(int) {
+    g_run_stop.store(true);
+}
+
 int runRun(const RunOptions& o) {
     auto designs = parseDesignList(o.designs);
     if (!designs) {
@@ -787,7 +800,13 @@ int runRun(const RunOptions& o) {
     bool recorded_workload = false;
     std::ofstream all_csv(out / "telemetry.csv");
     all_csv << telemetryCsvHeader();
+    g_run_stop.store(false);
+    std::signal(SIGINT, onRunSignal);
+    std::signal(SIGTERM, onRunSignal);
+    std::string interrupted_note;
     for (const DesignSpec& spec : *designs) {
+        if (g_run_stop.load())
+            break;
         const RuntimeDesign d = spec.design;
         const std::string label = spec.label();
         HeadsetConfig hc;
@@ -804,6 +823,7 @@ int runRun(const RunOptions& o) {
         hc.warmup_frames = o.warmup_frames;
         hc.lod_error_px = o.lod_px;
         hc.cluster_ring_counts = o.ring_counts == "clusters";
+        hc.stop = &g_run_stop;
         GlRendererOptions gl;
         gl.lod_error_px = o.lod_px;
         hc.renderer = glRendererFactory(gl);
@@ -843,6 +863,15 @@ int runRun(const RunOptions& o) {
             std::fprintf(stderr, "qvr run: %s: %s\n", label.c_str(), result.error().c_str());
             return 1;
         }
+        const bool stopped = g_run_stop.load();
+        if (stopped) {
+            interrupted_note =
+                fmt::format("interrupted during {} after {} of {} frames; {} of {} designs run",
+                            label, result->frames.size(), o.frames,
+                            runs.size() + (result->frames.empty() ? 0 : 1), designs->size());
+            if (result->frames.empty())
+                break;  // nothing measured for this design
+        }
         const DesignSummary& s = result->summary;
         fmt::print(
             "  {:6} fps {:6.1f}  mtp {:6.1f} ms (p99 {:6.1f})  {:8.0f} B/frame  e1 {:5.1f} deg  "
@@ -857,6 +886,12 @@ int runRun(const RunOptions& o) {
             !st)
             std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
         runs.push_back({spec, std::move(*result)});
+        if (stopped) {
+            // No quality pass: the user asked to stop.
+            if (quality.empty() && quality_note.empty())
+                quality_note = "the run was interrupted before the quality pass";
+            break;
+        }
         // Image quality, between the measured runs: each sampled display against a
         // full-resolution render of the same frame (rendered now, on this thread).
         if (sampler && !sampler->samples().empty()) {
@@ -882,6 +917,14 @@ int runRun(const RunOptions& o) {
         // Let the server finish the last session before the next one starts.
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
+    // A second Ctrl-C while the report is written ends the process at once.
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    const bool interrupted = g_run_stop.load();
+    if (interrupted && interrupted_note.empty())
+        interrupted_note = fmt::format("interrupted between designs; {} of {} designs run",
+                                       runs.size(), designs->size());
+    all_csv.flush();
     const int server_status = server->stop();
     nlohmann::json server_stats = nlohmann::json::object();
     if (std::ifstream f(server_stats_path); f) {
@@ -947,10 +990,18 @@ int runRun(const RunOptions& o) {
         probe.setName("qvr-run-prediction", "qvr run: the run's poses and gazes, BVH rings");
         WorkloadTrace t;
         t.header = probe.header();
-        for (int i = 0; i < o.frames; ++i) {
-            const double content_ms = 1000.0 * i / profile->refresh_hz;
-            WorkloadFrame wf = probe.frame(i, content_ms, poseAt(traces.motion, content_ms),
-                                           gazeAt(traces.gaze, content_ms), 180.0);
+        // An interrupted run predicts the frames its designs got through, not the ones asked for.
+        size_t predict_frames = static_cast<size_t>(o.frames);
+        if (interrupted) {
+            predict_frames = 0;
+            for (const DesignRun& r : runs)
+                predict_frames = std::max(predict_frames, r.result.frames.size());
+        }
+        for (size_t i = 0; i < predict_frames; ++i) {
+            const double content_ms = 1000.0 * static_cast<double>(i) / profile->refresh_hz;
+            WorkloadFrame wf =
+                probe.frame(static_cast<int64_t>(i), content_ms, poseAt(traces.motion, content_ms),
+                            gazeAt(traces.gaze, content_ms), 180.0);
             for (size_t k = 0; k < wf.bits_per_pixel.size(); ++k)
                 wf.bits_per_pixel[k] = rcosts.bits_per_px_at_1 *
                                        std::pow(t.header.scales[k], rcosts.bits_scale_exponent);
@@ -1038,6 +1089,11 @@ int runRun(const RunOptions& o) {
                     {"refresh_hz", profile->refresh_hz}};
     j["net"] = o.net;
     j["frames_per_design"] = o.frames;
+    j["interrupted"] = interrupted;
+    if (interrupted)
+        j["interrupted_note"] = interrupted_note;
+    j["designs_requested"] = designs->size();
+    j["designs_run"] = runs.size();
     j["pinning"] = {{"client_core", client_core},
                     {"server_core", server_core},
                     {"cores", cores},
@@ -1400,6 +1456,11 @@ int runRun(const RunOptions& o) {
         "  {}\n  {}\n  wrote {}/summary.json, telemetry.csv, frames_*.csv, report.html in {:.0f} "
         "s\n",
         video_note, trace_note, o.out, run_s);
+    if (interrupted) {
+        std::fprintf(stderr, "qvr run: %s; wrote what was measured to %s\n",
+                     interrupted_note.c_str(), o.out.c_str());
+        return 130;
+    }
     return 0;
 }
 

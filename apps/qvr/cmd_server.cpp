@@ -160,9 +160,11 @@ int runServer(const ServerCmdOptions& o) {
                 o.duration_s)
             break;
     }
+    // Stop first (the frame in flight finishes, the render thread is joined), then read: the
+    // stats and the frames CSV then describe the same frames, however the server was ended.
+    (*server)->stop();
     const RenderServerStats s = (*server)->stats();
     const std::vector<ServerFrameRecord> frame_records = (*server)->frameRecords();
-    (*server)->stop();
     if (stamps && std::fflush(stamps.get()) != 0)
         std::fprintf(stderr, "qvr server: error writing '%s'\n", o.stamps_csv.c_str());
     if (!o.stats_json.empty()) {
