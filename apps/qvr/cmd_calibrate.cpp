@@ -168,7 +168,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 3;
+    constexpr int kCalibrationVersion = 4;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -274,8 +274,21 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         return makeError(st.error());
     Renderer& r = **renderer;
     const LayerPlanner planner(*profile);
+    // The triangles a layer draws (render/renderer.h layerTriangles): the draw list as the
+    // renderer builds it, at the same level of detail; the server's periphery layers with their
+    // holes (RenderServerConfig::holes), as `qvr run`'s server draws them.
+    auto draw_list = std::make_shared<DrawList>(buildDrawList(*inputs->scene));
+    if (o.lod_px > 0.0f)
+        buildLods(*draw_list, *inputs->scene);
+    const LayerHoles holes{.enabled = true};
+    auto drawnTriangles = [&](const LayerPlan& plan, const Pose& head, int eye, LayerKind kind) {
+        return double(layerTriangles(*draw_list, *profile, plan, head, static_cast<Eye>(eye), kind,
+                                     o.lod_px, CameraOptions{},
+                                     kind == LayerKind::kFovea ? LayerHoles{} : holes));
+    };
+    // LIWC's ring counts as the runtime makes them (HeadsetConfig::cluster_ring_counts).
     WorkloadProbe probe(*profile, inputs->bvh);
-    const double ring = probe.header().ring_deg;
+    probe.useClusters(draw_list, o.lod_px);
     CodecConfig codec;
     codec.backend = o.codec;
     const double eye_px = double(profile->width_px) * profile->height_px;
@@ -283,7 +296,6 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     struct PoseSample {
         Pose head;
         Gaze gaze;
-        WorkloadFrame wf;  // every ring counted
     };
     std::vector<PoseSample> poses;
     for (int k = 0; k < n_poses; ++k) {
@@ -291,7 +303,6 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         PoseSample p;
         p.head = poseAt(inputs->traces.motion, t_ms);
         p.gaze = gazeAt(inputs->traces.gaze, t_ms);
-        p.wf = probe.frame(k, t_ms, p.head, p.gaze, 180.0);
         poses.push_back(std::move(p));
     }
     auto log = [&](const std::string& line) {
@@ -301,20 +312,19 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         }
     };
 
-    // 1. The decision: BVH ring counts to e1 + 6° (and the pixel rings).
+    // 1. The decision: the draw clusters' ring counts (and the pixel rings), both eyes — one pass
+    // over the clusters whatever e1 is, so a constant.
     std::vector<Sample> decision;
     for (const PoseSample& p : poses)
-        for (double e1 : {1.0, 5.0, 10.0, 20.0, 35.0}) {
+        for (int rep = 0; rep < 5; ++rep) {
             const auto t0 = Clock::now();
-            const WorkloadFrame wf = probe.frame(0, 0.0, p.head, p.gaze, e1 + 6.0);
-            const double ms = msSince(t0);
-            decision.push_back(
-                {ms, 0.0, sumWithinDeg(p.wf.triangles_per_ring, ring, e1 + 6.0 + ring)});
+            const WorkloadFrame wf = probe.frame(0, 0.0, p.head, p.gaze);
+            decision.push_back({msSince(t0), 0.0, 0.0});
             (void)wf;
         }
-    cal.costs.decision = fit(decision, false, true);
+    cal.costs.decision = fit(decision, false, false);
     cal.parts.push_back(
-        summarise("decision", "ring counts to e1+6°, both eyes", decision, cal.costs.decision));
+        summarise("decision", "cluster ring counts, both eyes", decision, cal.costs.decision));
     log(fmt::format("  decision: {} samples\n", decision.size()));
 
     // 2. The plan and bookkeeping of a frame.
@@ -379,9 +389,6 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 p.gaze = gazeAt(inputs->traces.gaze, t_ms);
                 const bool sampled = step > 0;
                 const LayerPlan plan = planner.plan(p.gaze, e1);
-                const double fovea_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e1_deg);
-                const double mid_tris = sumWithinDeg(p.wf.triangles_per_ring, ring, plan.e2_deg);
-                const double all_tris = sumTotal(p.wf.triangles_per_ring);
                 auto frame = std::make_shared<LayerFrame>();
                 frame->plan = plan;
                 frame->render_pose = p.head;
@@ -397,9 +404,10 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                                               LayerKind::kFovea, imgs.fovea);
                         if (!st)
                             return makeError("fovea render: " + st.error());
+                        const double ms = msSince(t0);
                         if (step == 0)
-                            fovea.push_back(
-                                {msSince(t0), double(layers.fovea.pixels()), fovea_tris / 2});
+                            fovea.push_back({ms, double(layers.fovea.pixels()),
+                                             drawnTriangles(plan, p.head, eye, LayerKind::kFovea)});
                     }
                     for (int li = 0; li < 2; ++li) {
                         const bool middle = li == 0;
@@ -407,14 +415,15 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                         if (rect.empty())
                             continue;
                         ImageRgba8& img = middle ? imgs.middle : imgs.outer;
+                        const LayerKind kind = middle ? LayerKind::kMiddle : LayerKind::kOuter;
                         const auto t0 = Clock::now();
                         auto st = renderLayer(r, *profile, plan, p.head, static_cast<Eye>(eye),
-                                              middle ? LayerKind::kMiddle : LayerKind::kOuter, img);
+                                              kind, img, CameraOptions{}, holes);
                         if (!st)
                             return makeError("layer render: " + st.error());
+                        const double ms = msSince(t0);
                         server.push_back(
-                            {msSince(t0), double(rect.pixels()),
-                             serverLayerTriangles(middle ? mid_tris : all_tris, rect.scale)});
+                            {ms, double(rect.pixels()), drawnTriangles(plan, p.head, eye, kind)});
                         Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
                         if (!ch.enc) {
                             auto e = makeVideoEncoder(codec);
@@ -462,7 +471,6 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     for (size_t pi = 0; pi < (o.quick ? 1u : 2u); ++pi) {
         const PoseSample& p = poses[pi];
         const LayerPlan full = planner.plan(p.gaze, 180.0);
-        const double all_tris = sumTotal(p.wf.triangles_per_ring);
         auto frame = std::make_shared<LayerFrame>();
         frame->plan = full;
         frame->render_pose = p.head;
@@ -474,9 +482,10 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             if (!st)
                 return makeError("full render: " + st.error());
             const double ms = msSince(t0);
-            fovea.push_back({ms, eye_px, all_tris / 2});
+            const double tris = drawnTriangles(full, p.head, eye, LayerKind::kFovea);
+            fovea.push_back({ms, eye_px, tris});
             // The server's whole-frame layer is the same view at scale 1.
-            server.push_back({ms, eye_px, serverLayerTriangles(all_tris, 1.0)});
+            server.push_back({ms, eye_px, tris});
         }
         for (int rep_i = 0; rep_i < 2; ++rep_i) {
             const auto t0 = Clock::now();
@@ -512,8 +521,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     cal.parts.push_back(
         summarise("fovea/local", "one eye's fovea or full-frame pass", fovea, cal.costs.fovea));
     cal.parts.push_back(summarise("server render",
-                                  "one periphery or whole-frame layer (ktri: BVH/2/s²)", server,
-                                  cal.costs.server_render));
+                                  "one periphery or whole-frame layer (ktri drawn: LOD, holes)",
+                                  server, cal.costs.server_render));
     cal.parts.push_back(summarise("encode", "one layer, P-frame", encode, cal.costs.encode));
     cal.parts.push_back(summarise("decode", "one stream, P-frame", decode, cal.costs.decode));
     cal.parts.push_back(

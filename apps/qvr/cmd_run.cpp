@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <unistd.h>
@@ -37,6 +38,7 @@
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/render/camera.h"
+#include "qvr/render/renderer.h"
 #include "qvr/report/html_report.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/chrome_trace.h"
@@ -975,19 +977,45 @@ int runRun(const RunOptions& o) {
     nlohmann::json predicted_paper = nlohmann::json::object();  // design → paper model
     nlohmann::json sim_json = nlohmann::json::object();
     std::string sim_note;
-    // The workload the predictions replay: every frame's triangles and pixels per ring from the
-    // scene's BVH (all rings counted), computed here after the runs, off the clock, for the same
-    // poses and gazes; bits per pixel from the calibration's codec law. So every design set gets
-    // a prediction and nothing in it is measured on the run. Without a bits law in the
-    // calibration, the qvr run's recorded workload (its bits per pixel as the headset estimated
-    // them) is used.
+    // The workload the predictions replay: every frame's triangles and pixels per ring as the
+    // headset's LIWC counts them (the draw clusters at the fovea's level of detail, or the BVH
+    // with --ring-counts bvh; all rings), computed here after the runs, off the clock, for the
+    // same poses and gazes; bits per pixel from the calibration's codec law. The layers' render
+    // costs are charged on the triangles each layer draws (level of detail, holes) for the same
+    // poses and the plan the model chose, counted the same way off the clock
+    // (render/renderer.h layerTriangles). So every design set gets a prediction and nothing in
+    // it is measured on the run. Without a bits law in the calibration, the qvr run's recorded
+    // workload (its bits per pixel as the headset estimated them) is used.
     const RuntimeCosts& rcosts = calibration->hardware.runtime;
     Expected<WorkloadTrace> trace = makeError("no workload");
     std::string trace_source;
+    auto draw_list = std::make_shared<DrawList>(buildDrawList(*scene));
+    if (o.lod_px > 0.0f)
+        buildLods(*draw_list, *scene);
+    // Layer triangles by (frame, e1 in 1/1000°, eye, kind): LIWC revisits the same candidates.
+    std::map<std::tuple<int64_t, int64_t, int, int>, double> drawn_cache;
+    const LayerHoles server_holes{.enabled = !o.no_holes};
+    auto layer_triangles = [&](int64_t frame, const LayerPlan& plan, int eye, int kind) {
+        const auto key = std::make_tuple(
+            frame, static_cast<int64_t>(std::llround(plan.e1_deg * 1000.0)), eye, kind);
+        if (auto it = drawn_cache.find(key); it != drawn_cache.end())
+            return it->second;
+        const double content_ms = 1000.0 * double(frame) / profile->refresh_hz;
+        const LayerKind lk = kind == 0   ? LayerKind::kFovea
+                             : kind == 1 ? LayerKind::kMiddle
+                                         : LayerKind::kOuter;
+        const double tris = double(layerTriangles(
+            *draw_list, *profile, plan, poseAt(traces.motion, content_ms), static_cast<Eye>(eye),
+            lk, o.lod_px, CameraOptions{}, lk == LayerKind::kFovea ? LayerHoles{} : server_holes));
+        drawn_cache.emplace(key, tris);
+        return tris;
+    };
     if (rcosts.bits_per_px_at_1 > 0.0) {
         const auto t0 = std::chrono::steady_clock::now();
         WorkloadProbe probe(*profile, bvh);
-        probe.setName("qvr-run-prediction", "qvr run: the run's poses and gazes, BVH rings");
+        if (o.ring_counts == "clusters")
+            probe.useClusters(draw_list, o.lod_px);
+        probe.setName("qvr-run-prediction", "qvr run: the run's poses and gazes, LIWC's rings");
         WorkloadTrace t;
         t.header = probe.header();
         // An interrupted run predicts the frames its designs got through, not the ones asked for.
@@ -1009,8 +1037,10 @@ int runRun(const RunOptions& o) {
         }
         trace = std::move(t);
         trace_source = fmt::format(
-            "the run's poses and gazes, BVH ring counts computed after the run ({:.1f} s), bits "
-            "per pixel from the calibration",
+            "the run's poses and gazes, {} ring counts computed after the run ({:.1f} s), bits "
+            "per pixel from the calibration; layer triangles drawn (LOD, holes) counted off the "
+            "clock",
+            o.ring_counts,
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     } else if (recorded_workload) {
         trace = loadWorkloadTrace(workload_path.string());
@@ -1030,6 +1060,10 @@ int runRun(const RunOptions& o) {
         if (!rt_link_check)
             sim_note += (sim_note.empty() ? "" : "; ") +
                         ("no calibrated prediction: " + rt_link_check.error());
+        std::ofstream predicted_csv(out / "predicted_frames.csv");
+        predicted_csv << "design,frame,e1_deg,pose_ms,t_local_ms,t_remote_ms,headset_busy_ms,"
+                         "decision_ms,remote_done_ms,uca_end_ms,display_ms,mtp_ms,uca_ms,bytes,"
+                         "reused,served\n";
         if (trace && !trace->frames.empty()) {
             for (const DesignRun& r : runs) {
                 const std::string name = r.label();
@@ -1047,7 +1081,19 @@ int runRun(const RunOptions& o) {
                     rc.pipeline_depth = o.pipeline_depth;
                     rc.wait_limit_ms = o.remote_timeout_ms;
                     rc.frames = static_cast<int>(trace->frames.size());
-                    const RuntimeSummary ps = simulateRuntime(*trace, rc, **rt_link).summary;
+                    // The trace's frame k is the run's frame k (same poses).
+                    rc.layer_triangles = layer_triangles;
+                    const RuntimeRunResult pr = simulateRuntime(*trace, rc, **rt_link);
+                    const RuntimeSummary& ps = pr.summary;
+                    // The model's frames beside telemetry.csv's, to chase an error to its stage.
+                    for (const RuntimeFrame& f : pr.frames)
+                        predicted_csv << fmt::format(
+                            "{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},"
+                            "{:.3f},{:.3f},{:.0f},{:d},{:d}\n",
+                            name, f.index, f.e1_deg, f.pose_ms, f.t_local_ms, f.t_remote_ms,
+                            f.headset_busy_ms, f.decision_ms, f.remote_done_ms, f.uca_end_ms,
+                            f.display_ms, f.mtp_ms, f.uca_end_ms - f.uca_start_ms, f.bytes,
+                            int(f.reused), int(f.served));
                     predicted[name] = predictionJson(ps.fps_mean, ps.mtp_ms_mean, ps.mtp_ms_p99,
                                                      ps.bytes_per_frame_mean, ps.e1_deg_mean);
                     predicted[name]["headset_busy_ms_mean"] = ps.headset_busy_ms_mean;

@@ -39,6 +39,18 @@ Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
     return renderer.render(view, out);
 }
 
+uint64_t layerTriangles(const DrawList& list, const HmdProfile& profile, const LayerPlan& plan,
+                        const Pose& head, Eye eye, LayerKind kind, float lod_error_px,
+                        const CameraOptions& options, const LayerHoles& holes) {
+    const LayerRect& layer = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
+    if (layer.empty())
+        return 0;
+    RenderView view = layerView(profile, head, eye, layer, options);
+    setSkipCone(view, profile, head, eye, plan.gaze, layerHoleDeg(profile, plan, eye, kind, holes),
+                options);
+    return selectDraws(list, view, lod_error_px).triangles;
+}
+
 namespace {
 
 class NullRenderer final : public Renderer {

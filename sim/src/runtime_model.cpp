@@ -154,12 +154,26 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         local_only ? 1 : static_cast<size_t>(std::clamp(config.pipeline_depth, 1, 4));
     const size_t queue_cap = static_cast<size_t>(std::max(config.server_queue, 1));
 
-    std::unique_ptr<FoveaPolicy> policy;
-    if (liwc) {
+    // The runtime's policies (runtime/src/headset_client.cpp liwcConfig): qvr is LIWC with the
+    // frame-period objective, sw the same model fed reactively.
+    auto runtimeLiwc = [&](bool reactive) {
         LiwcConfig lc;
         lc.learn_remote_base = config.liwc_learn_remote_base;
-        policy = std::make_unique<LiwcPolicy>(header, lc);
-    } else if (traits.policy == "sw") {
+        lc.frame_period_objective = config.liwc_frame_period_objective;
+        lc.reactive = reactive;
+        return std::make_unique<LiwcPolicy>(header, lc);
+    };
+    const bool sw = traits.policy == "sw";
+    const bool sw_liwc = sw && config.sw_uses_liwc;
+    LiwcPolicy* link_aware = nullptr;  // the policy that reads the acks at decision time
+    std::unique_ptr<FoveaPolicy> policy;
+    if (liwc) {
+        auto p = runtimeLiwc(false);
+        link_aware = p.get();
+        policy = std::move(p);
+    } else if (sw_liwc) {
+        policy = runtimeLiwc(true);
+    } else if (sw) {
         policy = makeSoftwareReactivePolicy(header);
     } else if (traits.policy == "fixed") {
         policy = std::make_unique<FixedPolicy>(config.fixed_e1_deg);
@@ -206,6 +220,15 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         return px;
     };
 
+    // Triangles a layer draws (kind 0 fovea, 1 middle, 2 outer; eye 0/1): the caller's count of
+    // what the renderer submits when it has one, else the BVH rings of the trace.
+    auto drawn = [&](int64_t j, const LayerPlan& plan, int eye, int kind, double rings_both_eyes,
+                     double scale) {
+        if (config.layer_triangles)
+            return config.layer_triangles(j, plan, eye, kind);
+        return kind == 0 ? rings_both_eyes / 2.0 : serverLayerTriangles(rings_both_eyes, scale);
+    };
+
     // Renders, encodes and sends frame j's layers from `start`.
     auto serve = [&](int64_t j, double start) {
         FrameState& fs = state[static_cast<size_t>(j)];
@@ -217,8 +240,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         std::vector<LayerJob> jobs;
         if (whole_frame) {
             const double bytes = bitsPerPx(wf, 1.0) * eye_px / 8.0;
+            // The whole frame at scale 1 is the all-local plan's fovea view, no hole.
             for (int eye = 0; eye < 2; ++eye)
-                jobs.push_back({eye_px, serverLayerTriangles(total_tris, 1.0), bytes, true});
+                jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true});
         } else {
             const PeripheryBytes pb = {
                 2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1) / 8.0,
@@ -229,12 +253,12 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
                 const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
                 if (!e.middle.empty())
                     jobs.push_back({double(e.middle.pixels()),
-                                    serverLayerTriangles(mid_tris, e.middle.scale), pb.middle / 2.0,
-                                    true});
+                                    drawn(j, fs.plan, eye, 1, mid_tris, e.middle.scale),
+                                    pb.middle / 2.0, true});
                 if (!e.outer.empty())
                     jobs.push_back({double(e.outer.pixels()),
-                                    serverLayerTriangles(total_tris, e.outer.scale), pb.outer / 2.0,
-                                    false});
+                                    drawn(j, fs.plan, eye, 2, total_tris, e.outer.scale),
+                                    pb.outer / 2.0, false});
             }
         }
         for (const LayerJob& job : jobs) {
@@ -310,8 +334,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         if (!local_only)
             pump();
         const double decision_start = hs;
-        if (liwc) {
-            // The BVH ring counts reach e1 + 6° (one ring more than the candidates need).
+        if (liwc || sw_liwc) {
+            // The ring counts (the runtime probes for qvr and sw): the draw clusters' cost the
+            // same at every e1 (a calibration fits no triangle slope); the BVH's reach e1 + 6°.
             const double counted = sumWithinDeg(wf.triangles_per_ring, header.ring_deg,
                                                 last_e1_deg + 6.0 + header.ring_deg);
             work(c.decision.at(0.0, counted));
@@ -324,6 +349,8 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
             fs.expected = 2;
             rf.e1_deg = 0.0;
         } else {
+            if (link_aware)
+                link_aware->setLinkEstimate(ack_goodput_bps);
             const Decision d = policy->decide(wf);
             last_e1_deg = d.e1_deg;
             fs.plan = planner.plan(wf.gaze, d.e1_deg);
@@ -355,9 +382,12 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
             const double tris =
                 local_only ? sumTotal(wf.triangles_per_ring)
                            : sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e1_deg);
-            for (const EyeLayers& e : fs.plan.eyes)
+            for (int eye = 0; eye < 2; ++eye) {
+                const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
                 if (!e.fovea.empty())
-                    work(c.fovea.at(double(e.fovea.pixels()), tris / 2.0));
+                    work(
+                        c.fovea.at(double(e.fovea.pixels()), drawn(i, fs.plan, eye, 0, tris, 1.0)));
+            }
         }
         rf.local_end_ms = hs;
         rf.t_local_ms = rf.local_end_ms - rf.local_start_ms;
@@ -379,7 +409,10 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
                 decodeNext();
             }
             have_current = fs.decoded == fs.expected;
-            const double end = have_current ? rf.remote_done_ms : hs;
+            // To the last packet's arrival, as the runtime measures it (not to the decode, which
+            // waits behind the headset's own work); censored at the wait for a late frame.
+            const double end =
+                have_current ? (config.t_remote_to_decode ? rf.remote_done_ms : fs.last_rx_ms) : hs;
             rf.t_remote_ms = std::max(0.0, end - service_start);
         }
         // 6. UCA with the newest pose; a late frame re-warps older layers.
@@ -391,13 +424,15 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         work(c.uca.at(uca_px, 0.0) + c.frame_overhead_ms);
         rf.uca_end_ms = hs;
         rf.mtp_ms = rf.uca_end_ms - rf.pose_ms;
-        // 7. Scan-out at the next free vsync slot.
+        // 7. Scan-out at the next free vsync slot. The runtime queues the image for its slot (two
+        // images: the headset sleeps only while the previous frame still holds the other one,
+        // VsyncPacer::queueForScanout); with wait_for_vsync it blocks until the slot.
         double slot = std::ceil(rf.uca_end_ms / period_ms - 1e-9) * period_ms;
         if (slot <= last_scanout_ms)
             slot = last_scanout_ms + period_ms;
         last_scanout_ms = slot;
         rf.display_ms = slot;
-        hs = slot;
+        hs = config.wait_for_vsync ? slot : std::max(hs, slot - period_ms);
         rf.headset_busy_ms = i > 0 ? busy : 0.0;
         busy = 0.0;
         rf.served = fs.served;

@@ -2,7 +2,8 @@
 // depend on the frame, a design with one bottleneck stage runs at that stage's rate (rounded to
 // vsync slots where the headset waits for them), two frames in flight overlap the headset's and
 // the server's work exactly as far as the shorter stage allows, and a frame whose layers arrive
-// later than the wait limit is reused.
+// later than the wait limit is reused. The closed forms rounded to vsync slots block the headset
+// until its slot (RuntimeSimConfig::wait_for_vsync); the runtime's queued scan-out has its own.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -65,7 +66,7 @@ double slots(double ms) {
 }
 
 RuntimeRunResult run(Design d, const RuntimeCosts& costs, int depth, int frames = 60,
-                     double wait_limit_ms = 250.0) {
+                     double wait_limit_ms = 250.0, bool wait_for_vsync = true) {
     const WorkloadTrace trace = flatTrace(frames);
     RuntimeSimConfig cfg;
     cfg.design = d;
@@ -73,6 +74,7 @@ RuntimeRunResult run(Design d, const RuntimeCosts& costs, int depth, int frames 
     cfg.pipeline_depth = depth;
     cfg.frames = frames;
     cfg.wait_limit_ms = wait_limit_ms;
+    cfg.wait_for_vsync = wait_for_vsync;
     NoisyLink link = fastLink();
     return simulateRuntime(trace, cfg, link);
 }
@@ -207,6 +209,113 @@ TEST(RuntimeModel, ServerLayersCostTheirTrianglesOverTheirScaleSquared) {
     EXPECT_NEAR(r.summary.server_busy_ms_mean, expected, 1e-9);
     EXPECT_NEAR(serverLayerTriangles(1000.0, 2.0), 125.0, 1e-12);
     EXPECT_NEAR(serverLayerTriangles(1000.0, 0.5), 500.0, 1e-12);  // scales below 1 count as 1
+}
+
+TEST(RuntimeModel, QueuedScanOutLetsTheHeadsetRunAtItsOwnRate) {
+    // The runtime queues the composed image for its slot and goes on: a 65 ms local frame is
+    // shown every 65 ms on average (each at the slot after it, so the span of n intervals is
+    // 65·n within one slot), not every ⌈65 / slot⌉ slots as when it blocked.
+    const int n = 60;
+    const RuntimeRunResult r = run(Design::Local, flatCosts(30.0, 5.0, 0.0), 2, n, 250.0, false);
+    const double intervals = double(n - 1);
+    EXPECT_NEAR(1000.0 / r.summary.fps_mean, 65.0, kSlotMs / intervals);
+    EXPECT_NEAR(r.summary.mtp_ms_mean, 65.0, 1e-6);
+    for (size_t k = 1; k < r.frames.size(); ++k) {
+        EXPECT_NEAR(r.frames[k].pose_ms - r.frames[k - 1].pose_ms, 65.0, 1e-6);
+        EXPECT_NEAR(std::fmod(r.frames[k].display_ms + 1e-9, kSlotMs), 0.0, 1e-6);
+    }
+    // Faster than the display: one frame per slot, the headset sleeping only until the slot
+    // before its frame's (the other image is free then), so each frame still takes 5 ms.
+    const RuntimeRunResult fast = run(Design::Local, flatCosts(2.0, 1.0, 0.0), 2, n, 250.0, false);
+    EXPECT_NEAR(fast.summary.fps_mean, 90.0, 1e-6);
+    EXPECT_NEAR(fast.summary.mtp_ms_mean, 5.0, 1e-6);
+    for (size_t k = 2; k < fast.frames.size(); ++k)
+        EXPECT_NEAR(fast.frames[k].pose_ms, fast.frames[k - 1].display_ms, 1e-6);
+}
+
+TEST(RuntimeModel, TRemoteRunsToTheLastPacketNotTheDecode) {
+    // Remote, one frame in flight, two 100 ms layers, 3 ms per decode, an instant link: the last
+    // packet arrives 200 ms after the request; its decode ends 3 ms later (the first stream was
+    // decoded while the headset waited for the second).
+    RuntimeCosts c = flatCosts(0.0, 1.0, 100.0);
+    c.decode = {3.0, 0.0, 0.0};
+    const WorkloadTrace trace = flatTrace(20);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Remote;
+    cfg.costs = c;
+    cfg.pipeline_depth = 1;
+    cfg.frames = 20;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult rx = simulateRuntime(trace, cfg, link);
+    EXPECT_NEAR(rx.summary.t_remote_ms_mean, 200.0, 1e-6);
+    cfg.t_remote_to_decode = true;
+    NoisyLink link2 = fastLink();
+    const RuntimeRunResult dec = simulateRuntime(trace, cfg, link2);
+    EXPECT_NEAR(dec.summary.t_remote_ms_mean, 203.0, 1e-6);
+    // Both show the frame after the decode: MTP = 200 + 3 + UCA 1.
+    EXPECT_NEAR(rx.summary.mtp_ms_mean, 204.0, 1e-6);
+}
+
+TEST(RuntimeModel, LayersCostTheTrianglesTheCallerSaysTheyDraw) {
+    // With a layer_triangles count (what the renderer submits: level of detail, holes), fovea
+    // and server layers are charged on it, not on the trace's rings: per ktri costs only, a
+    // count of 1000·(kind + 1) + 500·eye triangles per layer gives closed forms.
+    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
+    c.fovea = {0.0, 0.0, 1.0};
+    c.server_render = {0.0, 0.0, 2.0};
+    const WorkloadTrace trace = flatTrace(10);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Ffr;
+    cfg.costs = c;
+    cfg.frames = 10;
+    int calls = 0;
+    cfg.layer_triangles = [&](int64_t frame, const LayerPlan& plan, int eye, int kind) {
+        ++calls;
+        EXPECT_GE(frame, 0);
+        EXPECT_LT(frame, 10);
+        EXPECT_NEAR(plan.e1_deg, 5.0, 1e-9);
+        return 1000.0 * (kind + 1) + 500.0 * eye;
+    };
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    EXPECT_GT(calls, 0);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[0].gaze, 5.0);
+    double fovea = 0.0, server = 0.0;
+    for (int eye = 0; eye < 2; ++eye) {
+        const EyeLayers& e = plan.eyes[static_cast<size_t>(eye)];
+        if (!e.fovea.empty())
+            fovea += 1.0 * (1.0 + 0.5 * eye);
+        if (!e.middle.empty())
+            server += 2.0 * (2.0 + 0.5 * eye);
+        if (!e.outer.empty())
+            server += 2.0 * (3.0 + 0.5 * eye);
+    }
+    EXPECT_GT(server, 0.0);
+    EXPECT_NEAR(r.frames[3].t_local_ms, fovea, 1e-9);
+    EXPECT_NEAR(r.summary.server_busy_ms_mean, server, 1e-9);
+    // Remote's whole frame is the all-local plan's full view (kind 0) per eye.
+    cfg.design = Design::Remote;
+    cfg.layer_triangles = [](int64_t, const LayerPlan&, int eye, int kind) {
+        EXPECT_EQ(kind, 0);
+        return 1000.0 + 1000.0 * eye;
+    };
+    NoisyLink link2 = fastLink();
+    const RuntimeRunResult rr = simulateRuntime(trace, cfg, link2);
+    EXPECT_NEAR(rr.summary.server_busy_ms_mean, 2.0 * (1.0 + 2.0), 1e-9);
+}
+
+TEST(RuntimeModel, SwAndQvrPayTheRingCountsEveryFrame) {
+    // The runtime counts the rings for qvr and sw (LIWC's model, fed reactively for sw), the
+    // draw clusters at a constant cost: with only that and a 1 ms UCA, both are charged it in
+    // every frame's headset time; ffr is not.
+    RuntimeCosts c = flatCosts(0.0, 1.0, 1.0);
+    c.decision = {4.0, 0.0, 0.0};
+    for (Design d : {Design::Qvr, Design::Sw, Design::Ffr}) {
+        const RuntimeRunResult r = run(d, c, 2, 30, 250.0, false);
+        for (size_t k = 1; k < r.frames.size(); ++k)
+            EXPECT_NEAR(r.frames[k].decision_ms, d == Design::Ffr ? 0.0 : 4.0, 1e-9)
+                << static_cast<int>(d);
+    }
 }
 
 TEST(RuntimeModel, DesignNames) {

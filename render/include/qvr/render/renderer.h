@@ -11,6 +11,7 @@
 #include "qvr/core/expected.h"
 #include "qvr/core/image.h"
 #include "qvr/render/camera.h"
+#include "qvr/render/draw_list.h"
 #include "qvr/scene/scene.h"
 
 namespace qvr {
@@ -69,6 +70,15 @@ Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
                                   const LayerPlan& plan, const Pose& head, Eye eye, LayerKind kind,
                                   ImageRgba8& out, const CameraOptions& options = {},
                                   const LayerHoles& holes = {});
+
+// The triangles renderLayer() submits for this layer through a renderer at lod_error_px (what
+// the OpenGL renderer's primitives-generated query counts), without a device: the draw list's
+// selection for the layer's view, level of detail and hole. `list` is buildDrawList() of the
+// uploaded scene, with buildLods() when lod_error_px > 0, as the renderer makes it. The
+// calibration fits render costs on it and the runtime model charges it (docs/MODEL.md §8).
+uint64_t layerTriangles(const DrawList& list, const HmdProfile& profile, const LayerPlan& plan,
+                        const Pose& head, Eye eye, LayerKind kind, float lod_error_px,
+                        const CameraOptions& options = {}, const LayerHoles& holes = {});
 
 // Renders nothing: fills the image with the clear colour and reports the triangles of the
 // clusters that survive frustum culling — the same count the OpenGL renderer submits.

@@ -8,10 +8,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "qvr/foveation/layer_plan.h"
 #include "qvr/sim/design.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/network.h"
@@ -31,6 +33,25 @@ struct RuntimeSimConfig {
     // LIWC learns the server's render + encode time (LiwcConfig::learn_remote_base), as in the
     // runtime.
     bool liwc_learn_remote_base = true;
+    // The runtime's LIWC minimises the frame period max(L, R) (LiwcConfig::frame_period_objective);
+    // false: Eq. 2's balance.
+    bool liwc_frame_period_objective = true;
+    // sw is the runtime's: LIWC's model fed reactively (LiwcConfig::reactive); false: the
+    // simulator's software-reactive policy (makeSoftwareReactivePolicy).
+    bool sw_uses_liwc = true;
+    // Scan-out: false queues the composed image for its slot and goes on (the runtime's two-image
+    // swapchain, VsyncPacer::queueForScanout); true blocks the headset until the slot.
+    bool wait_for_vsync = false;
+    // T_remote as the policies see it: to the last packet's arrival (the runtime's t_remote_ms),
+    // or, when set, to the last stream decoded (t_remote_decoded_ms).
+    bool t_remote_to_decode = false;
+    // The triangles one layer draws — kind 0 fovea (the whole frame for local and remote), 1
+    // middle, 2 outer; eye 0 left, 1 right — for frame `frame` of the trace under `plan`: what
+    // the renderer submits at its level of detail with the periphery's holes (render/renderer.h
+    // layerTriangles), computed by the caller off the clock from the frame's pose. Empty: the
+    // BVH rings of the trace (fovea: within e1 / 2; middle: within e2 / 2 / s1²; outer: all
+    // / 2 / s2²), which see neither level of detail nor holes.
+    std::function<double(int64_t frame, const LayerPlan& plan, int eye, int kind)> layer_triangles;
 };
 
 // One frame, ms from the run's start, as the runtime's telemetry records it.
