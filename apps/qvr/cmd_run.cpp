@@ -996,9 +996,9 @@ int runRun(const RunOptions& o) {
     std::map<std::tuple<int64_t, int64_t, int, int>, double> drawn_cache;
     const LayerHoles server_holes{.enabled = !o.no_holes};
     auto layer_triangles = [&](int64_t frame, const LayerPlan& plan, int eye, int kind) {
-        const auto key = std::make_tuple(
+        const auto cache_key = std::make_tuple(
             frame, static_cast<int64_t>(std::llround(plan.e1_deg * 1000.0)), eye, kind);
-        if (auto it = drawn_cache.find(key); it != drawn_cache.end())
+        if (auto it = drawn_cache.find(cache_key); it != drawn_cache.end())
             return it->second;
         const double content_ms = 1000.0 * double(frame) / profile->refresh_hz;
         const LayerKind lk = kind == 0   ? LayerKind::kFovea
@@ -1007,7 +1007,7 @@ int runRun(const RunOptions& o) {
         const double tris = double(layerTriangles(
             *draw_list, *profile, plan, poseAt(traces.motion, content_ms), static_cast<Eye>(eye),
             lk, o.lod_px, CameraOptions{}, lk == LayerKind::kFovea ? LayerHoles{} : server_holes));
-        drawn_cache.emplace(key, tris);
+        drawn_cache.emplace(cache_key, tris);
         return tris;
     };
     if (rcosts.bits_per_px_at_1 > 0.0) {
