@@ -189,7 +189,7 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
     double busy = 0.0;  // busy time since the previous frame finished
     double last_e1_deg = 5.0;
     double last_complete_rx_ms = 0.0;
-    double last_scanout_ms = -1.0;
+    int64_t last_slot = -1;  // the newest scan-out's vsync slot index
     double ack_goodput_bps = 0.0;
     // Server and link.
     struct Request {
@@ -427,10 +427,12 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         // 7. Scan-out at the next free vsync slot. The runtime queues the image for its slot (two
         // images: the headset sleeps only while the previous frame still holds the other one,
         // VsyncPacer::queueForScanout); with wait_for_vsync it blocks until the slot.
-        double slot = std::ceil(rf.uca_end_ms / period_ms - 1e-9) * period_ms;
-        if (slot <= last_scanout_ms)
-            slot = last_scanout_ms + period_ms;
-        last_scanout_ms = slot;
+        // Slots by index: a slot recomputed from a time is not bit-equal to the one stored.
+        int64_t slot_k = static_cast<int64_t>(std::ceil(rf.uca_end_ms / period_ms - 1e-9));
+        if (slot_k <= last_slot)
+            slot_k = last_slot + 1;
+        last_slot = slot_k;
+        const double slot = double(slot_k) * period_ms;
         rf.display_ms = slot;
         hs = config.wait_for_vsync ? slot : std::max(hs, slot - period_ms);
         rf.headset_busy_ms = i > 0 ? busy : 0.0;
