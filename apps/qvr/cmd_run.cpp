@@ -1081,6 +1081,7 @@ int runRun(const RunOptions& o) {
                     rc.pipeline_depth = o.pipeline_depth;
                     rc.wait_limit_ms = o.remote_timeout_ms;
                     rc.frames = static_cast<int>(trace->frames.size());
+                    rc.warmup_frames = o.warmup_frames;  // the same frames left out as measured
                     // The trace's frame k is the run's frame k (same poses).
                     rc.layer_triangles = layer_triangles;
                     const RuntimeRunResult pr = simulateRuntime(*trace, rc, **rt_link);

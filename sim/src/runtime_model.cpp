@@ -474,13 +474,18 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
     // Summary, as summarizeRun (runtime/telemetry.cpp) computes it.
     RuntimeSummary& s = result.summary;
     s.design = std::string(traits.name);
-    s.frames = n_frames;
-    if (n_frames == 0)
+    // Statistics over the frames after the warm-up, as summarizeRun skips them.
+    const int skip =
+        config.warmup_frames > 0 && n_frames > config.warmup_frames ? config.warmup_frames : 0;
+    const int counted = n_frames - skip;
+    s.frames = counted;
+    if (counted <= 0)
         return result;
-    const double n = double(n_frames);
+    const double n = double(counted);
     std::vector<double> mtp;
     int remote_frames = 0, busy_frames = 0;
-    for (const RuntimeFrame& f : result.frames) {
+    for (size_t k = static_cast<size_t>(skip); k < result.frames.size(); ++k) {
+        const RuntimeFrame& f = result.frames[k];
         mtp.push_back(f.mtp_ms);
         s.mtp_ms_mean += f.mtp_ms / n;
         s.bytes_per_frame_mean += f.bytes / n;
@@ -503,8 +508,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         s.headset_busy_ms_mean /= busy_frames;
     if (served_frames > 0)
         s.server_busy_ms_mean = server_busy_total / served_frames;
-    const double span = result.frames.back().display_ms - result.frames.front().display_ms;
-    if (n_frames > 1 && span > 0)
+    const double span =
+        result.frames.back().display_ms - result.frames[static_cast<size_t>(skip)].display_ms;
+    if (counted > 1 && span > 0)
         s.fps_mean = (n - 1.0) * 1000.0 / span;
     return result;
 }

@@ -30,6 +30,9 @@ struct RuntimeSimConfig {
     int server_queue = 2;          // the server's request queue; the newest request wins
     double wait_limit_ms = 250.0;  // remote layers later than this are late: the frame is reused
     int frames = 300;              // clamped to the trace's length
+    // The summary leaves out the first frames, as the runtime's (DesignSummary::warmup_frames,
+    // qvr run --warmup-frames): the frames are still simulated.
+    int warmup_frames = 0;
     // LIWC learns the server's render + encode time (LiwcConfig::learn_remote_base), as in the
     // runtime.
     bool liwc_learn_remote_base = true;
