@@ -98,6 +98,23 @@ void BM_MediaCopyPerDatagram(benchmark::State& state) {
 }
 BENCHMARK(BM_MediaCopyPerDatagram);
 
+// Sealed control (docs/PROTOCOL.md §Sealed control): the largest message, a 232-byte frame
+// request, sealed (encode + encrypt) and opened (decrypt + decode), against the plain
+// encode/decode of BM_FrameRequestEncodeDecode.
+void BM_ControlSealOpenFrameRequest(benchmark::State& state) {
+    ControlKey key{};
+    key.fill(9);
+    const FrameRequest request = sampleRequest(1);
+    uint64_t counter = 0, next = 0;
+    for (auto _ : state) {
+        const auto wire = sealControl(request, key, counter++);
+        ControlMessage back;
+        benchmark::DoNotOptimize(openControl(wire, key, next, back));
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ControlSealOpenFrameRequest);
+
 void BM_LinkEmulatorPerPacket(benchmark::State& state) {
     LinkConfig c = parseLinkSpec("wifi,delay_ms=5,jitter_ms=1,loss=0.01").value();
     LinkEmulator link(c);

@@ -1,6 +1,7 @@
 // libFuzzer target for the qvr wire protocol (docs/PROTOCOL.md): whole control messages, header
 // then payload as the transport reads them, media datagrams, and a stream of datagrams through
-// the reassembler, and the sealed media format (open, seal → open, the replay window). A decoded
+// the reassembler, the sealed media format (open, seal → open, the replay window), sealed control
+// messages (open hostile bytes; seal → open) and the return-routability probe. A decoded
 // message must re-encode to bytes that decode again.
 #include <algorithm>
 #include <cstddef>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "qvr/core/check.h"
+#include "qvr/net/auth.h"
 #include "qvr/net/protocol.h"
 #include "qvr/net/stream_assembler.h"
 
@@ -33,6 +35,39 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         ControlMessage m;
         (void)decodeControlPayload(
             header.type, payload.first(std::min<size_t>(payload.size(), header.payload_bytes)), m);
+    }
+
+    // Sealed control (docs/PROTOCOL.md §Sealed control): hostile bytes never open without the
+    // key's tag and the expected counter; a message that may travel sealed survives seal → open.
+    {
+        ControlKey key{};
+        key.fill(0x24);
+        uint64_t next = 0;
+        ControlMessage opened;
+        const WireError e = openControl(bytes, key, next, opened);
+        if (e == WireError::kNone) {
+            QVR_CHECK(next == 1 && sealable(static_cast<ControlType>(opened.index() + 1)));
+        }
+        if (e == WireError::kBadMac || e == WireError::kReplayed || e == WireError::kUnsealed) {
+            QVR_CHECK(next == 0);  // only an authentic message with the due counter counts
+        }
+        if (decodeControl(bytes, message) == WireError::kNone &&
+            sealable(static_cast<ControlType>(message.index() + 1))) {
+            const uint64_t counter = size;  // any counter
+            const auto sealed = sealControl(message, key, counter);
+            uint64_t expect = counter;
+            ControlMessage back;
+            QVR_CHECK(openControl(sealed, key, expect, back) == WireError::kNone);
+            QVR_CHECK(expect == counter + 1 && encodeControl(back) == encodeControl(message));
+            uint64_t again = counter;  // the same bytes a second time
+            QVR_CHECK(openControl(sealed, key, expect, back) == WireError::kReplayed);
+            auto flipped = sealed;
+            flipped[data[0] % flipped.size()] ^= static_cast<uint8_t>(1u << (size % 8));
+            const WireError fe = openControl(flipped, key, again, back);
+            QVR_CHECK(fe != WireError::kNone && again == counter);
+        }
+        RouteToken token{};
+        (void)openRouteProbe(bytes, key, 1, token);
     }
 
     MediaPacketView view;

@@ -153,6 +153,8 @@ int runClient(const ClientCmdOptions& o) {
                         {"media_forged", st.net.media_drops[net::WireError::kBadMac]},
                         {"media_replayed", st.net.media_drops[net::WireError::kReplayed]},
                         {"control_drops", st.net.control_drops.total()},
+                        {"control_forged", st.net.control_forged},
+                        {"control_replayed", st.net.control_replayed},
                         {"key_frame_requests", st.key_frame_requests},
                         {"nacks_sent", st.net.assembler.nacks},
                         {"packets_nacked", st.net.assembler.packets_nacked},
@@ -194,6 +196,12 @@ int runClient(const ClientCmdOptions& o) {
         st.connect_failures);
     if (st.connects == 0 && st.net.server_proof_failures > 0)
         std::fprintf(stderr, "qvr client: the server did not prove the pre-shared key\n");
+    if (st.net.control_forged + st.net.control_replayed > 0)
+        std::fprintf(stderr,
+                     "qvr client: %llu forged and %llu replayed control messages ended "
+                     "connections\n",
+                     static_cast<unsigned long long>(st.net.control_forged),
+                     static_cast<unsigned long long>(st.net.control_replayed));
     if (g_client_stop.load()) {
         std::fprintf(stderr, "qvr client: interrupted: kept %zu of %d frames in %s\n",
                      result->frames.size(), o.frames, o.out.c_str());

@@ -193,6 +193,9 @@ int runServer(const ServerCmdOptions& o) {
                                   {"protocol_errors", s.net.protocol_errors},
                                   {"version_mismatches", s.net.version_mismatches},
                                   {"settings_refusals", s.net.settings_refusals},
+                                  {"route_failures", s.net.route_failures},
+                                  {"control_forged", s.net.control_forged},
+                                  {"control_replayed", s.net.control_replayed},
                                   {"nacks", s.net.nacks},
                                   {"packets_retransmitted", s.net.packets_retransmitted},
                                   {"bytes_retransmitted", s.net.bytes_retransmitted},
@@ -240,11 +243,13 @@ int runServer(const ServerCmdOptions& o) {
         s.net.auth_failures, s.net.control_drops.total());
     fmt::print(
         "qvr server: {} connections, {} sessions; {} handshake timeouts, {} idle timeouts, {} "
-        "evicted, {} refused full, {} protocol errors, {} version / {} settings refusals; {} "
-        "NACKs, {} packets retransmitted\n",
+        "evicted, {} refused full, {} protocol errors, {} version / {} settings refusals, {} "
+        "media ports unverified; {} forged / {} replayed control messages; {} NACKs, {} packets "
+        "retransmitted\n",
         s.net.connections, s.net.clients_accepted, s.net.handshake_timeouts, s.net.idle_timeouts,
         s.net.pending_evicted, s.net.refused_full, s.net.protocol_errors, s.net.version_mismatches,
-        s.net.settings_refusals, s.net.nacks, s.net.packets_retransmitted);
+        s.net.settings_refusals, s.net.route_failures, s.net.control_forged, s.net.control_replayed,
+        s.net.nacks, s.net.packets_retransmitted);
     return 0;
 }
 

@@ -104,6 +104,27 @@ MediaKey mediaKey(const PresharedKey& key, const Nonce& client_nonce, const Nonc
     return hmac(key, "qvr2 media", transcript(client_nonce, server_nonce, session_id));
 }
 
+SessionKeys sessionKeys(const PresharedKey& key, const Nonce& client_nonce,
+                        const Nonce& server_nonce, uint64_t session_id) {
+    static_assert(sizeof(ControlKey) == kMacBytes);
+    const auto data = transcript(client_nonce, server_nonce, session_id);
+    return {hmac(key, "qvr4 control c2s", data), hmac(key, "qvr4 control s2c", data),
+            hmac(key, "qvr4 route", data)};
+}
+
+RouteToken randomRouteToken() {
+    ensureSodium();
+    RouteToken t{};
+    randombytes_buf(t.data(), t.size());
+    return t;
+}
+
+bool tokenEqual(const RouteToken& a, const RouteToken& b) {
+    ensureSodium();
+    static_assert(sizeof(RouteToken) == 16);
+    return crypto_verify_16(a.data(), b.data()) == 0;
+}
+
 Mac serverProof(const PresharedKey& key, const Nonce& client_nonce, const Nonce& server_nonce,
                 uint64_t session_id) {
     return hmac(key, "qvr1 server", transcript(client_nonce, server_nonce, session_id));

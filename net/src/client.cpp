@@ -7,6 +7,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -61,6 +62,9 @@ const char* byeText(ByeReason r) {
             return "refused our codec (codec mismatch)";
         case ByeReason::kProfileMismatch:
             return "refused our display profile (profile mismatch)";
+        case ByeReason::kRouteUnverified:
+            return "could not verify that we receive media at our UDP port (no probe arrived or "
+                   "none was answered: a firewall or NAT in the way?)";
     }
     return "said bye";
 }
@@ -83,6 +87,7 @@ struct Connection {
     udp::socket media{io};
     detail::ControlReader reader;
     detail::ControlWriter writer;
+    detail::ControlSealer sealer;  // on from the end of the handshake
     asio::steady_timer expire_timer;
     StreamAssembler assembler;
     uint64_t session_id = 0;
@@ -128,10 +133,12 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
         bool done = false;
         Status result;
     } st;
-    const auto finish = [&st](Status s) {
+    const auto finish = [&st, &c](Status s) {
         if (!st.done) {
             st.done = true;
             st.result = std::move(s);
+            // Return at once, even with the probe's receive still pending (a refusal).
+            c.io.stop();
         }
     };
     const std::string where = host + ":" + std::to_string(port);
@@ -163,6 +170,30 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
         }
         return makeError(text);
     };
+
+    // The return-routability probe: the first datagram that opens with the route key and names
+    // our session is answered with its token over sealed control; anything else is counted.
+    ControlKey route_key{};
+    bool route_echoed = false;
+    std::function<void(const asio::error_code&, size_t)> probe_handler =
+        [&](const asio::error_code& rec, size_t n) {
+            if (rec || st.done) {
+                return;
+            }
+            RouteToken token{};
+            const WireError e = openRouteProbe(std::span<const uint8_t>(c.datagram.data(), n),
+                                               route_key, challenge.session_id, token);
+            if (e != WireError::kNone) {
+                {
+                    std::lock_guard lock(mutex);
+                    stats.media_drops.count(e);
+                }
+                c.media.async_receive(asio::buffer(c.datagram), probe_handler);
+                return;
+            }
+            route_echoed = true;
+            c.writer.push(c.control, c.sealer.encode(RouteConfirm{token}));
+        };
 
     asio::async_connect(
         c.control, endpoints, [&](const asio::error_code& cec, const tcp::endpoint&) {
@@ -234,6 +265,15 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                 c.writer.push(c.control, encodeControl(ClientAuth{clientProof(
                                              options.key, client_nonce, challenge.server_nonce,
                                              challenge.session_id, media_port)}));
+                // Everything after ClientAuth is sealed, both ways (docs/PROTOCOL.md §Sealed
+                // control); only a Bye refusing the handshake may still come plain.
+                const SessionKeys keys = sessionKeys(options.key, client_nonce,
+                                                     challenge.server_nonce, challenge.session_id);
+                c.reader.seal(keys.server_to_client);
+                c.sealer.start(keys.client_to_server);
+                route_key = keys.route;
+                // The server probes our media port; echoing the token proves we receive there.
+                c.media.async_receive(asio::buffer(c.datagram), probe_handler);
                 c.reader.read(c.control, [&](detail::ReadResult w) {
                     if (w.ec) {
                         finish(makeError("connect " + where +
@@ -241,13 +281,24 @@ Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t 
                                          ")"));
                         return;
                     }
-                    if (const auto* bye = std::get_if<Bye>(&w.message)) {
+                    if (const auto* bye = std::get_if<Bye>(&w.message);
+                        bye && w.error == WireError::kNone) {
                         finish(byeError(bye->reason));
                         return;
                     }
                     const auto* welcome = std::get_if<Welcome>(&w.message);
-                    if (w.error != WireError::kNone || !welcome ||
-                        welcome->session_id != challenge.session_id) {
+                    if (w.error != WireError::kNone || !w.sealed || !welcome ||
+                        welcome->session_id != challenge.session_id || !route_echoed) {
+                        {
+                            std::lock_guard lock(mutex);
+                            stats.control_drops.count(w.error);
+                            stats.control_forged +=
+                                w.error == WireError::kBadMac ||
+                                        (w.error == WireError::kNone && !w.sealed)
+                                    ? 1
+                                    : 0;
+                            stats.control_replayed += w.error == WireError::kReplayed ? 1 : 0;
+                        }
                         finish(
                             makeError("connect " + where + ": no valid welcome from the server"));
                         return;
@@ -322,7 +373,7 @@ void Client::Impl::sendControl(Connection& c, const ControlMessage& m) {
     if (c.closed) {
         return;
     }
-    const bool queued = c.writer.push(c.control, encodeControl(m));
+    const bool queued = c.writer.push(c.control, c.sealer.encode(m));
     if (!queued) {
         fail(c, makeError("the server stopped reading control messages"));
     }
@@ -337,10 +388,19 @@ void Client::Impl::readControl(Connection& c) {
             fail(c, makeError("connection to the server lost: " + r.ec.message()));
             return;
         }
+        if (r.error == WireError::kNone && !r.sealed) {
+            r.error = WireError::kUnsealed;  // after the handshake only sealed messages count
+            r.stream_broken = true;
+        }
         if (r.error != WireError::kNone) {
             {
                 std::lock_guard lock(mutex);
                 stats.control_drops.count(r.error);
+                if (r.error == WireError::kBadMac || r.error == WireError::kUnsealed) {
+                    ++stats.control_forged;
+                } else if (r.error == WireError::kReplayed) {
+                    ++stats.control_replayed;
+                }
             }
             if (r.stream_broken) {
                 fail(c, makeError(std::string("protocol error from the server: ") +
@@ -371,6 +431,10 @@ void Client::Impl::readMedia(Connection& c) {
             // Forged or altered datagrams stop at the tag, before any field is believed;
             // authentic ones are then checked like any packet, and each is taken only once.
             const std::span<uint8_t> sealed(c.datagram.data(), n);
+            if (isRouteProbe(sealed)) {
+                readMedia(c);  // a repeat of the probe we already answered
+                return;
+            }
             MediaPacketView view;
             WireError e = openMediaPacket(sealed, c.media_key);
             if (e == WireError::kNone) {
@@ -522,9 +586,10 @@ void Client::disconnect() {
     }
     Connection* c = impl.conn.get();
     asio::post(c->io, [&impl, c] {
-        if (!c->closed) {
-            // Say goodbye if the socket takes it at once; the server also copes without.
-            const auto bye = encodeControl(Bye{ByeReason::kNormal});
+        if (!c->closed && c->writer.idle()) {
+            // Say goodbye if the socket takes it at once; the server also copes without. Not
+            // while a queued write is in flight: the bytes would interleave.
+            const auto bye = c->sealer.encode(Bye{ByeReason::kNormal});
             asio::error_code ec;
             c->control.non_blocking(true, ec);
             asio::write(c->control, asio::buffer(bye), ec);

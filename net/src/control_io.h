@@ -31,54 +31,101 @@ inline void enableKeepAlive(asio::ip::tcp::socket& socket) {
 struct ReadResult {
     asio::error_code ec;  // the socket failed or closed
     WireError error = WireError::kNone;
-    bool stream_broken = false;  // a bad header: the byte stream cannot be re-synchronised
+    // A bad header, or (once sealed) a message that fails its tag or counter: the byte stream
+    // cannot be re-synchronised, or can no longer be trusted.
+    bool stream_broken = false;
+    bool sealed = false;  // the message came sealed (and opened with the expected counter)
     ControlMessage message;
+};
+
+// Sealing of outgoing control messages once the session keys exist (docs/PROTOCOL.md §Sealed
+// control): plain before, sealed with the next counter after.
+struct ControlSealer {
+    bool on = false;
+    ControlKey key{};
+    uint64_t next = 0;
+    void start(const ControlKey& k) {
+        on = true;
+        key = k;
+        next = 0;
+    }
+    std::vector<uint8_t> encode(const ControlMessage& m) {
+        return on ? sealControl(m, key, next++) : encodeControl(m);
+    }
 };
 
 class ControlReader {
 public:
+    // From now on sealed messages are opened with this key, counting from 0. Plain ones are still
+    // decoded (ReadResult::sealed says which): the owner decides whether it accepts them.
+    void seal(const ControlKey& key) {
+        m_sealed = true;
+        m_key = key;
+        m_next = 0;
+    }
+
     // handler(ReadResult). The reader and socket must outlive the operation.
     template <typename Handler>
     void read(asio::ip::tcp::socket& socket, Handler handler) {
-        asio::async_read(socket, asio::buffer(m_header),
-                         [this, &socket, handler = std::move(handler)](const asio::error_code& ec,
-                                                                       size_t) mutable {
-                             if (ec) {
-                                 handler(ReadResult{ec, WireError::kNone, true, {}});
-                                 return;
-                             }
-                             ControlHeader header;
-                             const WireError e = decodeControlHeader(m_header, header);
-                             if (e != WireError::kNone) {
-                                 handler(ReadResult{{}, e, true, {}});
-                                 return;
-                             }
-                             readPayload(socket, header, std::move(handler));
-                         });
+        asio::async_read(
+            socket, asio::buffer(m_buffer.data(), kControlHeaderBytes),
+            [this, &socket, handler = std::move(handler)](const asio::error_code& ec,
+                                                          size_t) mutable {
+                if (ec) {
+                    handler(ReadResult{ec, WireError::kNone, true, false, {}});
+                    return;
+                }
+                ControlHeader header;
+                WireError e = decodeControlHeader(
+                    std::span<const uint8_t>(m_buffer.data(), kControlHeaderBytes), header);
+                if (e == WireError::kNone && header.type == ControlType::kSealed && !m_sealed) {
+                    e = WireError::kUnknownType;  // nothing to open it with yet
+                }
+                if (e != WireError::kNone) {
+                    handler(ReadResult{{}, e, true, false, {}});
+                    return;
+                }
+                readPayload(socket, header, std::move(handler));
+            });
     }
 
 private:
     template <typename Handler>
     void readPayload(asio::ip::tcp::socket& socket, ControlHeader header, Handler handler) {
         // decodeControlHeader bounded payload_bytes by kMaxControlPayloadBytes.
-        asio::async_read(socket, asio::buffer(m_payload.data(), header.payload_bytes),
-                         [this, header, handler = std::move(handler)](const asio::error_code& ec,
-                                                                      size_t) mutable {
-                             if (ec) {
-                                 handler(ReadResult{ec, WireError::kNone, true, {}});
-                                 return;
-                             }
-                             ReadResult r;
-                             r.error = decodeControlPayload(
-                                 header.type,
-                                 std::span<const uint8_t>(m_payload.data(), header.payload_bytes),
-                                 r.message);
-                             handler(std::move(r));
-                         });
+        asio::async_read(
+            socket, asio::buffer(m_buffer.data() + kControlHeaderBytes, header.payload_bytes),
+            [this, header, handler = std::move(handler)](const asio::error_code& ec,
+                                                         size_t) mutable {
+                if (ec) {
+                    handler(ReadResult{ec, WireError::kNone, true, false, {}});
+                    return;
+                }
+                ReadResult r;
+                if (header.type == ControlType::kSealed) {
+                    r.error = openControl(
+                        std::span<const uint8_t>(m_buffer.data(),
+                                                 kControlHeaderBytes + header.payload_bytes),
+                        m_key, m_next, r.message);
+                    // A forged or out-of-order message ends the trust in the stream.
+                    r.stream_broken =
+                        r.error == WireError::kBadMac || r.error == WireError::kReplayed;
+                    r.sealed = !r.stream_broken;
+                } else {
+                    r.error = decodeControlPayload(
+                        header.type,
+                        std::span<const uint8_t>(m_buffer.data() + kControlHeaderBytes,
+                                                 header.payload_bytes),
+                        r.message);
+                }
+                handler(std::move(r));
+            });
     }
 
-    std::array<uint8_t, kControlHeaderBytes> m_header{};
-    std::array<uint8_t, kMaxControlPayloadBytes> m_payload{};
+    std::array<uint8_t, kControlHeaderBytes + kMaxControlPayloadBytes> m_buffer{};
+    bool m_sealed = false;
+    ControlKey m_key{};
+    uint64_t m_next = 0;
 };
 
 // A bounded queue of outgoing messages with one write in flight at a time. One error handler
@@ -105,6 +152,8 @@ public:
         m_queue.clear();
         m_busy = false;
     }
+    // Nothing queued or being written: a direct write cannot interleave with a queued one.
+    bool idle() const { return !m_busy && m_queue.empty(); }
 
 private:
     void writeNext(asio::ip::tcp::socket& socket) {

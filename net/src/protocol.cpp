@@ -54,6 +54,10 @@ size_t payloadBytesOf(ControlType type) {
             return 1;
         case ControlType::kNack:
             return 1 + 4 + 8;
+        case ControlType::kRouteConfirm:
+            return kRouteTokenBytes;
+        case ControlType::kSealed:
+            return 0;  // variable: checked by decodeControlHeader and openControl
     }
     return 0;
 }
@@ -154,6 +158,7 @@ struct Encoder {
         w.u32(m.first_seq);
         w.u64(m.missing_mask);
     }
+    void operator()(const RouteConfirm& m) { w.bytes(m.token); }
 };
 
 ControlType typeOf(const ControlMessage& m) {
@@ -278,6 +283,8 @@ std::string_view byeReasonName(ByeReason r) {
             return "codec mismatch";
         case ByeReason::kProfileMismatch:
             return "display profile mismatch";
+        case ByeReason::kRouteUnverified:
+            return "media port not verified";
     }
     return "?";
 }
@@ -306,6 +313,8 @@ std::string_view wireErrorName(WireError e) {
             return "wrong session";
         case WireError::kReplayed:
             return "replayed";
+        case WireError::kUnsealed:
+            return "unsealed";
     }
     return "?";
 }
@@ -393,6 +402,18 @@ WireError decodeControlHeader(std::span<const uint8_t> bytes, ControlHeader& out
     }
     if (version != kProtocolVersion) {
         return WireError::kWrongVersion;
+    }
+    if (static_cast<ControlType>(type) == ControlType::kSealed) {
+        // Variable: the counter, at least a one-byte inner message, the tag.
+        if (length > kMaxControlPayloadBytes) {
+            return WireError::kOversized;
+        }
+        if (length < kSealedControlOverhead + 1) {
+            return WireError::kTruncated;
+        }
+        out.type = ControlType::kSealed;
+        out.payload_bytes = length;
+        return WireError::kNone;
     }
     const size_t expected = payloadBytesOf(static_cast<ControlType>(type));
     if (expected == 0) {
@@ -540,6 +561,14 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
             out = m;
             break;
         }
+        case ControlType::kRouteConfirm: {
+            RouteConfirm m;
+            r.bytes(m.token);
+            out = m;
+            break;
+        }
+        case ControlType::kSealed:
+            return WireError::kUnknownType;  // unreachable: payloadBytesOf is 0
     }
     return r.ok() ? WireError::kNone : WireError::kTruncated;
 }
@@ -769,6 +798,169 @@ WireError openMediaPacket(std::span<uint8_t> sealed, const MediaKey& key) {
             nonce.data(), key.data()) != 0) {
         return WireError::kBadMac;
     }
+    return WireError::kNone;
+}
+
+namespace {
+
+constexpr uint8_t kRouteMagic0 = 'Q';
+constexpr uint8_t kRouteMagic1 = 'R';
+using AeadNonce = std::array<uint8_t, crypto_aead_chacha20poly1305_IETF_NPUBBYTES>;
+
+AeadNonce counterNonce(uint64_t counter) {
+    AeadNonce nonce{};
+    for (size_t i = 0; i < 8; ++i) {
+        nonce[i] = static_cast<uint8_t>(counter >> (8 * i));
+    }
+    return nonce;
+}
+
+}  // namespace
+
+bool sealable(ControlType type) {
+    switch (type) {
+        case ControlType::kWelcome:
+        case ControlType::kFrameRequest:
+        case ControlType::kMediaAck:
+        case ControlType::kKeyFrameRequest:
+        case ControlType::kThroughputReport:
+        case ControlType::kBye:
+        case ControlType::kNack:
+        case ControlType::kRouteConfirm:
+            return true;
+        case ControlType::kClientHello:
+        case ControlType::kServerChallenge:
+        case ControlType::kClientAuth:
+        case ControlType::kSealed:
+            return false;
+    }
+    return false;
+}
+
+std::vector<uint8_t> sealControl(const ControlMessage& m, const ControlKey& key, uint64_t counter) {
+    const ControlType type = typeOf(m);
+    QVR_CHECK(sealable(type));
+    const std::vector<uint8_t> plain = encodeControl(m);
+    const size_t inner = 1 + plain.size() - kControlHeaderBytes;
+    const size_t payload = 8 + inner + kControlTagBytes;
+    std::vector<uint8_t> out;
+    out.reserve(kControlHeaderBytes + payload);
+    ByteWriter w(out);
+    w.u8(kControlMagic0);
+    w.u8(kControlMagic1);
+    w.u8(kProtocolVersion);
+    w.u8(static_cast<uint8_t>(ControlType::kSealed));
+    w.u32(static_cast<uint32_t>(payload));
+    w.u64(counter);
+    w.u8(static_cast<uint8_t>(type));
+    w.bytes(std::span<const uint8_t>(plain).subspan(kControlHeaderBytes));
+    out.resize(kControlHeaderBytes + payload);
+    constexpr size_t kAd = kControlHeaderBytes + 8;  // header and counter in clear
+    const AeadNonce nonce = counterNonce(counter);
+    unsigned long long tag_len = 0;
+    crypto_aead_chacha20poly1305_ietf_encrypt_detached(
+        out.data() + kAd, out.data() + kAd + inner, &tag_len, out.data() + kAd, inner, out.data(),
+        kAd, nullptr, nonce.data(), key.data());
+    return out;
+}
+
+WireError openControl(std::span<const uint8_t> bytes, const ControlKey& key, uint64_t& next_counter,
+                      ControlMessage& out) {
+    ControlHeader header;
+    const WireError e = decodeControlHeader(bytes, header);
+    if (e != WireError::kNone) {
+        return e;
+    }
+    if (header.type != ControlType::kSealed) {
+        return WireError::kUnsealed;
+    }
+    const size_t total = kControlHeaderBytes + header.payload_bytes;
+    if (bytes.size() < total) {
+        return WireError::kTruncated;
+    }
+    if (bytes.size() > total) {
+        return WireError::kTrailingBytes;
+    }
+    constexpr size_t kAd = kControlHeaderBytes + 8;
+    uint64_t counter = 0;
+    for (size_t i = 0; i < 8; ++i) {
+        counter |= static_cast<uint64_t>(bytes[kControlHeaderBytes + i]) << (8 * i);
+    }
+    // decodeControlHeader bounded the payload: inner < kMaxControlPayloadBytes.
+    const size_t inner = header.payload_bytes - 8 - kControlTagBytes;
+    std::array<uint8_t, kMaxControlPayloadBytes> plain{};
+    const AeadNonce nonce = counterNonce(counter);
+    if (crypto_aead_chacha20poly1305_ietf_decrypt_detached(
+            plain.data(), nullptr, bytes.data() + kAd, inner, bytes.data() + kAd + inner,
+            bytes.data(), kAd, nonce.data(), key.data()) != 0) {
+        return WireError::kBadMac;
+    }
+    if (counter != next_counter) {
+        return WireError::kReplayed;
+    }
+    ++next_counter;
+    const auto type = static_cast<ControlType>(plain[0]);
+    if (!sealable(type)) {
+        return WireError::kUnknownType;
+    }
+    return decodeControlPayload(type, std::span<const uint8_t>(plain.data() + 1, inner - 1), out);
+}
+
+std::vector<uint8_t> sealRouteProbe(uint64_t session_id, uint8_t attempt, const RouteToken& token,
+                                    const ControlKey& key) {
+    std::vector<uint8_t> out;
+    out.reserve(kRouteProbeBytes);
+    ByteWriter w(out);
+    w.u8(kRouteMagic0);
+    w.u8(kRouteMagic1);
+    w.u8(kProtocolVersion);
+    w.u8(attempt);
+    w.u64(session_id);
+    w.bytes(token);
+    out.resize(kRouteProbeBytes);
+    const AeadNonce nonce = counterNonce(attempt);
+    unsigned long long tag_len = 0;
+    crypto_aead_chacha20poly1305_ietf_encrypt_detached(
+        out.data() + kRouteProbeHeaderBytes, out.data() + kRouteProbeHeaderBytes + kRouteTokenBytes,
+        &tag_len, out.data() + kRouteProbeHeaderBytes, kRouteTokenBytes, out.data(),
+        kRouteProbeHeaderBytes, nullptr, nonce.data(), key.data());
+    return out;
+}
+
+bool isRouteProbe(std::span<const uint8_t> datagram) {
+    return datagram.size() >= 2 && datagram[0] == kRouteMagic0 && datagram[1] == kRouteMagic1;
+}
+
+WireError openRouteProbe(std::span<const uint8_t> datagram, const ControlKey& key,
+                         uint64_t session_id, RouteToken& token) {
+    if (datagram.size() < kRouteProbeBytes) {
+        return WireError::kTruncated;
+    }
+    if (datagram.size() > kRouteProbeBytes) {
+        return WireError::kTrailingBytes;
+    }
+    if (!isRouteProbe(datagram)) {
+        return WireError::kBadMagic;
+    }
+    if (datagram[2] != kProtocolVersion) {
+        return WireError::kWrongVersion;
+    }
+    const AeadNonce nonce = counterNonce(datagram[3]);
+    RouteToken plain{};
+    if (crypto_aead_chacha20poly1305_ietf_decrypt_detached(
+            plain.data(), nullptr, datagram.data() + kRouteProbeHeaderBytes, kRouteTokenBytes,
+            datagram.data() + kRouteProbeHeaderBytes + kRouteTokenBytes, datagram.data(),
+            kRouteProbeHeaderBytes, nonce.data(), key.data()) != 0) {
+        return WireError::kBadMac;
+    }
+    uint64_t sid = 0;
+    for (size_t i = 0; i < 8; ++i) {
+        sid |= static_cast<uint64_t>(datagram[4 + i]) << (8 * i);
+    }
+    if (sid != session_id) {
+        return WireError::kWrongSession;
+    }
+    token = plain;
     return WireError::kNone;
 }
 

@@ -49,12 +49,13 @@ struct Server::Impl {
     std::map<ClientId, std::shared_ptr<Session>> clients;
     std::vector<std::shared_ptr<Session>> sessions;  // every open connection
     int pending = 0;
+    int routing = 0;  // authenticated sessions whose media port is being checked (a slot each)
     ServerStats stats;
     int64_t last_unauth_report_ns = INT64_MIN / 2;
 };
 
 struct Session : std::enable_shared_from_this<Session> {
-    enum class State { kAwaitHello, kAwaitAuth, kAuthed, kClosed };
+    enum class State { kAwaitHello, kAwaitAuth, kAwaitRoute, kAuthed, kClosed };
 
     Session(Server::Impl& s, tcp::socket sock)
         : server(s),
@@ -75,7 +76,7 @@ struct Session : std::enable_shared_from_this<Session> {
         handshake_timer.expires_after(
             std::chrono::milliseconds(server.options.handshake_timeout_ms));
         handshake_timer.async_wait([self = shared_from_this()](const asio::error_code& ec) {
-            if (!ec && self->state != State::kAuthed && self->state != State::kClosed) {
+            if (!ec && (self->state == State::kAwaitHello || self->state == State::kAwaitAuth)) {
                 self->count([](ServerStats& st) { ++st.handshake_timeouts; });
                 self->refuse(ByeReason::kTimeout);
             }
@@ -115,8 +116,21 @@ struct Session : std::enable_shared_from_this<Session> {
             refuse(ByeReason::kVersionMismatch);
             return;
         }
+        const bool keyed = state == State::kAwaitRoute || state == State::kAuthed;
+        if (keyed && r.error == WireError::kNone && !r.sealed) {
+            r.error = WireError::kUnsealed;  // someone else's bytes in the stream
+            r.stream_broken = true;
+        }
         if (r.error != WireError::kNone) {
-            count([&](ServerStats& st) { st.control_drops.count(r.error); });
+            count([&](ServerStats& st) {
+                st.control_drops.count(r.error);
+                if (keyed && (r.error == WireError::kBadMac || r.error == WireError::kUnsealed)) {
+                    ++st.control_forged;
+                } else if (keyed && r.error == WireError::kReplayed) {
+                    ++st.control_replayed;
+                }
+            });
+            // A stream that carried a forged or replayed message cannot be trusted further.
             // Before authentication nothing malformed is tolerated; after it, a well-framed
             // but invalid message is dropped and the stream goes on.
             if (r.stream_broken || state != State::kAuthed) {
@@ -186,6 +200,8 @@ struct Session : std::enable_shared_from_this<Session> {
                 }
                 return admit();
             }
+            case State::kAwaitRoute:
+                return onRouteMessage(m);
             case State::kAuthed:
                 return onAuthedMessage(m);
             case State::kClosed:
@@ -245,6 +261,8 @@ struct Session : std::enable_shared_from_this<Session> {
         });
     }
 
+    // Authenticated, with acceptable settings: takes a slot and starts the return-routability
+    // check; the session is admitted (Welcome, media) when the client echoes the token.
     bool admit() {
         handshake_timer.cancel();
         asio::error_code ec;
@@ -253,24 +271,87 @@ struct Session : std::enable_shared_from_this<Session> {
             close();
             return false;
         }
+        bool full = false;
         {
             std::lock_guard lock(server.mutex);
             --server.pending;
             pending = false;
-            if (static_cast<int>(server.clients.size()) >= server.options.max_clients) {
+            if (static_cast<int>(server.clients.size()) + server.routing >=
+                server.options.max_clients) {
                 ++server.stats.refused_full;
+                full = true;
             } else {
-                server.clients.emplace(session_id, shared_from_this());
-                ++server.stats.clients_accepted;
-                state = State::kAuthed;
+                ++server.routing;
+                state = State::kAwaitRoute;
             }
         }
-        if (state != State::kAuthed) {
+        if (full) {
             refuse(ByeReason::kServerFull);
             return false;
         }
-        // Media goes only to the address that authenticated, at the port it named.
+        // From here on every control message in both directions is sealed.
+        const SessionKeys keys =
+            sessionKeys(server.options.key, client_nonce, server_nonce, session_id);
+        reader.seal(keys.client_to_server);
+        sealer.start(keys.server_to_client);
+        route_key = keys.route;
+        route_token = randomRouteToken();
+        // Media will go only to the address that authenticated, at the port it named — once
+        // the client shows it receives there.
         media_endpoint = udp::endpoint(peer.address(), media_port);
+        probeRoute();
+        return true;
+    }
+
+    // One probe (sent directly, not through the link emulator), then the next or the verdict.
+    void probeRoute() {
+        if (state != State::kAwaitRoute) {
+            return;
+        }
+        if (probes_sent >= std::max(1, server.options.route_probe_attempts)) {
+            count([](ServerStats& st) { ++st.route_failures; });
+            refuse(ByeReason::kRouteUnverified);
+            return;
+        }
+        const auto probe =
+            sealRouteProbe(session_id, static_cast<uint8_t>(probes_sent), route_token, route_key);
+        ++probes_sent;
+        asio::error_code ec;
+        server.udp_socket.send_to(asio::buffer(probe), media_endpoint, 0, ec);
+        handshake_timer.expires_after(
+            std::chrono::milliseconds(std::max(1, server.options.route_probe_interval_ms)));
+        handshake_timer.async_wait([self = shared_from_this()](const asio::error_code& tec) {
+            if (!tec) {
+                self->probeRoute();
+            }
+        });
+    }
+
+    bool onRouteMessage(const ControlMessage& m) {
+        if (std::holds_alternative<Bye>(m)) {
+            close();
+            return false;
+        }
+        const auto* confirm = std::get_if<RouteConfirm>(&m);
+        if (!confirm || !tokenEqual(confirm->token, route_token)) {
+            count([&](ServerStats& st) {
+                if (confirm) {
+                    ++st.route_failures;
+                } else {
+                    ++st.protocol_errors;
+                }
+            });
+            refuse(confirm ? ByeReason::kRouteUnverified : ByeReason::kProtocolError);
+            return false;
+        }
+        handshake_timer.cancel();
+        {
+            std::lock_guard lock(server.mutex);
+            --server.routing;
+            server.clients.emplace(session_id, shared_from_this());
+            ++server.stats.clients_accepted;
+            state = State::kAuthed;
+        }
         if (!send(Welcome{session_id, server.media_port})) {
             return false;
         }
@@ -308,7 +389,7 @@ struct Session : std::enable_shared_from_this<Session> {
     }
 
     bool send(const ControlMessage& m) {
-        const bool queued = writer.push(socket, encodeControl(m));
+        const bool queued = writer.push(socket, sealer.encode(m));
         if (!queued) {
             // The client stopped reading its control channel: drop it rather than grow.
             count([](ServerStats& st) { ++st.protocol_errors; });
@@ -323,10 +404,14 @@ struct Session : std::enable_shared_from_this<Session> {
         if (state == State::kClosed) {
             return;
         }
-        const std::vector<uint8_t> bye = encodeControl(Bye{reason});
-        asio::error_code ec;
-        socket.non_blocking(true, ec);
-        asio::write(socket, asio::buffer(bye), ec);
+        // Not while a queued write is in flight: the bytes would interleave (and a sealed Bye
+        // would overtake messages with lower counters).
+        if (writer.idle()) {
+            const std::vector<uint8_t> bye = sealer.encode(Bye{reason});
+            asio::error_code ec;
+            socket.non_blocking(true, ec);
+            asio::write(socket, asio::buffer(bye), ec);
+        }
         close();
     }
 
@@ -335,6 +420,7 @@ struct Session : std::enable_shared_from_this<Session> {
             return;
         }
         const bool was_client = state == State::kAuthed;
+        const bool was_routing = state == State::kAwaitRoute;
         state = State::kClosed;
         asio::error_code ec;
         handshake_timer.cancel();
@@ -348,6 +434,9 @@ struct Session : std::enable_shared_from_this<Session> {
             if (pending) {
                 --server.pending;
                 pending = false;
+            }
+            if (was_routing) {
+                --server.routing;
             }
             if (was_client) {
                 server.clients.erase(session_id);
@@ -487,7 +576,8 @@ struct Session : std::enable_shared_from_this<Session> {
     tcp::socket socket;
     detail::ControlReader reader;
     detail::ControlWriter writer;
-    asio::steady_timer handshake_timer;
+    detail::ControlSealer sealer;        // on from the end of the handshake
+    asio::steady_timer handshake_timer;  // handshake, then route probes, then idle timeout
     asio::steady_timer flush_timer;
     bool flush_armed = false;
     State state = State::kAwaitHello;
@@ -498,6 +588,9 @@ struct Session : std::enable_shared_from_this<Session> {
     uint16_t media_port = 0;
     SessionSettings client_settings;
     MediaKey media_key{};  // seals every datagram of the session (docs/PROTOCOL.md §Sealed media)
+    ControlKey route_key{};
+    RouteToken route_token{};
+    int probes_sent = 0;
     asio::ip::address peer_address;  // fixed at accept
     int64_t accepted_ns = 0;
     int64_t last_rx_ns = 0;  // the last control message (or its start) from the peer

@@ -121,6 +121,7 @@ import json, sys
 d = json.load(open(sys.argv[1]))
 assert d['connects'] >= 1 and d['incompatible_refusals'] == 0, d
 assert d['media_forged'] == 0 and d['media_replayed'] >= 0, d
+assert d['control_forged'] == 0 and d['control_replayed'] == 0, d
 " "$tmp/ok/summary.json"; then
         pass "client with the server's settings connects"
     else
@@ -161,8 +162,10 @@ assert d['settings_refusals'] == 2, d
 assert d['clients_accepted'] == 2, d
 for k in ('connections', 'handshake_timeouts', 'refused_full', 'protocol_errors',
           'version_mismatches', 'nacks', 'packets_retransmitted', 'bytes_retransmitted',
-          'retransmissions_refused', 'pending_evicted', 'idle_timeouts'):
+          'retransmissions_refused', 'pending_evicted', 'idle_timeouts', 'route_failures',
+          'control_forged', 'control_replayed'):
     assert k in d, k
+assert d['route_failures'] == 0 and d['control_forged'] == 0 and d['control_replayed'] == 0, d
 " "$tmp/server_stats.json"; then
         pass "server stats count the refusals"
     else

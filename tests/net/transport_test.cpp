@@ -191,29 +191,45 @@ TEST(NetTransport, WrongKeyIsRefused) {
     EXPECT_FALSE(client.nextStream(10).ok());
 }
 
-// A raw peer on the control port: lets tests send exactly the bytes they mean.
+// A raw peer on the control port: lets tests send exactly the bytes they mean. It has its own
+// UDP socket (the media port it claims unless told otherwise), answers the server's
+// return-routability probe, and seals and opens control messages after the handshake.
 class RawPeer {
 public:
-    explicit RawPeer(uint16_t port) : m_socket(m_io) {
+    explicit RawPeer(uint16_t port)
+        : m_socket(m_io), m_media(m_io, {asio::ip::make_address("127.0.0.1"), 0}) {
         m_socket.connect({asio::ip::make_address("127.0.0.1"), port});
+        m_media.set_option(asio::socket_base::receive_buffer_size(8 << 20));
     }
     void send(const std::vector<uint8_t>& bytes) { asio::write(m_socket, asio::buffer(bytes)); }
-    // Reads one control message; nullopt when the server closed the connection.
+    // Sealed with the client's key and its next counter (after the handshake).
+    std::vector<uint8_t> seal(const ControlMessage& m) {
+        return sealControl(m, m_keys.client_to_server, m_send_counter++);
+    }
+    void sendSealed(const ControlMessage& m) { send(seal(m)); }
+    // Reads one control message (opening sealed ones); nullopt when the server closed the
+    // connection or sent something this peer cannot decode.
     std::optional<ControlMessage> read() {
-        std::array<uint8_t, kControlHeaderBytes> header{};
+        std::vector<uint8_t> raw(kControlHeaderBytes);
         asio::error_code ec;
-        asio::read(m_socket, asio::buffer(header), ec);
+        asio::read(m_socket, asio::buffer(raw), ec);
         if (ec) {
             return std::nullopt;
         }
         ControlHeader h;
-        if (decodeControlHeader(header, h) != WireError::kNone) {
+        if (decodeControlHeader(raw, h) != WireError::kNone) {
             return std::nullopt;
         }
-        std::vector<uint8_t> payload(h.payload_bytes);
-        asio::read(m_socket, asio::buffer(payload), ec);
+        raw.resize(kControlHeaderBytes + h.payload_bytes);
+        asio::read(m_socket, asio::buffer(raw.data() + kControlHeaderBytes, h.payload_bytes), ec);
         ControlMessage m;
-        if (ec || decodeControlPayload(h.type, payload, m) != WireError::kNone) {
+        if (ec) {
+            return std::nullopt;
+        }
+        const WireError e = h.type == ControlType::kSealed
+                                ? openControl(raw, m_keys.server_to_client, m_read_counter, m)
+                                : decodeControl(raw, m);
+        if (e != WireError::kNone) {
             return std::nullopt;
         }
         return m;
@@ -227,7 +243,14 @@ public:
         return ec == asio::error::eof || ec == asio::error::connection_reset;
     }
     // The client side of the handshake with any key; returns the Welcome or what came instead.
-    std::optional<ControlMessage> handshake(const PresharedKey& key, uint16_t media_port = 40000) {
+    // `claimed_port`: the media port named in the ClientHello (default: this peer's own);
+    // `route`: how to answer the server's probe (only possible when it comes to this peer's
+    // port).
+    enum class Route { kEcho, kSilent, kWrongToken, kSomethingElse };
+    std::optional<ControlMessage> handshake(const PresharedKey& key,
+                                            std::optional<uint16_t> claimed_port = std::nullopt,
+                                            Route route = Route::kEcho) {
+        const uint16_t media_port = claimed_port.value_or(mediaPort());
         const Nonce cn = randomNonce();
         send(encodeControl(ClientHello{cn, media_port}));
         auto m = read();
@@ -235,14 +258,57 @@ public:
             return m;
         }
         const auto& ch = std::get<ServerChallenge>(*m);
+        m_session = ch.session_id;
+        m_keys = sessionKeys(key, cn, ch.server_nonce, ch.session_id);
+        m_media_key = mediaKey(key, cn, ch.server_nonce, ch.session_id);
         send(encodeControl(
             ClientAuth{clientProof(key, cn, ch.server_nonce, ch.session_id, media_port)}));
+        if (route == Route::kSomethingElse) {
+            sendSealed(KeyFrameRequest{1, 0, KeyFrameReason::kStart});
+        } else if (route != Route::kSilent && !claimed_port) {
+            if (auto token = awaitProbe(2s)) {
+                (*token)[0] ^= route == Route::kWrongToken ? 1 : 0;
+                sendSealed(RouteConfirm{*token});
+            }
+        }
         return read();
     }
+    // The token of the next valid probe on this peer's media socket, within `timeout`.
+    std::optional<RouteToken> awaitProbe(std::chrono::milliseconds timeout) {
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        m_media.non_blocking(true);
+        std::array<uint8_t, 2048> buf{};
+        while (std::chrono::steady_clock::now() < deadline) {
+            asio::error_code ec;
+            if (m_socket.available(ec) > 0) {
+                return std::nullopt;  // the server answered on control instead (a refusal)
+            }
+            const size_t n = m_media.receive(asio::buffer(buf), 0, ec);
+            if (ec) {
+                std::this_thread::sleep_for(2ms);
+                continue;
+            }
+            RouteToken token{};
+            if (openRouteProbe(std::span<const uint8_t>(buf.data(), n), m_keys.route, m_session,
+                               token) == WireError::kNone) {
+                return token;
+            }
+        }
+        return std::nullopt;
+    }
+    uint16_t mediaPort() const { return m_media.local_endpoint().port(); }
+    asio::ip::udp::socket& media() { return m_media; }
+    const MediaKey& mediaKey_() const { return m_media_key; }
 
 private:
     asio::io_context m_io;
     asio::ip::tcp::socket m_socket;
+    asio::ip::udp::socket m_media;
+    uint64_t m_session = 0;
+    SessionKeys m_keys;
+    MediaKey m_media_key{};
+    uint64_t m_send_counter = 0;
+    uint64_t m_read_counter = 0;
 };
 
 TEST(NetTransport, ServerRefusesABadProofAndSaysWhy) {
@@ -299,8 +365,8 @@ TEST(NetTransport, MalformedControlBytesAreDroppedAndCounted) {
         ASSERT_TRUE(welcome && std::holds_alternative<Welcome>(*welcome));
         FrameRequest bad = request(1);
         bad.e1_deg = std::numeric_limits<float>::quiet_NaN();
-        peer.send(encodeControl(bad));
-        peer.send(encodeControl(request(2)));
+        peer.sendSealed(bad);
+        peer.sendSealed(request(2));
         const auto deadline = std::chrono::steady_clock::now() + 2s;
         while (handler.requests.load() < 1 && std::chrono::steady_clock::now() < deadline) {
             std::this_thread::sleep_for(5ms);
@@ -400,6 +466,140 @@ TEST(NetTransport, ClientNamesAServerOfAnotherVersion) {
     EXPECT_EQ(client.stats().incompatible_refusals, 1u);
 }
 
+// Control after the handshake is sealed (docs/PROTOCOL.md §Sealed control): a message that is
+// replayed, skips a counter, carries a flipped bit, was sealed with another key or comes plain
+// is counted and ends the session, and never reaches the handler.
+TEST(NetTransport, ForgedReplayedAndTamperedControlEndTheSessionUnheard) {
+    EchoServer handler(1000);
+    auto server = startServer(handler);
+    const auto waitFor = [](auto done) {
+        const auto deadline = std::chrono::steady_clock::now() + 2s;
+        while (!done() && std::chrono::steady_clock::now() < deadline) {
+            std::this_thread::sleep_for(2ms);
+        }
+    };
+    {
+        // An authentic request is served; the very same bytes again are a replay.
+        RawPeer peer(server->port());
+        auto welcome = peer.handshake(testKey());
+        ASSERT_TRUE(welcome && std::holds_alternative<Welcome>(*welcome));
+        const auto sealed = peer.seal(request(1));
+        peer.send(sealed);
+        waitFor([&] { return handler.requests.load() == 1; });
+        ASSERT_EQ(handler.requests.load(), 1);
+        peer.send(sealed);
+        peer.sendSealed(request(2));  // authentic, but the stream is no longer trusted
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // counter 1 where 0 is due: a message was deleted
+        ASSERT_TRUE(peer.handshake(testKey()).has_value());
+        (void)peer.seal(request(3));
+        peer.sendSealed(request(4));
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // one bit flipped in the ciphertext
+        ASSERT_TRUE(peer.handshake(testKey()).has_value());
+        auto flipped = peer.seal(request(5));
+        flipped[kControlHeaderBytes + 8 + 20] ^= 0x04;
+        peer.send(flipped);
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // sealed with a key of another session
+        ASSERT_TRUE(peer.handshake(testKey()).has_value());
+        const SessionKeys other = sessionKeys(testKey(), randomNonce(), randomNonce(), 99);
+        peer.send(sealControl(request(6), other.client_to_server, 1));
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    {
+        RawPeer peer(server->port());  // plain, as an injector without the key would send it
+        ASSERT_TRUE(peer.handshake(testKey()).has_value());
+        peer.send(encodeControl(request(7)));
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    waitFor([&] { return handler.gone.load() == 5; });
+    const ServerStats st = server->stats();
+    EXPECT_EQ(handler.requests.load(), 1);  // only the authentic first request was heard
+    EXPECT_EQ(st.frame_requests, 1u);
+    EXPECT_EQ(st.control_replayed, 2u);
+    EXPECT_EQ(st.control_forged, 3u);
+    EXPECT_EQ(st.control_drops[WireError::kReplayed], 2u);
+    EXPECT_EQ(st.control_drops[WireError::kBadMac], 2u);
+    EXPECT_EQ(st.control_drops[WireError::kUnsealed], 1u);
+    EXPECT_EQ(st.clients_accepted, 5u);
+    EXPECT_EQ(handler.gone.load(), 5);
+    EXPECT_TRUE(server->clients().empty());
+}
+
+// Return routability (docs/PROTOCOL.md §Return routability): a key holder that names a UDP port
+// it does not receive at (another process's port on its host), or never echoes the probe, or
+// echoes a wrong token, gets no media and is refused with the reason, counted.
+TEST(NetTransport, MediaGoesOnlyToAPortTheClientProvedItReceivesAt) {
+    EchoServer handler(1000);
+    ServerOptions o;
+    o.route_probe_interval_ms = 50;
+    o.route_probe_attempts = 3;
+    auto server = startServer(handler, o);
+    asio::io_context io;
+    asio::ip::udp::socket victim(io, {asio::ip::make_address("127.0.0.1"), 0});
+    {
+        RawPeer peer(server->port());  // names the victim's port
+        auto reply = peer.handshake(testKey(), victim.local_endpoint().port());
+        ASSERT_TRUE(reply && std::holds_alternative<Bye>(*reply));
+        EXPECT_EQ(std::get<Bye>(*reply).reason, ByeReason::kRouteUnverified);
+        EXPECT_TRUE(peer.closedByPeer());
+    }
+    using Route = RawPeer::Route;
+    for (const Route route : {Route::kSilent, Route::kWrongToken}) {
+        RawPeer peer(server->port());  // receives the probe, then never answers or guesses
+        auto reply = peer.handshake(testKey(), std::nullopt, route);
+        ASSERT_TRUE(reply && std::holds_alternative<Bye>(*reply));
+        EXPECT_EQ(std::get<Bye>(*reply).reason, ByeReason::kRouteUnverified);
+    }
+    {
+        // Asking for a key frame before the check passed is a protocol error, not honoured.
+        RawPeer peer(server->port());
+        auto reply =
+            peer.handshake(testKey(), victim.local_endpoint().port(), Route::kSomethingElse);
+        ASSERT_TRUE(reply && std::holds_alternative<Bye>(*reply));
+        EXPECT_EQ(std::get<Bye>(*reply).reason, ByeReason::kProtocolError);
+    }
+    // What reached the victim's port: probes only (3 for the first peer, the first of the
+    // last peer's), never media.
+    victim.non_blocking(true);
+    std::array<uint8_t, 2048> buf{};
+    int probes = 0, other = 0;
+    for (;;) {
+        asio::error_code ec;
+        const size_t n = victim.receive(asio::buffer(buf), 0, ec);
+        if (ec) {
+            break;
+        }
+        (isRouteProbe(std::span<const uint8_t>(buf.data(), n)) ? probes : other) += 1;
+    }
+    EXPECT_EQ(other, 0);
+    // (The last peer's request reaches the server before its second probe unless the machine
+    // stalls the server for an interval.)
+    EXPECT_GE(probes, 3 + 1);
+    EXPECT_LE(probes, 3 + 3);
+    const ServerStats st = server->stats();
+    EXPECT_EQ(st.route_failures, 3u);
+    EXPECT_EQ(st.protocol_errors, 1u);
+    EXPECT_EQ(st.control_drops.total(), 0u);
+    EXPECT_EQ(st.packets_sent, 0u);
+    EXPECT_EQ(st.clients_accepted, 0u);
+    EXPECT_EQ(handler.connected.load(), 0);
+    EXPECT_EQ(handler.requests.load(), 0);
+    // A client that does receive at its port gets in and is served as always.
+    Client client(clientOptions());
+    ASSERT_TRUE(client.connect("127.0.0.1", server->port()).ok()) << client.lastError().error();
+    ASSERT_TRUE(client.sendFrameRequest(request(1)).ok());
+    const Received r = receive(client, 0, 1000, 4, 5s);
+    EXPECT_EQ(r.streams, 4);
+}
+
 TEST(NetTransport, SilentPeerIsDroppedAfterTheHandshakeTimeout) {
     EchoServer handler(1000);
     ServerOptions o;
@@ -418,12 +618,10 @@ TEST(NetTransport, SilentPeerIsDroppedAfterTheHandshakeTimeout) {
 TEST(NetTransport, NackFloodDrawsAtMostTwiceTheMedia) {
     EchoServer handler(20 * 1200);  // 20 datagrams per stream and frame
     auto server = startServer(handler);
-    asio::io_context io;
-    asio::ip::udp::socket media(io, {asio::ip::make_address("127.0.0.1"), 0});
-    media.set_option(asio::socket_base::receive_buffer_size(8 << 20));
     RawPeer peer(server->port());
-    auto welcome = peer.handshake(testKey(), media.local_endpoint().port());
+    auto welcome = peer.handshake(testKey());
     ASSERT_TRUE(welcome && std::holds_alternative<Welcome>(*welcome));
+    asio::ip::udp::socket& media = peer.media();
     const auto drain = [&] {
         std::array<uint8_t, 2048> buf{};
         uint64_t bytes = 0;
@@ -442,7 +640,7 @@ TEST(NetTransport, NackFloodDrawsAtMostTwiceTheMedia) {
         return bytes;
     };
     for (uint32_t f = 1; f <= 10; ++f) {
-        peer.send(encodeControl(request(f)));
+        peer.sendSealed(request(f));
     }
     const uint64_t media_bytes = drain();
     ASSERT_GT(media_bytes, 10u * 4 * 20 * 1200);
@@ -450,8 +648,8 @@ TEST(NetTransport, NackFloodDrawsAtMostTwiceTheMedia) {
     uint64_t nack_bytes = 0;
     for (int i = 0; i < 10'000; ++i) {
         const auto nack =
-            encodeControl(Nack{static_cast<uint8_t>(i % kMaxStreams),
-                               static_cast<uint32_t>((i / kMaxStreams) % 3 * 64), ~uint64_t{0}});
+            peer.seal(Nack{static_cast<uint8_t>(i % kMaxStreams),
+                           static_cast<uint32_t>((i / kMaxStreams) % 3 * 64), ~uint64_t{0}});
         nack_bytes += nack.size();
         peer.send(nack);
     }
@@ -996,43 +1194,76 @@ TEST(NetTransport, SigkilledServerProcessSurfacesAsErrorAndTheClientReconnects) 
     EXPECT_EQ(receive(client, second->clients()[0], 3000, 4, 3s).streams, 4);
 }
 
+// Plays the server by hand (challenge, probe of the claimed media port, sealed Welcome), so a
+// test can send the client exactly the datagrams and control bytes it means.
+struct FakeServer {
+    asio::io_context io;
+    asio::ip::tcp::acceptor acceptor{io, {asio::ip::make_address("127.0.0.1"), 0}};
+    asio::ip::udp::socket media{io, {asio::ip::make_address("127.0.0.1"), 0}};
+    asio::ip::tcp::socket peer{io};
+    ClientHello hello;
+    Nonce server_nonce = randomNonce();
+    uint64_t session = 77;
+    SessionKeys keys;
+    uint64_t send_counter = 0;
+    uint64_t read_counter = 0;
+
+    uint16_t port() const { return acceptor.local_endpoint().port(); }
+    // The next message from the client, opened if sealed.
+    ControlMessage read() {
+        std::vector<uint8_t> raw(kControlHeaderBytes);
+        asio::read(peer, asio::buffer(raw));
+        ControlHeader h;
+        EXPECT_EQ(decodeControlHeader(raw, h), WireError::kNone);
+        raw.resize(kControlHeaderBytes + h.payload_bytes);
+        asio::read(peer, asio::buffer(raw.data() + kControlHeaderBytes, h.payload_bytes));
+        ControlMessage m;
+        EXPECT_EQ(h.type == ControlType::kSealed
+                      ? openControl(raw, keys.client_to_server, read_counter, m)
+                      : decodeControl(raw, m),
+                  WireError::kNone);
+        return m;
+    }
+    std::vector<uint8_t> seal(const ControlMessage& m) {
+        return sealControl(m, keys.server_to_client, send_counter++);
+    }
+    void send(const std::vector<uint8_t>& bytes) { asio::write(peer, asio::buffer(bytes)); }
+    void handshake() {
+        acceptor.accept(peer);
+        hello = std::get<ClientHello>(read());
+        send(encodeControl(
+            ServerChallenge{server_nonce, session,
+                            serverProof(testKey(), hello.client_nonce, server_nonce, session)}));
+        const auto auth = std::get<ClientAuth>(read());
+        EXPECT_TRUE(macEqual(
+            auth.client_proof,
+            clientProof(testKey(), hello.client_nonce, server_nonce, session, hello.media_port)));
+        keys = sessionKeys(testKey(), hello.client_nonce, server_nonce, session);
+        const RouteToken token = randomRouteToken();
+        media.send_to(asio::buffer(sealRouteProbe(session, 0, token, keys.route)),
+                      {asio::ip::make_address("127.0.0.1"), hello.media_port});
+        const auto echo = std::get<RouteConfirm>(read());
+        EXPECT_TRUE(tokenEqual(echo.token, token));
+        send(seal(Welcome{session, media.local_endpoint().port()}));
+    }
+};
+
 // The test plays the server by hand, so it can send the client exactly the datagrams and
 // control bytes it means: every malformed datagram is dropped and counted by reason, a valid
 // stream still completes and is acknowledged, and a broken control stream ends the session.
 TEST(NetTransport, ClientDropsAndCountsMalformedMedia) {
-    asio::io_context io;
-    asio::ip::tcp::acceptor acceptor(io, {asio::ip::make_address("127.0.0.1"), 0});
-    asio::ip::udp::socket media(io, {asio::ip::make_address("127.0.0.1"), 0});
+    FakeServer fake;
     Client client(clientOptions());
     Status connected = makeError("not run");
-    std::thread connecting(
-        [&] { connected = client.connect("127.0.0.1", acceptor.local_endpoint().port()); });
-
-    asio::ip::tcp::socket peer(io);
-    acceptor.accept(peer);
-    const auto readMessage = [&peer]() -> ControlMessage {
-        std::array<uint8_t, kControlHeaderBytes> header{};
-        asio::read(peer, asio::buffer(header));
-        ControlHeader h;
-        EXPECT_EQ(decodeControlHeader(header, h), WireError::kNone);
-        std::vector<uint8_t> payload(h.payload_bytes);
-        asio::read(peer, asio::buffer(payload));
-        ControlMessage m;
-        EXPECT_EQ(decodeControlPayload(h.type, payload, m), WireError::kNone);
-        return m;
-    };
-    const auto hello = std::get<ClientHello>(readMessage());
-    const Nonce server_nonce = randomNonce();
-    const uint64_t session = 77;
-    asio::write(peer, asio::buffer(encodeControl(ServerChallenge{
-                          server_nonce, session,
-                          serverProof(testKey(), hello.client_nonce, server_nonce, session)})));
-    const auto auth = std::get<ClientAuth>(readMessage());
-    EXPECT_TRUE(macEqual(auth.client_proof, clientProof(testKey(), hello.client_nonce, server_nonce,
-                                                        session, hello.media_port)));
-    asio::write(peer, asio::buffer(encodeControl(Welcome{session, media.local_endpoint().port()})));
+    std::thread connecting([&] { connected = client.connect("127.0.0.1", fake.port()); });
+    fake.handshake();
     connecting.join();
     ASSERT_TRUE(connected.ok()) << connected.error();
+    const auto readMessage = [&fake] { return fake.read(); };
+    auto& media = fake.media;
+    const ClientHello& hello = fake.hello;
+    const Nonce& server_nonce = fake.server_nonce;
+    const uint64_t session = fake.session;
 
     const asio::ip::udp::endpoint to(asio::ip::make_address("127.0.0.1"), hello.media_port);
     // The fake server knows the nonces, so it holds the session's media key, as the real one.
@@ -1110,18 +1341,63 @@ TEST(NetTransport, ClientDropsAndCountsMalformedMedia) {
     EXPECT_EQ(client.stats().media_drops[WireError::kReplayed], 2u);
     EXPECT_TRUE(client.connected());
 
-    asio::write(peer, asio::buffer(encodeControl(ThroughputReport{123'000'000, 1})));
+    fake.send(fake.seal(ThroughputReport{123'000'000, 1}));
     const auto deadline = std::chrono::steady_clock::now() + 2s;
     while (client.throughputBps() == 0 && std::chrono::steady_clock::now() < deadline) {
         std::this_thread::sleep_for(2ms);
     }
     EXPECT_EQ(client.throughputBps(), 123e6);
     // A control header that is not qvr: the client cannot re-frame the stream and hangs up.
-    asio::write(peer, asio::buffer(std::vector<uint8_t>{'H', 'T', 'T', 'P', '/', '1', '.', '1'}));
+    fake.send(std::vector<uint8_t>{'H', 'T', 'T', 'P', '/', '1', '.', '1'});
     auto gone = client.nextStream(2000);
     ASSERT_FALSE(gone.ok());
     EXPECT_NE(gone.error().find("protocol error"), std::string::npos) << gone.error();
     EXPECT_EQ(client.stats().control_drops[WireError::kBadMagic], 1u);
+}
+
+// The client side of sealed control: a server message replayed, bit-flipped or sent plain is
+// counted, never acted on, and ends the connection (the caller reconnects).
+TEST(NetTransport, ClientEndsAConnectionWhoseControlStreamWasTampered) {
+    Client client(clientOptions());
+    struct Case {
+        const char* what;
+        uint64_t forged, replayed;
+    };
+    const Case cases[] = {{"replayed", 0, 1}, {"flipped", 1, 1}, {"plain", 2, 1}};
+    for (const Case& c : cases) {
+        FakeServer fake;
+        Status connected = makeError("not run");
+        std::thread connecting([&] { connected = client.connect("127.0.0.1", fake.port()); });
+        fake.handshake();
+        connecting.join();
+        ASSERT_TRUE(connected.ok()) << connected.error();
+        const auto report = fake.seal(ThroughputReport{1'000'000, 1});
+        fake.send(report);
+        const auto deadline = std::chrono::steady_clock::now() + 2s;
+        while (client.throughputBps() == 0 && std::chrono::steady_clock::now() < deadline) {
+            std::this_thread::sleep_for(2ms);
+        }
+        ASSERT_EQ(client.throughputBps(), 1e6) << c.what;
+        if (std::string_view(c.what) == "replayed") {
+            fake.send(report);
+        } else if (std::string_view(c.what) == "flipped") {
+            auto flipped = fake.seal(ThroughputReport{2'000'000, 2});
+            flipped[kControlHeaderBytes + 8 + 3] ^= 0x10;
+            fake.send(flipped);
+        } else {
+            fake.send(encodeControl(ThroughputReport{3'000'000, 3}));
+        }
+        auto gone = client.nextStream(2000);
+        ASSERT_FALSE(gone.ok()) << c.what;
+        EXPECT_NE(gone.error().find("protocol error"), std::string::npos) << gone.error();
+        EXPECT_EQ(client.throughputBps(), 1e6) << c.what;  // nothing forged was believed
+        EXPECT_EQ(client.stats().control_forged, c.forged) << c.what;
+        EXPECT_EQ(client.stats().control_replayed, c.replayed) << c.what;
+    }
+    const DropCounters drops = client.stats().control_drops;
+    EXPECT_EQ(drops[WireError::kReplayed], 1u);
+    EXPECT_EQ(drops[WireError::kBadMac], 1u);
+    EXPECT_EQ(drops[WireError::kUnsealed], 1u);
 }
 
 TEST(NetTransport, ConnectTimesOutOnASilentServer) {

@@ -367,8 +367,8 @@ bool writeAll(int fd, const std::vector<uint8_t>& bytes) {
     return true;
 }
 
-// One control message, raw (header + payload) and decoded.
-bool readControl(int fd, std::vector<uint8_t>& raw, net::ControlMessage& message) {
+// One control message, raw (header + payload) and decoded; a sealed one stays raw (`sealed`).
+bool readControl(int fd, std::vector<uint8_t>& raw, net::ControlMessage& message, bool& sealed) {
     raw.assign(net::kControlHeaderBytes, 0);
     if (!readExact(fd, raw.data(), raw.size()))
         return false;
@@ -378,7 +378,8 @@ bool readControl(int fd, std::vector<uint8_t>& raw, net::ControlMessage& message
     raw.resize(net::kControlHeaderBytes + h.payload_bytes);
     if (!readExact(fd, raw.data() + net::kControlHeaderBytes, h.payload_bytes))
         return false;
-    return net::decodeControl(raw, message) == net::WireError::kNone;
+    sealed = h.type == net::ControlType::kSealed;
+    return sealed || net::decodeControl(raw, message) == net::WireError::kNone;
 }
 
 class MediaTamperingProxy {
@@ -445,13 +446,29 @@ private:
         down.join();
     }
 
-    // Forwards control messages from `from` to `to`, rewriting the handshake's media ports.
+    // Forwards control messages from `from` to `to`, rewriting the handshake's media ports (the
+    // proxy holds the key, so it can open and re-seal the server's Welcome).
     void relay(int from, int to) {
         std::vector<uint8_t> raw;
         net::ControlMessage m;
-        while (readControl(from, raw, m)) {
+        bool sealed = false;
+        uint64_t next_counter = 0;  // of the server's sealed messages
+        while (readControl(from, raw, m, sealed)) {
             std::unique_lock lock(m_mutex);
-            if (auto* hello = std::get_if<net::ClientHello>(&m)) {
+            if (sealed) {
+                if (from == m_server) {
+                    const net::ControlKey key =
+                        net::sessionKeys(m_key, m_client_nonce, m_server_nonce, m_session)
+                            .server_to_client;
+                    const uint64_t counter = next_counter;
+                    if (net::openControl(raw, key, next_counter, m) == net::WireError::kNone) {
+                        if (auto* welcome = std::get_if<net::Welcome>(&m)) {
+                            welcome->media_port = localPort(m_to_headset);
+                            raw = net::sealControl(*welcome, key, counter);
+                        }
+                    }
+                }
+            } else if (auto* hello = std::get_if<net::ClientHello>(&m)) {
                 m_client_nonce = hello->client_nonce;
                 m_headset_media_port = hello->media_port;
                 hello->media_port = localPort(m_from_server);

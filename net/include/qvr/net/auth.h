@@ -49,4 +49,18 @@ bool macEqual(const Mac& a, const Mac& b);
 MediaKey mediaKey(const PresharedKey& key, const Nonce& client_nonce, const Nonce& server_nonce,
                   uint64_t session_id);
 
+// The session's control keys, one per direction, and the key of the return-routability probe:
+// HMAC-SHA-256(K, "qvr4 control c2s" | "qvr4 control s2c" | "qvr4 route" ‖ Nc ‖ Ns ‖ sid).
+struct SessionKeys {
+    ControlKey client_to_server{};
+    ControlKey server_to_client{};
+    ControlKey route{};
+};
+SessionKeys sessionKeys(const PresharedKey& key, const Nonce& client_nonce,
+                        const Nonce& server_nonce, uint64_t session_id);
+// 16 random bytes for the return-routability check.
+RouteToken randomRouteToken();
+// Constant-time comparison.
+bool tokenEqual(const RouteToken& a, const RouteToken& b);
+
 }  // namespace qvr::net

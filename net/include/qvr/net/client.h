@@ -38,6 +38,10 @@ struct ClientStats {
     // version): reconnecting cannot help, lastError() says why.
     uint64_t incompatible_refusals = 0;
     uint64_t disconnects = 0;
+    // Sealed control from the server (each ends the connection): a tag that does not verify or
+    // a plain message after the handshake; a counter that is not the next one.
+    uint64_t control_forged = 0;
+    uint64_t control_replayed = 0;
     DropCounters control_drops;
     DropCounters media_drops;
     AssemblerStats assembler;  // accumulated over connections

@@ -19,7 +19,12 @@ namespace qvr::net {
 
 // 2: the ClientHello carries the session settings (codec, display profile) and the server
 // refuses a mismatch with a named Bye reason.
-inline constexpr uint8_t kProtocolVersion = 3;
+// 3: forward error correction — the media header's fec_parity byte and parity flag, the
+// MediaAck's loss_ppm.
+// 4: every control message after the handshake is sealed (ChaCha20-Poly1305, a key per
+// direction, a message counter as nonce), and the server checks that the client receives at its
+// media port (a sealed UDP probe echoed back) before it sends any media there.
+inline constexpr uint8_t kProtocolVersion = 4;
 
 // Limits a decoder enforces before it trusts any length a peer sent.
 inline constexpr size_t kControlHeaderBytes = 8;
@@ -39,6 +44,17 @@ inline constexpr size_t kMediaTagBytes = 16;
 inline constexpr size_t kMaxSealedDatagramBytes = kMaxDatagramBytes + kMediaTagBytes;
 inline constexpr size_t kMediaKeyBytes = 32;
 using MediaKey = std::array<uint8_t, kMediaKeyBytes>;
+// Sealed control (docs/PROTOCOL.md §Sealed control): counter u64 ‖ ciphertext of (inner type ‖
+// inner payload) ‖ 16-byte tag, inside a control header of type kSealed.
+using ControlKey = std::array<uint8_t, kMediaKeyBytes>;
+inline constexpr size_t kControlTagBytes = 16;
+inline constexpr size_t kSealedControlOverhead = 8 + 1 + kControlTagBytes;
+// Return routability (docs/PROTOCOL.md §Return routability): a random token the server seals
+// into a UDP probe to the client's claimed media port and the client echoes over control.
+inline constexpr size_t kRouteTokenBytes = 16;
+using RouteToken = std::array<uint8_t, kRouteTokenBytes>;
+inline constexpr size_t kRouteProbeHeaderBytes = 12;
+inline constexpr size_t kRouteProbeBytes = kRouteProbeHeaderBytes + kRouteTokenBytes + 16;
 
 // Stream id = 2·eye + layer: the four parallel streams of Fig. 7.
 enum class Layer : uint8_t { kMiddle = 0, kOuter = 1 };
@@ -58,9 +74,11 @@ enum class WireError : uint8_t {
     kTrailingBytes,  // more bytes than the type's fixed layout
     kBadMac,         // handshake proof that does not verify
     kWrongSession,   // media of another session
-    kReplayed,       // sealed media seen before, or older than the replay window
+    kReplayed,       // sealed media seen before, or older than the replay window; sealed
+                     // control whose counter is not the next one (replayed, reordered, deleted)
+    kUnsealed,       // a plain control message where only sealed ones are allowed
 };
-inline constexpr int kWireErrorCount = 11;
+inline constexpr int kWireErrorCount = 12;
 std::string_view wireErrorName(WireError e);
 
 struct DropCounters {
@@ -84,6 +102,9 @@ enum class ControlType : uint8_t {
     kThroughputReport = 8,
     kBye = 9,
     kNack = 10,
+    kRouteConfirm = 11,
+    // The envelope of every control message after the handshake; not a ControlMessage itself.
+    kSealed = 12,
 };
 
 struct ControlHeader {
@@ -192,8 +213,9 @@ enum class ByeReason : uint8_t {
     kVersionMismatch = 5,  // the ClientHello was of another protocol version
     kCodecMismatch = 6,    // the client's codec is not the server's
     kProfileMismatch = 7,  // nor its display profile
+    kRouteUnverified = 8,  // the client never echoed the probe sent to its media port
 };
-inline constexpr uint8_t kMaxByeReason = 7;
+inline constexpr uint8_t kMaxByeReason = 8;
 std::string_view byeReasonName(ByeReason r);
 struct Bye {
     ByeReason reason = ByeReason::kNormal;
@@ -208,8 +230,15 @@ struct Nack {
     uint64_t missing_mask = 0;  // ≠ 0
 };
 
-using ControlMessage = std::variant<ClientHello, ServerChallenge, ClientAuth, Welcome, FrameRequest,
-                                    MediaAck, KeyFrameRequest, ThroughputReport, Bye, Nack>;
+// The client's echo of the token the server sealed into the UDP probe (sealed, like every
+// message after the handshake): proof that it receives at the media port it claimed.
+struct RouteConfirm {
+    RouteToken token{};
+};
+
+using ControlMessage =
+    std::variant<ClientHello, ServerChallenge, ClientAuth, Welcome, FrameRequest, MediaAck,
+                 KeyFrameRequest, ThroughputReport, Bye, Nack, RouteConfirm>;
 
 // Header + payload, ready to write.
 std::vector<uint8_t> encodeControl(const ControlMessage& message);
@@ -220,6 +249,31 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
                                ControlMessage& out);
 // A whole message (header + payload), nothing after it.
 WireError decodeControl(std::span<const uint8_t> bytes, ControlMessage& out);
+
+// ---- sealed control (docs/PROTOCOL.md §Sealed control) -------------------------------------
+
+// Whether a message may travel sealed (Welcome onwards) — the handshake's three may not.
+bool sealable(ControlType type);
+// m encoded, then sealed with ChaCha20-Poly1305-IETF under `key` and nonce `counter`: a control
+// message of type kSealed. Each direction has its own key and counts from 0; a counter is never
+// used twice under one key. Precondition: sealable(type of m).
+std::vector<uint8_t> sealControl(const ControlMessage& m, const ControlKey& key, uint64_t counter);
+// A whole kSealed message (header + payload). Checks the header, then the tag (kBadMac: forged,
+// altered, or sealed with another key), then that its counter is `next_counter` (kReplayed:
+// replayed, reordered, or a message before it was deleted), and only then advances
+// next_counter and decodes the inner message by the plain rules (a handshake type inside is
+// kUnknownType). A plain message is kUnsealed.
+WireError openControl(std::span<const uint8_t> bytes, const ControlKey& key, uint64_t& next_counter,
+                      ControlMessage& out);
+
+// The UDP probe of the return-routability check: magic 'Q' 'R', version, attempt, session_id
+// (12 bytes in clear, associated data), then the token encrypted and a 16-byte tag.
+std::vector<uint8_t> sealRouteProbe(uint64_t session_id, uint8_t attempt, const RouteToken& token,
+                                    const ControlKey& key);
+bool isRouteProbe(std::span<const uint8_t> datagram);  // magic only: not media
+// Size, magic, version, tag (kBadMac), then the session (kWrongSession).
+WireError openRouteProbe(std::span<const uint8_t> datagram, const ControlKey& key,
+                         uint64_t session_id, RouteToken& token);
 
 // ---- media streams (UDP datagrams): 32-byte header + payload ------------------------------
 

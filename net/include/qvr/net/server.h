@@ -34,6 +34,12 @@ struct ServerOptions {
     // An authenticated session with no control message from its client for this long (a
     // stopped or idle client holding a slot) is ended with Bye(timeout); 0: never.
     int idle_timeout_ms = 10000;
+    // Return routability (docs/PROTOCOL.md §Return routability): after authentication the
+    // server sends a sealed token to the client's claimed media port, every interval, at most
+    // this many times, and admits the session (Welcome, media) only once the client echoes it;
+    // unanswered, it ends the session with Bye(media port not verified).
+    int route_probe_interval_ms = 250;
+    int route_probe_attempts = 4;
     size_t max_control_queue = 256;           // outgoing control messages per client
     int64_t max_media_queue_bytes = 8 << 20;  // accepted by sendStream, not yet in the link
     LinkConfig link;                          // each client gets its own emulator with this
@@ -78,6 +84,11 @@ struct ServerStats {
     uint64_t protocol_errors = 0;     // wrong message for the state, or a broken stream
     uint64_t version_mismatches = 0;  // a ClientHello of another protocol version
     uint64_t settings_refusals = 0;   // authenticated, but another codec or display profile
+    uint64_t route_failures = 0;      // never proved it receives at its media port
+    // Sealed control after the handshake (each ends the session): a tag that does not verify
+    // or a plain message; a counter that is not the next one (replayed, reordered, deleted).
+    uint64_t control_forged = 0;
+    uint64_t control_replayed = 0;
     DropCounters control_drops;
     uint64_t frame_requests = 0;
     uint64_t key_frame_requests = 0;
