@@ -687,21 +687,26 @@ std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t&
     const uint32_t count = packetCountFor(frame_bytes);
     const uint32_t parity_count = parityPacketsFor(static_cast<uint16_t>(count), fec_parity);
     std::vector<std::vector<uint8_t>> packets(count + parity_count);
-    for (uint32_t i = 0; i < count; ++i) {
-        const size_t offset = static_cast<size_t>(i) * kMediaChunkBytes;
-        const size_t n = std::min(kMediaChunkBytes, bytes.size() - offset);
+    // Data and parity packets differ only in their index, payload and parity flag.
+    auto header = [&](uint32_t index, size_t payload_bytes, bool parity) {
         MediaHeader h;
         h.key_frame = key_frame;
         h.session_id = session_id;
         h.seq = seq++;
         h.frame_id = frame_id;
         h.stream_id = stream_id;
-        h.packet_index = static_cast<uint16_t>(i);
+        h.packet_index = static_cast<uint16_t>(index);
         h.packet_count = static_cast<uint16_t>(count);
-        h.payload_bytes = static_cast<uint16_t>(n);
+        h.payload_bytes = static_cast<uint16_t>(payload_bytes);
         h.frame_bytes = frame_bytes;
         h.fec_parity = fec_parity;
-        encodeMediaPacket(h, bytes.subspan(offset, n), packets[i]);
+        h.parity = parity;
+        return h;
+    };
+    for (uint32_t i = 0; i < count; ++i) {
+        const size_t offset = static_cast<size_t>(i) * kMediaChunkBytes;
+        const size_t n = std::min(kMediaChunkBytes, bytes.size() - offset);
+        encodeMediaPacket(header(i, n, false), bytes.subspan(offset, n), packets[i]);
     }
     if (parity_count == 0) {
         return packets;
@@ -725,19 +730,7 @@ std::vector<std::vector<uint8_t>> packetizeStream(uint64_t session_id, uint32_t&
         fecEncode(static_cast<int>(kMediaChunkBytes), data, out);
     }
     for (uint32_t j = 0; j < parity_count; ++j) {
-        MediaHeader h;
-        h.key_frame = key_frame;
-        h.session_id = session_id;
-        h.seq = seq++;
-        h.frame_id = frame_id;
-        h.stream_id = stream_id;
-        h.packet_index = static_cast<uint16_t>(j);
-        h.packet_count = static_cast<uint16_t>(count);
-        h.payload_bytes = static_cast<uint16_t>(kMediaChunkBytes);
-        h.frame_bytes = frame_bytes;
-        h.fec_parity = fec_parity;
-        h.parity = true;
-        encodeMediaPacket(h,
+        encodeMediaPacket(header(j, kMediaChunkBytes, true),
                           std::span<const uint8_t>(parity).subspan(
                               static_cast<size_t>(j) * kMediaChunkBytes, kMediaChunkBytes),
                           packets[count + j]);
