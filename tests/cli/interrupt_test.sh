@@ -33,6 +33,11 @@ wait_for() {
     done
     return 1
 }
+# interrupt PID: SIGINT, then the process's exit status.
+interrupt() {
+    kill -INT "$1"
+    wait "$1"
+}
 
 # --- qvr server, SIGINT while a client streams ------------------------------------------------
 K=(--key pass:interrupt-test)
@@ -58,8 +63,7 @@ else
     if ! wait_for "$tmp/stamps.csv" 20 120; then
         fail "server serves frames" "$(head -c 300 "$tmp/client_err.txt")"
     fi
-    kill -INT "$server_pid"
-    wait "$server_pid"
+    interrupt "$server_pid"
     rc=$?
     if [ $rc -eq 0 ] && python3 -c "
 import csv, json, sys
@@ -75,8 +79,7 @@ assert d['clients_accepted'] == 1, d
             "exit $rc: $(head -c 300 "$tmp/server_err.txt"); $(head -c 300 "$tmp/stats.json" 2>/dev/null)"
     fi
     # The client outlives its server (local fallback); end it the same way.
-    kill -INT "$client_pid"
-    wait "$client_pid"
+    interrupt "$client_pid"
     rc=$?
     if [ $rc -eq 130 ] && [ -f "$tmp/client/summary.json" ]; then
         pass "client outliving its server ends on SIGINT with its summary (exit 130)"
@@ -96,8 +99,7 @@ pids+=("$run_pid")
 if ! wait_for "$tmp/run/server_stamps.csv" 40 180; then
     fail "qvr run streams frames" "$(head -c 300 "$tmp/run_err.txt")"
 fi
-kill -INT "$run_pid"
-wait "$run_pid"
+interrupt "$run_pid"
 rc=$?
 if [ $rc -eq 130 ] && grep -q "interrupted" "$tmp/run_err.txt" && python3 -c "
 import csv, json, os, sys
