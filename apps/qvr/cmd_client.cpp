@@ -26,6 +26,9 @@ namespace {
 
 using namespace qvr::runtime;
 
+// Frames kept in memory for trace.json: the newest ~45 s at 90 Hz.
+constexpr size_t kClientFramesKept = 4096;
+
 // Set by SIGINT/SIGTERM: the headset ends at the next frame boundary and everything measured so
 // far is written.
 std::atomic<bool> g_client_stop{false};
@@ -115,6 +118,20 @@ int runClient(const ClientCmdOptions& o) {
     gl.lod_error_px = o.lod_px;
     hc.renderer = glRendererFactory(gl);
     hc.stop = &g_client_stop;
+    // Telemetry goes to disk as frames finish and only the newest frames stay in memory (for
+    // trace.json), so a session of any length runs in flat memory.
+    const std::filesystem::path out(o.out);
+    std::ofstream telemetry(out / "telemetry.csv");
+    if (!telemetry) {
+        std::fprintf(stderr, "qvr client: cannot write '%s'\n",
+                     (out / "telemetry.csv").string().c_str());
+        return 2;
+    }
+    telemetry << telemetryCsvHeader();
+    hc.frame_sink = [&telemetry, &o](const FrameTelemetry& t) {
+        telemetry << telemetryCsvRow(o.design, t);
+    };
+    hc.keep_frames = kClientFramesKept;
     g_client_stop.store(false);
     std::signal(SIGINT, onClientSignal);
     std::signal(SIGTERM, onClientSignal);
@@ -125,10 +142,10 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: %s\n", result.error().c_str());
         return 1;
     }
-    const std::filesystem::path out(o.out);
-    if (auto st = writeTelemetryCsv((out / "telemetry.csv").string(), o.design, result->frames);
-        !st) {
-        std::fprintf(stderr, "qvr client: %s\n", st.error().c_str());
+    telemetry.close();
+    if (!telemetry) {
+        std::fprintf(stderr, "qvr client: error writing '%s'\n",
+                     (out / "telemetry.csv").string().c_str());
         return 1;
     }
     const DesignSummary& s = result->summary;
@@ -136,6 +153,9 @@ int runClient(const ClientCmdOptions& o) {
     nlohmann::json j = {{"design", s.design},
                         {"frames", s.frames},
                         {"frames_requested", o.frames},
+                        // telemetry.csv's times are ns after this steady-clock (CLOCK_MONOTONIC)
+                        // instant, so other tools can place their own events on its timeline
+                        {"clock_origin_ns", result->origin_ns},
                         {"interrupted", g_client_stop.load()},
                         {"fps_mean", s.fps_mean},
                         {"mtp_ms_mean", s.mtp_ms_mean},
@@ -163,7 +183,9 @@ int runClient(const ClientCmdOptions& o) {
                         {"fec_packets_recovered", st.net.assembler.fec_packets_recovered},
                         {"fec_parity_received", st.net.assembler.fec_parity_received},
                         {"fec_parity_unused", st.net.assembler.fec_parity_unused},
-                        {"streams_lost", st.streams_lost}};
+                        {"streams_lost", st.streams_lost},
+                        {"late_frames", st.late_frames},
+                        {"silent_server_frames", st.silent_server_frames}};
     // trace.json: the headset's stages, and the server's when its stamps file is given (a server
     // on this machine: qvr server --stamps-csv F; read after the server has stopped or flushed).
     std::vector<ServerFrameStamps> stamps;
@@ -183,6 +205,8 @@ int runClient(const ClientCmdOptions& o) {
         return 1;
     }
     j["trace"] = {{"path", "trace.json"},
+                  {"frames", result->frames.size()},
+                  {"first_frame", result->frames.empty() ? 0 : result->frames.front().frame},
                   {"events", trace->events},
                   {"server_frames", trace->server_frames_matched},
                   {"server_offset_ms", trace->offset.offset_ns * 1e-6},

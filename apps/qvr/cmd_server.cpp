@@ -116,6 +116,8 @@ int runServer(const ServerCmdOptions& o) {
     cfg.core = o.core;
     cfg.one_pass_periphery = o.one_pass_periphery;
     cfg.holes.enabled = !o.no_holes;
+    if (o.frames_csv.empty())
+        cfg.max_frame_records = 0;
     GlRendererOptions gl;
     gl.lod_error_px = o.lod_px;
     cfg.renderer = glRendererFactory(gl);

@@ -45,7 +45,7 @@ namespace {
 // One frame waiting for its remote layers.
 struct PendingFrame {
     int64_t frame = 0;
-    size_t telemetry = 0;  // index into the result's frames
+    size_t telemetry = 0;  // the frame's index in the run (Headset::tel)
     std::shared_ptr<LayerFrame> layers;
     uint8_t expected = 0;  // stream mask
     uint8_t decoded = 0;
@@ -93,7 +93,8 @@ public:
           m_traces(traces),
           m_planner(config.profile),
           m_probe(config.profile, std::move(bvh)),
-          m_compositor(config.profile, composeOptions()) {}
+          m_compositor(config.profile, composeOptions()),
+          m_summary(designLabel(config.design, config.fixed_e1_deg), config.warmup_frames) {}
 
     static LiwcConfig liwcConfig(bool reactive) {
         LiwcConfig c;
@@ -166,7 +167,6 @@ public:
 
     HeadsetResult run() {
         HeadsetResult result;
-        result.frames.reserve(static_cast<size_t>(std::max(m_config.frames, 0)));
         m_origin_ns = m_clock.nowNs();
         result.origin_ns = m_origin_ns;
         m_pacer.reset();
@@ -184,28 +184,61 @@ public:
         // A server that refused our version, codec or profile will not change its mind: stop.
         for (int64_t i = 0; i < m_config.frames && m_refusal.empty(); ++i) {
             while (ahead.size() < depth && next < m_config.frames && !stopRequested())
-                ahead.push_back(prepare(next++, result));
+                ahead.push_back(prepare(next++));
             if (ahead.empty())
                 break;  // stopped: every started frame was finished
-            finish(ahead.front(), result);
+            finish(ahead.front());
             ahead.pop_front();
+            retireOldFrames(m_config.keep_frames);
         }
         // Streams still in flight belong to frames already shown: drain them so the server's
         // acks complete, then leave.
         if (m_client) {
-            pumpNetwork(result, 0);
+            pumpNetwork(0);
             m_stats.net = m_client->stats();
             m_client->disconnect();
         }
         m_stats.core = currentCore();
         result.stats = m_stats;
-        result.summary = summarizeRun(designLabel(m_config.design, m_config.fixed_e1_deg),
-                                      result.frames, m_config.warmup_frames);
+        // The frames still held (all of them when keep_frames is 0) go to the summary and the
+        // sink, and stay in the result.
+        result.frames.reserve(m_frames.size());
+        for (FrameTelemetry& t : m_frames) {
+            m_summary.add(t);
+            if (m_config.frame_sink)
+                m_config.frame_sink(t);
+            result.frames.push_back(std::move(t));
+        }
+        m_frames.clear();
+        result.summary = m_summary.finish();
         return result;
     }
 
 private:
     bool stopRequested() const { return m_config.stop && m_config.stop->load(); }
+
+    // A frame's telemetry by its index in the run.
+    FrameTelemetry& tel(size_t ti) { return m_frames[ti - m_frames_base]; }
+
+    // With keep_frames set, frames more than that behind the newest (and never fewer than
+    // kMinFramesHeld, past any frame whose late streams could still be counted) leave memory:
+    // into the summary and the sink. Memory then stays flat however long the session runs.
+    void retireOldFrames(size_t keep) {
+        if (keep == 0)
+            return;
+        const size_t held = std::max(keep, kMinFramesHeld);
+        while (m_frames.size() > held) {
+            m_summary.add(m_frames.front());
+            if (m_config.frame_sink)
+                m_config.frame_sink(m_frames.front());
+            m_frames.pop_front();
+            ++m_frames_base;
+        }
+        // A frame that old is long past its wait limit: its streams, if they ever come, only
+        // feed the decoders' reference chains.
+        for (auto it = m_pending.begin(); it != m_pending.end();)
+            it = it->telemetry < m_frames_base ? m_pending.erase(it) : std::next(it);
+    }
     int64_t rel(int64_t t_ns) const { return t_ns - m_origin_ns; }
     double frameTimeMs(int64_t i) const { return 1000.0 * double(i) / m_config.profile.refresh_hz; }
 
@@ -217,6 +250,7 @@ private:
         m_last_connect_try_ns = now_ns;
         if (auto st = m_client->connect(m_config.host, m_config.port); st) {
             ++m_stats.connects;
+            m_last_stream_ns = m_clock.nowNs();  // a new session has a whole limit to start
             // A new session: new encoders on the server, so new decoders here.
             for (auto& d : m_decoders)
                 d.reset();
@@ -251,13 +285,14 @@ private:
         return nullptr;
     }
 
-    void onStream(net::CompletedStream& cs, HeadsetResult& result) {
+    void onStream(net::CompletedStream& cs) {
         ++m_stats.streams_received;
+        m_last_stream_ns = m_clock.nowNs();
         if (cs.stream_id >= net::kMaxStreams)
             return;
         PendingFrame* p = pendingFor(cs.frame_id);
         if (p) {
-            FrameTelemetry& t = result.frames[p->telemetry];
+            FrameTelemetry& t = tel(p->telemetry);
             t.stream_rx_ns[cs.stream_id] = rel(cs.last_rx_ns);
             p->last_rx_ns = std::max(p->last_rx_ns, cs.last_rx_ns);
             t.bytes += static_cast<int64_t>(cs.bytes.size());
@@ -298,7 +333,7 @@ private:
         }
         layerSlot(*p->layers, cs.stream_id) = std::move(*image);
         p->decoded |= static_cast<uint8_t>(1u << cs.stream_id);
-        FrameTelemetry& t = result.frames[p->telemetry];
+        FrameTelemetry& t = tel(p->telemetry);
         t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
         if (p->complete()) {
             t.remote_done_ns = rel(m_clock.nowNs());
@@ -310,7 +345,7 @@ private:
     }
 
     // Takes what the transport has, waiting up to wait_ms for the first stream.
-    void pumpNetwork(HeadsetResult& result, int wait_ms) {
+    void pumpNetwork(int wait_ms) {
         if (!m_client)
             return;
         int timeout_ms = wait_ms;
@@ -328,14 +363,14 @@ private:
             }
             if (!next->has_value())
                 break;
-            onStream(**next, result);
+            onStream(**next);
             timeout_ms = 0;
         }
         for (const net::LostStream& l : m_client->takeLost()) {
             ++m_stats.streams_lost;
             if (PendingFrame* p = pendingFor(l.frame_id)) {
                 p->failed |= static_cast<uint8_t>(1u << l.stream_id);
-                result.frames[p->telemetry].bytes += l.bytes_received;
+                tel(p->telemetry).bytes += l.bytes_received;
                 p->bytes[l.stream_id] += l.bytes_received;
             }
         }
@@ -357,12 +392,12 @@ private:
     };
 
     // Steps 1–3: pose sample, decision, request.
-    Prepared prepare(int64_t i, HeadsetResult& result) {
+    Prepared prepare(int64_t i) {
         if (m_config.before_frame)
             m_config.before_frame(i);
-        result.frames.emplace_back();
-        const size_t ti = result.frames.size() - 1;
-        FrameTelemetry& t0 = result.frames[ti];
+        m_frames.emplace_back();
+        const size_t ti = m_frames_base + m_frames.size() - 1;
+        FrameTelemetry& t0 = tel(ti);
         t0.frame = i;
 
         // 1. Pose and gaze sample: the start of motion-to-photon.
@@ -374,13 +409,13 @@ private:
 
         // Keep the transport drained and the session alive.
         if (m_client) {
-            pumpNetwork(result, 0);
+            pumpNetwork(0);
             if (!m_client->connected())
                 tryConnect(false);
             m_was_connected = m_client->connected();
         }
         const bool connected = m_client && m_client->connected();
-        result.frames[ti].connected = connected;
+        tel(ti).connected = connected;
 
         // 2. Decision: e1 before rendering.
         const bool needs_workload = m_config.design == RuntimeDesign::kQvr ||
@@ -439,7 +474,7 @@ private:
         }
         if (m_config.workload && wf)
             m_config.workload->writeFrame(*wf);
-        FrameTelemetry* t = &result.frames[ti];
+        FrameTelemetry* t = &tel(ti);
         t->decision_ns = rel(m_clock.nowNs());
         t->fallback_local = fallback;
         t->probe_ms = probe_ms;
@@ -495,7 +530,7 @@ private:
     }
 
     // Steps 4–7: fovea, remote layers, UCA, scan-out, what the policy learns.
-    void finish(Prepared& prep, HeadsetResult& result) {
+    void finish(Prepared& prep) {
         const int64_t i = prep.frame;
         const size_t ti = prep.telemetry;
         const int64_t pose_ns = prep.pose_ns;
@@ -506,7 +541,7 @@ private:
         const bool decided = prep.decided;
         const uint8_t expected = prep.expected;
         const std::shared_ptr<LayerFrame>& layers = prep.layers;
-        FrameTelemetry* t = &result.frames[ti];
+        FrameTelemetry* t = &tel(ti);
 
         // 4. The fovea (or the whole frame) locally.
         const int64_t local_start_ns = m_clock.nowNs();
@@ -520,7 +555,7 @@ private:
                 ++m_stats.render_failures;
         }
         const int64_t local_end_ns = m_clock.nowNs();
-        t = &result.frames[ti];
+        t = &tel(ti);
         t->local_end_ns = rel(local_end_ns);
         t->t_local_ms = double(local_end_ns - local_start_ns) * 1e-6;
 
@@ -532,8 +567,18 @@ private:
             const PendingFrame* started = pendingFor(i);
             const int64_t wait_from_ns =
                 std::max({local_end_ns, pose_ns, started ? started->service_start_ns : 0});
+            // A server that has delivered no stream for a whole wait limit is stalled or its
+            // link is dead: waiting the limit for every frame would drop the display to
+            // 1 / limit (4 Hz at 250 ms, measured under a 2 s SIGSTOP of the server). Then
+            // wait one refresh and re-warp the newest layers, until streams come again.
+            const int64_t limit_ns = static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
+            const bool silent = local_end_ns - m_last_stream_ns > limit_ns;
             const int64_t deadline_ns =
-                wait_from_ns + static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
+                silent ? std::max(local_end_ns, pose_ns) +
+                             static_cast<int64_t>(1e9 / m_config.profile.refresh_hz)
+                       : wait_from_ns + limit_ns;
+            if (silent)
+                ++m_stats.silent_server_frames;
             for (;;) {
                 PendingFrame* p = pendingFor(i);
                 if (!p || p->complete() || p->broken())
@@ -543,10 +588,10 @@ private:
                     break;
                 const int wait_ms =
                     static_cast<int>(std::clamp<int64_t>((deadline_ns - now_ns) / 1'000'000, 1, 5));
-                pumpNetwork(result, wait_ms);
+                pumpNetwork(wait_ms);
             }
             PendingFrame* p = pendingFor(i);
-            t = &result.frames[ti];
+            t = &tel(ti);
             have_current = p && p->complete();
             const int64_t now_ns = m_clock.nowNs();
             const int64_t decoded_ns = have_current ? m_origin_ns + t->remote_done_ns : now_ns;
@@ -587,7 +632,7 @@ private:
             reused = true;
         }
         const int64_t uca_end_ns = m_clock.nowNs();
-        t = &result.frames[ti];
+        t = &tel(ti);
         t->uca_start_ns = rel(uca_start_ns);
         t->uca_end_ns = rel(uca_end_ns);
         t->uca_ms = double(uca_end_ns - uca_start_ns) * 1e-6;
@@ -607,12 +652,12 @@ private:
         {
             const int64_t now_ns = m_clock.nowNs();
             if (m_last_finish_ns > 0)
-                result.frames[ti].headset_busy_ms =
+                tel(ti).headset_busy_ms =
                     double(std::max<int64_t>(0, now_ns - m_last_finish_ns - m_idle_ns)) * 1e-6;
             m_last_finish_ns = now_ns;
             m_idle_ns = 0;
         }
-        t = &result.frames[ti];
+        t = &tel(ti);
         t->display_ns = rel(display_ns);
         if (m_config.display && report) {
             const LayerFrame* shown = m_compositor.newestFrame();
@@ -665,6 +710,7 @@ private:
     }
 
     static constexpr size_t kMaxPendingFrames = 8;
+    static constexpr size_t kMinFramesHeld = 64;
     static constexpr int kKeyMismatchBackoffMs = 2000;
 
     const HeadsetConfig& m_config;
@@ -683,13 +729,17 @@ private:
     std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;
     std::array<int64_t, net::kMaxStreams> m_last_key_request_ns{};
     std::deque<PendingFrame> m_pending;
+    std::deque<FrameTelemetry> m_frames;  // the frames not yet retired, from m_frames_base
+    size_t m_frames_base = 0;
+    RunSummarizer m_summary;
     std::array<ImageRgba8, 2> m_display;
     HeadsetStats m_stats;
     int64_t m_origin_ns = 0;
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
     int64_t m_last_complete_rx_ns = 0;
-    int64_t m_idle_ns = 0;  // waiting for the network or vsync since the last frame finished
+    int64_t m_last_stream_ns = 0;  // the newest stream from the server, or the session's start
+    int64_t m_idle_ns = 0;         // waiting for the network or vsync since the last frame finished
     int64_t m_last_finish_ns = 0;
     size_t m_depth = 1;
     uint64_t m_proof_failures_seen = 0;

@@ -284,8 +284,9 @@ struct RenderServer::Impl final : net::ServerHandler {
             }
             rec.done_ns = steadyNs();
             std::lock_guard lock(mutex);
-            records.push_back(rec);
-            while (records.size() > RenderServer::kMaxFrameRecords)
+            if (config.max_frame_records > 0)
+                records.push_back(rec);
+            while (records.size() > config.max_frame_records)
                 records.pop_front();
             ++stats.frames_rendered;
             stats.layers_rendered += delta.layers_rendered;

@@ -19,62 +19,135 @@ double percentile(std::vector<double> values, double p) {
     return values[idx];
 }
 
-DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& all,
-                           int warmup_frames) {
-    DesignSummary s;
-    s.design = design;
-    const size_t skip = warmup_frames > 0 && all.size() > static_cast<size_t>(warmup_frames)
-                            ? static_cast<size_t>(warmup_frames)
-                            : 0;
-    s.warmup_frames = static_cast<int>(skip);
-    for (size_t k = 0; k < skip; ++k)
-        s.startup_mtp_ms_max = std::max(s.startup_mtp_ms_max, all[k].mtp_ms);
-    const std::vector<FrameTelemetry> frames(all.begin() + static_cast<std::ptrdiff_t>(skip),
-                                             all.end());
-    s.frames = static_cast<int>(frames.size());
-    std::vector<double> mtp;
-    double bytes = 0, e1 = 0, t_local = 0, t_remote = 0, uca = 0;
-    int remote_frames = 0;
-    int64_t first_display = -1, last_display = -1;
-    for (const FrameTelemetry& t : frames) {
-        if (t.display_ns >= 0) {
-            ++s.frames_displayed;
-            if (first_display < 0)
-                first_display = t.display_ns;
-            last_display = t.display_ns;
+namespace {
+
+// Log-spaced MTP bins: [kHistMinMs · r^b, kHistMinMs · r^(b+1)), r = 1.001, up to 10⁷ ms.
+constexpr double kHistMinMs = 1e-3;
+constexpr double kHistRatio = 1.001;
+const double kHistLogRatio = std::log(kHistRatio);
+const size_t kHistBins = static_cast<size_t>(std::ceil(std::log(1e7 / kHistMinMs) / kHistLogRatio));
+
+size_t histBin(double ms) {
+    if (!(ms > kHistMinMs))
+        return 0;
+    const double b = std::floor(std::log(ms / kHistMinMs) / kHistLogRatio);
+    return static_cast<size_t>(std::min(b, static_cast<double>(kHistBins - 1)));
+}
+
+}  // namespace
+
+RunSummarizer::RunSummarizer(std::string design, int warmup_frames)
+    : m_warmup(warmup_frames > 0 ? static_cast<size_t>(warmup_frames) : 0) {
+    m_s.design = std::move(design);
+    m_startup.reserve(m_warmup);
+}
+
+void RunSummarizer::add(const FrameTelemetry& t) {
+    if (!m_startup_done) {
+        if (m_startup.size() < m_warmup) {
+            m_startup.push_back(t);
+            return;
         }
-        if (t.reused)
-            ++s.frames_reused;
-        if (t.fallback_local)
-            s.frames_fallback_local += 1;
-        mtp.push_back(t.mtp_ms);
-        bytes += static_cast<double>(t.bytes);
-        e1 += t.e1_deg;
-        t_local += t.t_local_ms;
-        uca += t.uca_ms;
-        if (t.remote_requested) {
-            t_remote += t.t_remote_ms;
-            ++remote_frames;
+        // A frame past the start-up: the frames held were the start-up, left out.
+        m_startup_done = true;
+        m_s.warmup_frames = static_cast<int>(m_startup.size());
+        for (const FrameTelemetry& s : m_startup)
+            m_s.startup_mtp_ms_max = std::max(m_s.startup_mtp_ms_max, s.mtp_ms);
+        std::vector<FrameTelemetry>().swap(m_startup);
+    }
+    count(t);
+}
+
+void RunSummarizer::count(const FrameTelemetry& t) {
+    if (m_s.frames == 0)
+        m_first_pose_ns = t.pose_ns;
+    m_last_display_ns = t.display_ns;
+    ++m_s.frames;
+    if (t.display_ns >= 0) {
+        ++m_s.frames_displayed;
+        if (m_first_display < 0)
+            m_first_display = t.display_ns;
+        m_last_display = t.display_ns;
+    }
+    if (t.reused)
+        ++m_s.frames_reused;
+    if (t.fallback_local)
+        m_s.frames_fallback_local += 1;
+    m_mtp_sum += t.mtp_ms;
+    m_mtp_min = m_s.frames == 1 ? t.mtp_ms : std::min(m_mtp_min, t.mtp_ms);
+    m_mtp_max = m_s.frames == 1 ? t.mtp_ms : std::max(m_mtp_max, t.mtp_ms);
+    if (m_mtp_hist.empty() && m_mtp_exact.size() < kExactMtpFrames) {
+        m_mtp_exact.push_back(t.mtp_ms);
+    } else {
+        if (m_mtp_hist.empty()) {
+            m_mtp_hist.assign(kHistBins, 0);
+            for (double v : m_mtp_exact)
+                ++m_mtp_hist[histBin(v)];
+            std::vector<double>().swap(m_mtp_exact);
         }
+        ++m_mtp_hist[histBin(t.mtp_ms)];
     }
-    if (!frames.empty()) {
-        const double n = static_cast<double>(frames.size());
-        s.mtp_ms_mean = std::accumulate(mtp.begin(), mtp.end(), 0.0) / n;
-        s.mtp_ms_p99 = percentile(mtp, 99.0);
-        s.bytes_per_frame_mean = bytes / n;
-        s.e1_deg_mean = e1 / n;
-        s.t_local_ms_mean = t_local / n;
-        s.uca_ms_mean = uca / n;
-        s.wall_s = static_cast<double>(frames.back().display_ns - frames.front().pose_ns) * 1e-9;
+    m_bytes += static_cast<double>(t.bytes);
+    m_e1 += t.e1_deg;
+    m_t_local += t.t_local_ms;
+    m_uca += t.uca_ms;
+    if (t.remote_requested) {
+        m_t_remote += t.t_remote_ms;
+        ++m_remote_frames;
     }
-    if (remote_frames > 0)
-        s.t_remote_ms_mean = t_remote / remote_frames;
+}
+
+double RunSummarizer::mtpP99() const {
+    if (m_mtp_hist.empty())
+        return percentile(m_mtp_exact, 99.0);
+    // Nearest rank, as percentile(): the bin holding it, at its geometric middle, within the
+    // values seen.
+    const uint64_t rank = static_cast<uint64_t>(std::ceil(0.99 * static_cast<double>(m_s.frames)));
+    uint64_t seen = 0;
+    for (size_t b = 0; b < m_mtp_hist.size(); ++b) {
+        seen += m_mtp_hist[b];
+        if (seen >= rank)
+            return std::clamp(kHistMinMs * std::pow(kHistRatio, double(b) + 0.5), m_mtp_min,
+                              m_mtp_max);
+    }
+    return m_mtp_max;
+}
+
+DesignSummary RunSummarizer::finish() const {
+    if (!m_startup_done && !m_startup.empty()) {
+        // No frame past the start-up: summarize every frame.
+        RunSummarizer all(m_s.design, 0);
+        for (const FrameTelemetry& t : m_startup)
+            all.add(t);
+        return all.finish();
+    }
+    DesignSummary s = m_s;
+    if (s.frames > 0) {
+        const double n = static_cast<double>(s.frames);
+        s.mtp_ms_mean = m_mtp_sum / n;
+        s.mtp_ms_p99 = mtpP99();
+        s.bytes_per_frame_mean = m_bytes / n;
+        s.e1_deg_mean = m_e1 / n;
+        s.t_local_ms_mean = m_t_local / n;
+        s.uca_ms_mean = m_uca / n;
+        s.wall_s = static_cast<double>(m_last_display_ns - m_first_pose_ns) * 1e-9;
+    }
+    if (m_remote_frames > 0)
+        s.t_remote_ms_mean = m_t_remote / m_remote_frames;
     // Frames per second of scan-out: displays over the time between the first and the last,
     // so start-up does not count.
-    if (s.frames_displayed > 1 && last_display > first_display)
+    if (s.frames_displayed > 1 && m_last_display > m_first_display)
         s.fps_mean = static_cast<double>(s.frames_displayed - 1) * 1e9 /
-                     static_cast<double>(last_display - first_display);
+                     static_cast<double>(m_last_display - m_first_display);
     return s;
+}
+
+DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& all,
+                           int warmup_frames) {
+    RunSummarizer r(design, warmup_frames);
+    for (const FrameTelemetry& t : all)
+        r.add(t);
+    return r.finish();
 }
 
 std::string telemetryCsvHeader() {

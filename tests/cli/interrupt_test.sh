@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Stopping keeps the data (issue 12): `qvr server` and `qvr run` ended by SIGINT/SIGTERM at a
-# frame boundary write everything measured so far. The server's --stats-json and --frames-csv
+# Stopping keeps the data (issue 12): `qvr server`, `qvr client` and `qvr run` ended by
+# SIGINT/SIGTERM at a frame boundary write everything measured so far. The server's --stats-json and --frames-csv
 # agree on the frames it rendered; an interrupted `qvr run` leaves summary.json (interrupted,
 # the frames done), one telemetry row per frame done, the server's stats and a report, and
 # exits 130. Usage: interrupt_test.sh /path/to/qvr
@@ -78,11 +78,24 @@ assert d['clients_accepted'] == 1, d
         fail "server SIGINT writes stats and frames.csv" \
             "exit $rc: $(head -c 300 "$tmp/server_err.txt"); $(head -c 300 "$tmp/stats.json" 2>/dev/null)"
     fi
-    # The client outlives its server (local fallback); end it the same way.
+    # The client outlives its server (local fallback); end it the same way, after long enough
+    # for frames to have left its memory for telemetry.csv (it holds the newest 64 at least).
+    sleep 4
     interrupt "$client_pid"
     rc=$?
-    if [ $rc -eq 130 ] && [ -f "$tmp/client/summary.json" ]; then
-        pass "client outliving its server ends on SIGINT with its summary (exit 130)"
+    # Its telemetry streams to disk as frames age out of memory: one row per frame done, in
+    # order, however many frames that was (more than the 4096 it keeps for trace.json is a
+    # minute; this is hundreds).
+    if [ $rc -eq 130 ] && python3 -c "
+import csv, json, sys
+d = json.load(open(sys.argv[1] + '/summary.json'))
+rows = list(csv.DictReader(open(sys.argv[1] + '/telemetry.csv')))
+assert d['interrupted'] is True and 64 < d['frames'] < 100000, d
+assert len(rows) == d['frames'], (len(rows), d['frames'])
+assert [int(r['frame']) for r in rows] == list(range(d['frames'])), 'rows are not frames 0..N-1'
+assert d['trace']['frames'] == min(d['frames'], 4096), d['trace']
+" "$tmp/client"; then
+        pass "client outliving its server ends on SIGINT with its summary and one telemetry row per frame (exit 130)"
     else
         fail "client outliving its server ends on SIGINT" "exit $rc: $(head -c 300 "$tmp/client_err.txt")"
     fi

@@ -242,6 +242,64 @@ TEST(Runtime, FivePercentPacketLossKeepsFramesComingWithReusedFramesCounted) {
     EXPECT_GT(fresh_late, 5);
 }
 
+TEST(Runtime, ALongSessionHoldsOnlyItsNewestFramesAndStreamsTheRestInOrder) {
+    // qvr client's mode: keep_frames bounds the telemetry in memory; every frame still reaches
+    // the sink once, in order, and the summary is the whole session's (over lossy media, so
+    // late streams of frames already shown do arrive while older frames are retired).
+    auto server = RenderServer::start(serverConfig("wifi,loss=0.05,seed=5", "raw"), world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    HeadsetConfig h = headsetConfig(RuntimeDesign::kQvr, (*server)->port(), "raw", 200);
+    h.keep_frames = 10;  // held: at least 64
+    h.warmup_frames = 10;
+    std::vector<FrameTelemetry> sunk;
+    h.frame_sink = [&sunk](const FrameTelemetry& t) { sunk.push_back(t); };
+    const HeadsetResult r = runOn(h);
+    ASSERT_EQ(sunk.size(), 200u);
+    for (size_t i = 0; i < sunk.size(); ++i)
+        ASSERT_EQ(sunk[i].frame, static_cast<int64_t>(i));
+    ASSERT_EQ(r.frames.size(), 64u);
+    EXPECT_EQ(r.frames.front().frame, 200 - 64);
+    EXPECT_EQ(r.frames.back().bytes, sunk.back().bytes);
+    const DesignSummary whole = summarizeRun("qvr", sunk, 10);
+    EXPECT_EQ(r.summary.frames, 190);
+    EXPECT_EQ(r.summary.frames_displayed, whole.frames_displayed);
+    EXPECT_EQ(r.summary.frames_reused, whole.frames_reused);
+    EXPECT_DOUBLE_EQ(r.summary.mtp_ms_p99, whole.mtp_ms_p99);
+    EXPECT_DOUBLE_EQ(r.summary.bytes_per_frame_mean, whole.bytes_per_frame_mean);
+    EXPECT_GT(whole.bytes_per_frame_mean, 0.0);
+}
+
+TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
+    // The server's render thread stops for 1.5 s after its 20th frame (as under SIGSTOP). The
+    // headset keeps scanning out at its own rate, re-warping the newest layers it has, and shows
+    // fresh frames again once the server resumes. (Before: every frame of the stall waited the
+    // whole 250 ms wait limit, a 4 Hz display.)
+    RenderServerConfig sc = serverConfig("none", "raw");
+    std::atomic<int> served{0};
+    sc.on_frame = [&served](const ServerFrameStamps&) {
+        if (++served == 20)
+            std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    };
+    auto server = RenderServer::start(sc, world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    const HeadsetResult r =
+        runOn(headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 240));
+    ASSERT_EQ(r.frames.size(), 240u);
+    // The first frame into the stall waits the limit (nothing yet says the server stopped);
+    // after it the display keeps its rate (before: six 250 ms gaps in a row).
+    int long_gaps = 0;
+    for (size_t i = 1; i < r.frames.size(); ++i)
+        long_gaps += r.frames[i].display_ns - r.frames[i - 1].display_ns > 100'000'000;
+    EXPECT_LE(long_gaps, 1);
+    EXPECT_GT(r.stats.silent_server_frames, 30u);
+    EXPECT_GT(r.summary.frames_reused, 30);
+    // Fresh frames again after the stall: the last 40 frames come from the server.
+    int fresh_tail = 0;
+    for (size_t i = 200; i < 240; ++i)
+        fresh_tail += r.frames[i].reused ? 0 : 1;
+    EXPECT_GT(fresh_tail, 30);
+}
+
 TEST(Runtime, KillingTheServerLeavesTheHeadsetDisplayingAndItReconnects) {
     auto first = RenderServer::start(serverConfig("none", "raw"), world().scene);
     ASSERT_TRUE(first.ok()) << first.error();

@@ -85,6 +85,12 @@ struct HeadsetConfig {
     DisplaySink* display = nullptr;
     WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set
     std::function<void(int64_t frame)> before_frame;  // test hook, called at each frame start
+    // Every frame's telemetry, once final, in order (e.g. a CSV written as the session runs).
+    std::function<void(const FrameTelemetry&)> frame_sink;
+    // 0: HeadsetResult::frames holds every frame (qvr run). N: only the newest N (at least 64)
+    // stay in memory, the rest go to frame_sink and the summary as they age, so a session of
+    // any length runs in flat memory (qvr client).
+    size_t keep_frames = 0;
     // When set and true (e.g. from a SIGINT handler), no new frame starts; the frames already
     // started are finished, so the result holds every frame shown and nothing half-done.
     const std::atomic<bool>* stop = nullptr;
@@ -98,6 +104,9 @@ struct HeadsetStats {
     uint64_t streams_discarded = 0;  // decoded for the reference chain, frame already shown
     uint64_t key_frame_requests = 0;
     uint64_t late_frames = 0;
+    // Frames that waited one refresh, not the wait limit, because the server had sent nothing
+    // for a whole limit (stalled, killed, or its link dead): the display keeps its rate.
+    uint64_t silent_server_frames = 0;
     uint64_t connects = 0;
     uint64_t connect_failures = 0;
     uint64_t disconnects = 0;
@@ -108,8 +117,8 @@ struct HeadsetStats {
 };
 
 struct HeadsetResult {
-    int64_t origin_ns = 0;  // the pacing clock at the run's start: telemetry's 0
-    std::vector<FrameTelemetry> frames;
+    int64_t origin_ns = 0;               // the pacing clock at the run's start: telemetry's 0
+    std::vector<FrameTelemetry> frames;  // every frame, or the newest keep_frames
     HeadsetStats stats;
     DesignSummary summary;
 };

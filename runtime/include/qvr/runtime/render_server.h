@@ -57,6 +57,9 @@ struct RenderServerConfig {
     // displays); with LOD at the paper's display the extended grid's fill costs more than the
     // second pass saves (docs/RUNTIME.md), so it is off by default.
     bool one_pass_periphery = false;
+    // Served frames kept for frameRecords(), newest last (0: none, so a long-running server
+    // that nobody asks for them holds no per-frame memory).
+    size_t max_frame_records = 100'000;
     // Called on the render thread after each rendered request (keep it cheap).
     std::function<void(const ServerFrameStamps&)> on_frame;
     // Leave out of each periphery layer the clusters the compositor takes from a finer layer
@@ -114,9 +117,8 @@ public:
     void stop();
     uint16_t port() const;
     RenderServerStats stats() const;
-    // The newest served frames, oldest first (at most kMaxFrameRecords).
+    // The newest served frames, oldest first (at most config.max_frame_records).
     std::vector<ServerFrameRecord> frameRecords() const;
-    static constexpr size_t kMaxFrameRecords = 100'000;
     size_t clients() const;
 
     struct Impl;

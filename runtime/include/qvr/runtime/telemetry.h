@@ -81,6 +81,38 @@ struct DesignSummary {
 // Statistics over frames[warmup_frames…] (all frames when there are no more than that).
 DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTelemetry>& frames,
                            int warmup_frames = 0);
+
+// The same statistics, one frame at a time in display order, in memory that does not grow with
+// the session (a `qvr client` may run for hours): the MTP p99 is exact over the first
+// kExactMtpFrames frames and beyond that read from a log-spaced histogram (relative error
+// ≤ 0.05%). summarizeRun is this over a vector.
+class RunSummarizer {
+public:
+    static constexpr size_t kExactMtpFrames = size_t{1} << 16;
+
+    RunSummarizer(std::string design, int warmup_frames);
+    void add(const FrameTelemetry& t);
+    DesignSummary finish() const;
+
+private:
+    void count(const FrameTelemetry& t);
+    double mtpP99() const;
+
+    DesignSummary m_s;
+    size_t m_warmup = 0;
+    // The first warmup frames wait here until a later one proves they were the start-up (a
+    // session of no more frames than that is summarized whole).
+    std::vector<FrameTelemetry> m_startup;
+    bool m_startup_done = false;
+    double m_mtp_sum = 0.0, m_bytes = 0.0, m_e1 = 0.0, m_t_local = 0.0, m_t_remote = 0.0;
+    double m_uca = 0.0;
+    int m_remote_frames = 0;
+    int64_t m_first_display = -1, m_last_display = -1;
+    int64_t m_first_pose_ns = 0, m_last_display_ns = 0;
+    std::vector<double> m_mtp_exact;   // while no more than kExactMtpFrames
+    std::vector<uint32_t> m_mtp_hist;  // after that (fixed size)
+    double m_mtp_min = 0.0, m_mtp_max = 0.0;
+};
 // Nearest-rank percentile (p in (0, 100]) of a non-empty sample; 0 when empty.
 double percentile(std::vector<double> values, double p);
 std::string telemetryCsvHeader();
