@@ -400,6 +400,11 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
             {"key_frame_requests", st.key_frame_requests + st.net.key_frame_requests_sent},
             {"fec_recoveries", st.net.assembler.fec_recoveries},
             {"fec_packets_recovered", st.net.assembler.fec_packets_recovered},
+            {"nacks_sent", st.net.assembler.nacks},
+            {"packets_recovered", st.net.assembler.packets_recovered},
+            {"media_forged", st.net.media_drops[net::WireError::kBadMac]},
+            {"media_replayed", st.net.media_drops[net::WireError::kReplayed]},
+            {"media_drops", st.net.media_drops.total()},
             {"client_core", st.core}};
 }
 
@@ -409,6 +414,56 @@ struct DesignRun {
     RuntimeDesign design() const { return spec.design; }
     std::string label() const { return spec.label(); }
 };
+
+// The transport's and the handshake's counters (issue 12): what an operator reads to see loss
+// being repaired, or an attack — the server's (all designs' sessions together) and each design's
+// headset's.
+void countersHtml(report::HtmlReport& page, const std::vector<DesignRun>& runs,
+                  const nlohmann::json& server) {
+    page.heading(2, "Transport and security counters");
+    report::Table st({"server", "count"});
+    const std::pair<const char*, const char*> server_rows[] = {
+        {"connections", "TCP connections accepted"},
+        {"clients_accepted", "sessions (key proven)"},
+        {"auth_failures", "handshakes failing the key"},
+        {"handshake_timeouts", "handshake timeouts"},
+        {"pending_evicted", "unauthenticated connections evicted (flood)"},
+        {"refused_full", "connections refused: full"},
+        {"idle_timeouts", "sessions ended idle"},
+        {"protocol_errors", "protocol errors"},
+        {"version_mismatches", "version refusals"},
+        {"settings_refusals", "settings refusals (codec, profile)"},
+        {"route_failures", "media ports unverified"},
+        {"control_forged", "forged control messages"},
+        {"control_replayed", "replayed control messages"},
+        {"control_drops", "malformed control messages dropped"},
+        {"nacks", "NACKs served"},
+        {"packets_retransmitted", "packets retransmitted"},
+        {"bytes_retransmitted", "bytes retransmitted"},
+        {"retransmissions_refused", "retransmissions refused (budget)"},
+        {"fec_frames", "stream frames with FEC parity"},
+        {"fec_parity_bytes", "FEC parity bytes"},
+        {"key_frame_requests", "key-frame requests served"}};
+    for (const auto& [key, label] : server_rows)
+        if (server.contains(key) && server[key].is_number())
+            st.row({report::Cell(label, "", true), fmt::format("{}", server[key].get<double>())});
+    page.table(st);
+    report::Table ct({"design", "media forged", "media replayed", "media dropped (all reasons)",
+                      "NACKs sent", "packets recovered by NACK", "FEC rebuilt stream frames",
+                      "streams lost", "key-frame requests", "connects"});
+    for (const DesignRun& r : runs) {
+        const HeadsetStats& h = r.result.stats;
+        ct.row(
+            {r.label(), fmt::format("{}", h.net.media_drops[net::WireError::kBadMac]),
+             fmt::format("{}", h.net.media_drops[net::WireError::kReplayed]),
+             fmt::format("{}", h.net.media_drops.total()), fmt::format("{}", h.net.assembler.nacks),
+             fmt::format("{}", h.net.assembler.packets_recovered),
+             fmt::format("{}", h.net.assembler.fec_recoveries), fmt::format("{}", h.streams_lost),
+             fmt::format("{}", h.key_frame_requests + h.net.key_frame_requests_sent),
+             fmt::format("{}", h.connects)});
+    }
+    page.table(ct);
+}
 
 // What limits each design's frame rate on this machine: the headset's busy time per frame (its
 // core) against the server's service time per frame (T_remote: render, encode, link, decode
@@ -1417,6 +1472,7 @@ int runRun(const RunOptions& o) {
         page.paragraph(text);
     }
     limitsHtml(page, runs);
+    countersHtml(page, runs, j["server"]);
     page.html(validationHtml(dj, calibration->note + "; workload: " + trace_source, sim_note));
     page.heading(2, "Against the paper");
     {

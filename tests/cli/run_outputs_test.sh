@@ -36,6 +36,12 @@ assert "<source src='qvr_display.mp4' type='video/mp4'>" in html, "no video elem
 assert "<img src='qvr_display_still.png'" in html, "no still"
 for key in ["fps_mean", "mtp_ms_mean", "frames_displayed"]:
     assert key in d["designs"]["local"], key
+# The transport's and the handshake's counters, in summary.json and in the report.
+for key in ["nacks_sent", "media_forged", "media_replayed", "fec_recoveries", "streams_lost"]:
+    assert key in d["designs"]["qvr"], key
+for key in ["handshake_timeouts", "pending_evicted", "protocol_errors", "bytes_retransmitted"]:
+    assert key in d["server"], key
+assert "Transport and security counters" in html and "handshake timeouts" in html
 # trace.json: Chrome trace events; every frame's stages in order on one (the headset's) clock.
 t = json.load(open(os.path.join(out, "trace.json")))
 assert d["trace"]["events"] == len(t["traceEvents"]), (d["trace"], len(t["traceEvents"]))
