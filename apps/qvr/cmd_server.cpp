@@ -192,6 +192,7 @@ int runServer(const ServerCmdOptions& o) {
                                   {"refused_full", s.net.refused_full},
                                   {"pending_evicted", s.net.pending_evicted},
                                   {"idle_timeouts", s.net.idle_timeouts},
+                                  {"keepalives", s.net.keepalives},
                                   {"protocol_errors", s.net.protocol_errors},
                                   {"version_mismatches", s.net.version_mismatches},
                                   {"settings_refusals", s.net.settings_refusals},

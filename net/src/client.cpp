@@ -99,6 +99,7 @@ struct Connection {
     std::array<int64_t, kMaxStreams> last_key_request_ns{};
     std::thread thread;
     bool closed = false;
+    int64_t last_tx_ns = 0;  // the last sealed control message sent (the network thread's)
 };
 
 struct Client::Impl {
@@ -373,6 +374,7 @@ void Client::Impl::sendControl(Connection& c, const ControlMessage& m) {
     if (c.closed) {
         return;
     }
+    c.last_tx_ns = SteadyClock::instance().nowNs();
     const bool queued = c.writer.push(c.control, c.sealer.encode(m));
     if (!queued) {
         fail(c, makeError("the server stopped reading control messages"));
@@ -468,6 +470,17 @@ void Client::Impl::armExpiry(Connection& c) {
         const int64_t now_ns = SteadyClock::instance().nowNs();
         c.assembler.expire(now_ns);
         handleAssembler(c, now_ns);
+        // Nothing sent for a while (the headset renders everything itself): say we are here,
+        // or the server's idle timeout ends the session.
+        if (c.last_tx_ns == 0) {
+            c.last_tx_ns = now_ns;
+        }
+        if (options.keepalive_ms > 0 &&
+            now_ns - c.last_tx_ns >= int64_t{options.keepalive_ms} * 1'000'000) {
+            sendControl(c, KeepAlive{static_cast<uint64_t>(now_ns)});
+            std::lock_guard lock(mutex);
+            ++stats.keepalives_sent;
+        }
         armExpiry(c);
     });
 }

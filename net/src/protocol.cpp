@@ -56,6 +56,8 @@ size_t payloadBytesOf(ControlType type) {
             return 1 + 4 + 8;
         case ControlType::kRouteConfirm:
             return kRouteTokenBytes;
+        case ControlType::kKeepAlive:
+            return 8;
         case ControlType::kSealed:
             return 0;  // variable: checked by decodeControlHeader and openControl
     }
@@ -159,10 +161,13 @@ struct Encoder {
         w.u64(m.missing_mask);
     }
     void operator()(const RouteConfirm& m) { w.bytes(m.token); }
+    void operator()(const KeepAlive& m) { w.u64(m.client_send_ns); }
 };
 
 ControlType typeOf(const ControlMessage& m) {
-    return static_cast<ControlType>(m.index() + 1);  // the variant lists the types in id order
+    // The variant lists the types in id order, without the sealed envelope (12).
+    const size_t id = m.index() + 1;
+    return static_cast<ControlType>(id < static_cast<size_t>(ControlType::kSealed) ? id : id + 1);
 }
 
 WireError decodeFrameRequest(ByteReader& r, FrameRequest& m) {
@@ -567,6 +572,9 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
             out = m;
             break;
         }
+        case ControlType::kKeepAlive:
+            out = KeepAlive{r.u64()};
+            break;
         case ControlType::kSealed:
             return WireError::kUnknownType;  // unreachable: payloadBytesOf is 0
     }
@@ -820,6 +828,7 @@ bool sealable(ControlType type) {
         case ControlType::kBye:
         case ControlType::kNack:
         case ControlType::kRouteConfirm:
+        case ControlType::kKeepAlive:
             return true;
         case ControlType::kClientHello:
         case ControlType::kServerChallenge:

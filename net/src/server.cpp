@@ -379,6 +379,8 @@ struct Session : std::enable_shared_from_this<Session> {
         } else if (const auto* key = std::get_if<KeyFrameRequest>(&m)) {
             count([](ServerStats& st) { ++st.key_frame_requests; });
             server.handler.onKeyFrameRequest(session_id, *key);
+        } else if (std::holds_alternative<KeepAlive>(m)) {
+            count([](ServerStats& st) { ++st.keepalives; });  // last_rx_ns is what it is for
         } else if (std::holds_alternative<Bye>(m)) {
             close();
             return false;

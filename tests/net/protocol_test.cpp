@@ -51,7 +51,9 @@ std::vector<ControlMessage> everyMessage() {
             KeyFrameRequest{0b0101, 12, KeyFrameReason::kPacketLoss},
             ThroughputReport{187'000'000, 30},
             Bye{ByeReason::kAuthFailed},
-            Nack{2, 0xFFFFFFF0u, 0x8000000000000005ull}};
+            Nack{2, 0xFFFFFFF0u, 0x8000000000000005ull},
+            RouteConfirm{},
+            KeepAlive{0x0102030405060708ull}};
 }
 
 TEST(NetProtocol, EveryControlMessageRoundTrips) {
@@ -60,6 +62,8 @@ TEST(NetProtocol, EveryControlMessageRoundTrips) {
         ControlMessage back;
         ASSERT_EQ(decodeControl(wire, back), WireError::kNone) << m.index();
         ASSERT_EQ(back.index(), m.index());
+        // The type byte on the wire is the message's own id (12, the sealed envelope, is none).
+        EXPECT_EQ(wire[3], static_cast<uint8_t>(m.index() < 11 ? m.index() + 1 : m.index() + 2));
         // Re-encoding what was decoded gives the same bytes: nothing lost or invented.
         EXPECT_EQ(encodeControl(back), wire) << m.index();
     }

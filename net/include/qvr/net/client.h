@@ -23,7 +23,10 @@ struct ClientOptions {
     // NACK gaps so the server resends the missing packets (one frame's loss then costs a round
     // trip, not a key frame); assembler.retransmit follows this.
     bool retransmit = true;
-    int key_frame_retry_ms = 100;    // at most one key-frame request per stream in this time
+    int key_frame_retry_ms = 100;  // at most one key-frame request per stream in this time
+    // A KeepAlive after this long without any other control message (0: never); well under
+    // the server's idle timeout (ServerOptions::idle_timeout_ms, 10 s).
+    int keepalive_ms = kKeepAliveIntervalMs;
     size_t max_ready_streams = 256;  // completed streams the caller has not taken yet
     size_t max_control_queue = 256;
     // Sent in the ClientHello; a server with other settings refuses the session (Bye reason).
@@ -48,6 +51,7 @@ struct ClientStats {
     uint64_t frame_requests_sent = 0;
     uint64_t acks_sent = 0;
     uint64_t key_frame_requests_sent = 0;
+    uint64_t keepalives_sent = 0;        // nothing else sent for kKeepAliveIntervalMs
     uint64_t ready_streams_dropped = 0;  // the caller did not keep up
 };
 

@@ -24,7 +24,7 @@ namespace qvr::net {
 // 4: every control message after the handshake is sealed (ChaCha20-Poly1305, a key per
 // direction, a message counter as nonce), and the server checks that the client receives at its
 // media port (a sealed UDP probe echoed back) before it sends any media there.
-inline constexpr uint8_t kProtocolVersion = 4;
+inline constexpr uint8_t kProtocolVersion = 5;
 
 // Limits a decoder enforces before it trusts any length a peer sent.
 inline constexpr size_t kControlHeaderBytes = 8;
@@ -105,6 +105,7 @@ enum class ControlType : uint8_t {
     kRouteConfirm = 11,
     // The envelope of every control message after the handshake; not a ControlMessage itself.
     kSealed = 12,
+    kKeepAlive = 13,
 };
 
 struct ControlHeader {
@@ -236,9 +237,18 @@ struct RouteConfirm {
     RouteToken token{};
 };
 
+// A client with nothing else to say (its headset renders everything itself for a while, so it
+// requests no layers and receives no media to acknowledge) sends this at least every
+// kKeepAliveIntervalMs, so the server's idle timeout ends only clients that are really gone.
+struct KeepAlive {
+    uint64_t client_send_ns = 0;
+};
+inline constexpr int kKeepAliveIntervalMs = 2000;
+
+// In type-id order (typeOf), kSealed left out.
 using ControlMessage =
     std::variant<ClientHello, ServerChallenge, ClientAuth, Welcome, FrameRequest, MediaAck,
-                 KeyFrameRequest, ThroughputReport, Bye, Nack, RouteConfirm>;
+                 KeyFrameRequest, ThroughputReport, Bye, Nack, RouteConfirm, KeepAlive>;
 
 // Header + payload, ready to write.
 std::vector<uint8_t> encodeControl(const ControlMessage& message);

@@ -81,6 +81,7 @@ struct ServerStats {
     uint64_t refused_full = 0;
     uint64_t pending_evicted = 0;     // unauthenticated connections pushed out by newer ones
     uint64_t idle_timeouts = 0;       // authenticated sessions ended for silence
+    uint64_t keepalives = 0;          // KeepAlive messages from clients with nothing else to say
     uint64_t protocol_errors = 0;     // wrong message for the state, or a broken stream
     uint64_t version_mismatches = 0;  // a ClientHello of another protocol version
     uint64_t settings_refusals = 0;   // authenticated, but another codec or display profile
