@@ -3,10 +3,12 @@
 measured from the client's own telemetry.
 
 For every case a fresh server (the link emulator on its media egress set by the case's --net
-spec) and a client run FRAMES frames; faults that are events (SIGSTOP, SIGKILL, a pre-auth
+spec) and a client (design ffr unless --design says otherwise, so every frame needs the
+network) run FRAMES frames; faults that are events (SIGSTOP, SIGKILL, a pre-auth
 flood) start once the server has served its first frames. From telemetry.csv:
 
-  fresh      frames shown with this frame's own remote layers (not reused, not all-local)
+  fresh      frames shown with this frame's own content: its remote layers arrived in time (or
+             the policy drew the whole frame locally; counted apart for --design qvr)
   reused     frames whose display re-warped older layers (late or lost streams)
   all-local  frames rendered entirely on the headset (no session)
   gap        the longest time between two fresh frames' scan-outs, ms
@@ -79,10 +81,13 @@ def start_server(qvr, spec, port, folder, tag="server"):
     return p, None, stamps
 
 
+DESIGN = "ffr"  # every frame needs the network (qvr may render a frame all-locally by choice)
+
+
 def start_client(qvr, port, frames, folder, tag="client"):
     return subprocess.Popen(
         [qvr, "client", "--key", KEY, "--connect", "127.0.0.1:%d" % port, "--profile", "small",
-         "--codec", "x264", "--design", "qvr", "--frames", str(frames), "--out",
+         "--codec", "x264", "--design", DESIGN, "--frames", str(frames), "--out",
          os.path.join(folder, tag)],
         stdout=open(os.path.join(folder, tag + "_out.txt"), "w"),
         stderr=open(os.path.join(folder, tag + "_err.txt"), "w"))
@@ -181,7 +186,7 @@ def analyse(folder, events):
     rows = list(csv.DictReader(open(os.path.join(folder, "telemetry.csv"))))
     origin = summary["clock_origin_ns"]
     fresh_ns = []
-    shown = reused = local = fresh = 0
+    shown = reused = local = fresh = by_choice = 0
     for r in rows:
         d = int(r["display_ns"])
         if d < 0:
@@ -194,6 +199,8 @@ def analyse(folder, events):
         else:
             fresh += 1
             fresh_ns.append(origin + d)
+            # Fresh without the network: the policy drew the whole frame on the headset.
+            by_choice += r["remote_requested"] == "0"
     gap = max((b - a for a, b in zip(fresh_ns, fresh_ns[1:])), default=0) * 1e-6
     recovery = None
     if events:
@@ -203,6 +210,8 @@ def analyse(folder, events):
         recovery = (after[0] - end_ns) * 1e-6 if after else float("inf")
     return {"frames": len(rows), "shown": shown, "fresh": fresh, "reused": reused,
             "all_local": local, "fresh_pct": 100.0 * fresh / max(1, len(rows)),
+            "fresh_local_by_choice": by_choice, "connects_seen": summary.get("connects", 0),
+            "keepalives": summary.get("keepalives_sent", 0),
             "longest_gap_ms": gap, "recovery_ms": recovery,
             "fps": summary.get("fps_mean", 0.0), "mtp_p99_ms": summary.get("mtp_ms_p99", 0.0),
             "connects": summary.get("connects", 0),
@@ -405,6 +414,7 @@ def main():
     ap.add_argument("--frames", type=int, default=1350)
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--design", default=DESIGN, help="the client's design (default ffr)")
     ap.add_argument("--duration-s", type=float, default=0.0,
                     help="run each session this long (--frames is then only a ceiling)")
     ap.add_argument("--rss-every", type=float, default=0.0,
@@ -420,6 +430,8 @@ def main():
         print("fault_matrix: unknown case(s) %s (known: %s) or --frames < 100"
               % (",".join(unknown), ",".join(CASES)), file=sys.stderr)
         return 2
+    global DESIGN
+    DESIGN = a.design
     os.makedirs(a.out, exist_ok=True)
     results = []
     for name in names:

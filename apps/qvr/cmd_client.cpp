@@ -185,6 +185,7 @@ int runClient(const ClientCmdOptions& o) {
                         {"fec_parity_unused", st.net.assembler.fec_parity_unused},
                         {"streams_lost", st.streams_lost},
                         {"late_frames", st.late_frames},
+                        {"keepalives_sent", st.net.keepalives_sent},
                         {"silent_server_frames", st.silent_server_frames}};
     // trace.json: the headset's stages, and the server's when its stamps file is given (a server
     // on this machine: qvr server --stamps-csv F; read after the server has stopped or flushed).
