@@ -414,7 +414,7 @@ def main():
     ap.add_argument("--frames", type=int, default=1350)
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--check", action="store_true")
-    ap.add_argument("--design", default=DESIGN, help="the client's design (default ffr)")
+    ap.add_argument("--design", default="ffr", help="the client's design (default ffr)")
     ap.add_argument("--duration-s", type=float, default=0.0,
                     help="run each session this long (--frames is then only a ceiling)")
     ap.add_argument("--rss-every", type=float, default=0.0,
