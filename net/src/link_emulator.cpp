@@ -15,6 +15,23 @@ bool parseDouble(std::string_view s, double& out) {
     return ec == std::errc() && p == s.data() + s.size() && std::isfinite(out);
 }
 
+// "A:B:C" into up to `n` numbers; false unless there are between min_n and n of them.
+bool parseList(std::string_view s, size_t min_n, size_t n, double* out) {
+    size_t i = 0;
+    while (true) {
+        const size_t colon = s.find(':');
+        if (i == n || !parseDouble(s.substr(0, colon), out[i])) {
+            return false;
+        }
+        ++i;
+        if (colon == std::string_view::npos) {
+            break;
+        }
+        s.remove_prefix(colon + 1);
+    }
+    return i >= min_n;
+}
+
 bool parseU64(std::string_view s, uint64_t& out) {
     const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
     return ec == std::errc() && p == s.data() + s.size();
@@ -115,9 +132,42 @@ Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
                 return bad("must be an unsigned integer");
             }
             c.seed = u;
+        } else if (key == "ge") {
+            double pr[2] = {0, 0};
+            if (!parseList(value, 2, 2, pr) || pr[0] <= 0 || pr[0] >= 1 || pr[1] <= 0 ||
+                pr[1] > 1) {
+                return bad("must be P:R, P = P(good→bad) in (0, 1), R = P(bad→good) in (0, 1]");
+            }
+            c.ge_p = pr[0];
+            c.ge_r = pr[1];
+        } else if (key == "reorder") {
+            double pm[2] = {0, 5.0};
+            if (!parseList(value, 1, 2, pm) || pm[0] < 0 || pm[0] >= 1 || pm[1] <= 0 ||
+                pm[1] > 10'000) {
+                return bad("must be P[:MS], P in [0, 1), MS in (0, 10000]");
+            }
+            c.reorder = pm[0];
+            c.reorder_ms = pm[1];
+        } else if (key == "dup") {
+            if (!parseDouble(value, v) || v < 0 || v >= 1) {
+                return bad("must be a probability in [0, 1)");
+            }
+            c.duplicate = v;
+        } else if (key == "spike") {
+            double e[3] = {0, 0, 0};
+            if (!parseList(value, 3, 3, e) || e[0] <= 0 || e[0] > 3'600'000 || e[1] <= 0 ||
+                e[1] > e[0] || e[2] <= 0 || e[2] > 10'000) {
+                return bad(
+                    "must be EVERY:LEN:EXTRA ms, 0 < LEN <= EVERY <= 3600000, "
+                    "0 < EXTRA <= 10000");
+            }
+            c.spike_every_ms = e[0];
+            c.spike_len_ms = e[1];
+            c.spike_extra_ms = e[2];
         } else {
             return makeError("link '" + spec + "': unknown option '" + std::string(key) +
-                             "' (delay_ms, jitter_ms, loss, queue_kb, seed)");
+                             "' (delay_ms, jitter_ms, loss, queue_kb, seed, ge, reorder, dup, "
+                             "spike)");
         }
     }
     return c;
@@ -126,10 +176,18 @@ Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
 LinkEmulator::LinkEmulator(LinkConfig config)
     : m_config(std::move(config)),
       m_loss_rng(m_config.seed * 0x9E3779B97F4A7C15ull + 1),
-      m_jitter_rng(m_config.seed * 0xBF58476D1CE4E5B9ull + 2) {
+      m_jitter_rng(m_config.seed * 0xBF58476D1CE4E5B9ull + 2),
+      m_fault_rng(m_config.seed * 0x94D049BB133111EBull + 3) {
     QVR_CHECK(m_config.rate_bps >= 0 && m_config.delay_ms >= 0 && m_config.jitter_ms >= 0);
     QVR_CHECK(m_config.loss >= 0 && m_config.loss < 1 && m_config.queue_bytes > 0 &&
               m_config.max_in_flight_bytes > 0);
+    QVR_CHECK(m_config.ge_p >= 0 && m_config.ge_p < 1 && m_config.ge_r >= 0 && m_config.ge_r <= 1 &&
+              (m_config.ge_p == 0 || m_config.ge_r > 0));
+    QVR_CHECK(m_config.reorder >= 0 && m_config.reorder < 1 && m_config.reorder_ms >= 0 &&
+              m_config.reorder_ms <= 10'000 && m_config.duplicate >= 0 && m_config.duplicate < 1);
+    QVR_CHECK(m_config.spike_every_ms >= 0 && m_config.spike_len_ms >= 0 &&
+              m_config.spike_len_ms <= m_config.spike_every_ms && m_config.spike_extra_ms >= 0 &&
+              m_config.spike_extra_ms <= 10'000);
     if (m_config.trace) {
         QVR_CHECK(m_config.trace->period_ms > 0 && !m_config.trace->stamps_ms.empty());
         // Dividing every stamp by target / mean compresses time so the mean becomes the target.
@@ -226,9 +284,21 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
     const int64_t bytes = static_cast<int64_t>(packet.size());
     ++m_stats.packets_in;
     m_stats.bytes_in += static_cast<uint64_t>(bytes);
+    if (!m_started) {
+        m_started = true;
+        m_origin_ns = now_ns;
+    }
     if (m_config.loss > 0 && uniform01(m_loss_rng) < m_config.loss) {
         ++m_stats.dropped_loss;
         return false;
+    }
+    if (m_config.ge_p > 0) {
+        const double u = uniform01(m_fault_rng);
+        m_ge_bad = m_ge_bad ? !(u < m_config.ge_r) : u < m_config.ge_p;
+        if (m_ge_bad) {
+            ++m_stats.dropped_burst;
+            return false;
+        }
     }
     drainQueue(now_ns);
     if (m_queue_bytes + bytes > m_config.queue_bytes ||
@@ -252,30 +322,74 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         delay_ns += (2.0 * uniform01(m_jitter_rng) - 1.0) * m_config.jitter_ms * 1e6;
         delay_ns = std::max(0.0, delay_ns);
     }
+    if (m_config.spike_every_ms > 0) {
+        const double t_ms = static_cast<double>(now_ns - m_origin_ns) * 1e-6;
+        if (std::fmod(t_ms, m_config.spike_every_ms) >=
+            m_config.spike_every_ms - m_config.spike_len_ms) {
+            delay_ns += m_config.spike_extra_ms * 1e6;
+            ++m_stats.spiked;
+        }
+    }
     // Jitter never reorders: a packet leaves the delay line no earlier than the one before it.
     const int64_t deliver_ns =
         std::max(m_last_deliver_ns, static_cast<int64_t>(std::llround(departure + delay_ns)));
+    const bool duplicate = m_config.duplicate > 0 && uniform01(m_fault_rng) < m_config.duplicate &&
+                           m_flight_bytes + 2 * bytes <= m_config.max_in_flight_bytes;
+    if (m_config.reorder > 0 && uniform01(m_fault_rng) < m_config.reorder) {
+        // Out of the delay line: the packets behind it keep their own times and pass it.
+        ++m_stats.reordered;
+        const int64_t held_ns = deliver_ns + static_cast<int64_t>(m_config.reorder_ms * 1e6);
+        if (duplicate) {
+            ++m_stats.duplicated;
+            m_held.push_back({packet, held_ns});
+            m_flight_bytes += bytes;
+        }
+        m_held.push_back({std::move(packet), held_ns});
+        m_flight_bytes += bytes;
+        return true;
+    }
     m_last_deliver_ns = deliver_ns;
+    if (duplicate) {
+        ++m_stats.duplicated;
+        m_flight.push_back({packet, deliver_ns});
+        m_flight_bytes += bytes;
+    }
     m_flight.push_back({std::move(packet), deliver_ns});
     m_flight_bytes += bytes;
     return true;
 }
 
 void LinkEmulator::deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& out) {
-    while (!m_flight.empty() && m_flight.front().deliver_ns <= now_ns) {
+    // The delay line and the held-back packets, merged by delivery time (the delay line first
+    // on a tie: a held packet was due earlier than its time).
+    while (true) {
+        const bool flight = !m_flight.empty() && m_flight.front().deliver_ns <= now_ns;
+        const bool held = !m_held.empty() && m_held.front().deliver_ns <= now_ns;
+        if (!flight && !held) {
+            break;
+        }
+        std::deque<InFlight>& from =
+            flight && (!held || m_flight.front().deliver_ns <= m_held.front().deliver_ns) ? m_flight
+                                                                                          : m_held;
         ++m_stats.packets_delivered;
-        m_stats.bytes_delivered += m_flight.front().bytes.size();
-        m_flight_bytes -= static_cast<int64_t>(m_flight.front().bytes.size());
-        out.push_back(std::move(m_flight.front().bytes));
-        m_flight.pop_front();
+        m_stats.bytes_delivered += from.front().bytes.size();
+        m_flight_bytes -= static_cast<int64_t>(from.front().bytes.size());
+        out.push_back(std::move(from.front().bytes));
+        from.pop_front();
     }
 }
 
 std::optional<int64_t> LinkEmulator::nextDeliveryNs() const {
-    if (m_flight.empty()) {
+    if (m_flight.empty() && m_held.empty()) {
         return std::nullopt;
     }
-    return m_flight.front().deliver_ns;
+    if (m_held.empty()) {
+        return m_flight.front().deliver_ns;
+    }
+    if (m_flight.empty()) {
+        return m_held.front().deliver_ns;
+    }
+    return std::min(m_flight.front().deliver_ns, m_held.front().deliver_ns);
 }
 
 }  // namespace qvr::net

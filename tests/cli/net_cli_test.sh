@@ -67,6 +67,9 @@ for d in -5 nan 1e300 inf; do
 done
 expect_exit2 "server --net rate:1e-300" server "${K[@]}" --port 0 --duration-s 1 --net rate:1e-300
 expect_exit2 "server --net rate:0" server "${K[@]}" --port 0 --duration-s 1 --net rate:0
+expect_exit2 "server --net wifi,ge=junk" server "${K[@]}" --port 0 --duration-s 1 --net wifi,ge=junk
+expect_exit2 "server --net wifi,reorder=1" server "${K[@]}" --port 0 --duration-s 1 --net wifi,reorder=1
+expect_exit2 "server --net wifi,spike=100:200:5" server "${K[@]}" --port 0 --duration-s 1 --net wifi,spike=100:200:5
 expect_exit2 "server --codec foo" server "${K[@]}" --port 0 --duration-s 1 --codec foo
 expect_exit2 "server --bind 256.1.1.1" server "${K[@]}" --port 0 --duration-s 1 --bind 256.1.1.1
 expect_exit2 "server --bind localhost (names are not bound)" server "${K[@]}" --port 0 --duration-s 1 --bind localhost

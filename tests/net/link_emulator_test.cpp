@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 
 #include "qvr/net/clock.h"
@@ -334,6 +336,139 @@ TEST(NetMahimahi, MalformedFilesAreRejectedWithTheLine) {
     ASSERT_TRUE(crlf) << crlf.error();
     EXPECT_EQ(crlf->packets(), 3);
     EXPECT_FALSE(loadMahimahiTrace("/nonexistent/trace.down"));
+}
+
+}  // namespace
+}  // namespace qvr::net
+
+namespace qvr::net {
+namespace {
+
+// Sends n 1000-byte packets 1 ms apart through a link; returns the packets as delivered, each
+// tagged with its send index (first 4 bytes).
+struct Delivered {
+    std::vector<uint32_t> order;
+    std::vector<int64_t> at_ns;
+};
+Delivered sendNumbered(LinkEmulator& link, uint32_t n, std::vector<bool>* accepted = nullptr) {
+    FakeClock clock;
+    Delivered d;
+    std::vector<std::vector<uint8_t>> out;
+    auto take = [&] {
+        out.clear();
+        link.deliver(clock.nowNs(), out);
+        for (const auto& p : out) {
+            uint32_t i = 0;
+            std::memcpy(&i, p.data(), 4);
+            d.order.push_back(i);
+            d.at_ns.push_back(clock.nowNs());
+        }
+    };
+    for (uint32_t i = 0; i < n; ++i) {
+        std::vector<uint8_t> p(1000, 0);
+        std::memcpy(p.data(), &i, 4);
+        const bool ok = link.send(std::move(p), clock.nowNs());
+        if (accepted)
+            accepted->push_back(ok);
+        take();
+        clock.setNs(clock.nowNs() + 1'000'000);
+    }
+    while (auto next = link.nextDeliveryNs()) {
+        clock.setNs(std::max(clock.nowNs(), *next));
+        take();
+    }
+    return d;
+}
+
+TEST(NetLinkFaults, GilbertElliottLosesInBurstsAtItsLongRunRate) {
+    LinkConfig c = parseLinkSpec("none,ge=0.01:0.25,seed=4").value();
+    LinkEmulator link(c);
+    std::vector<bool> ok;
+    sendNumbered(link, 200'000, &ok);
+    int64_t lost = 0, bursts = 0;
+    for (size_t i = 0; i < ok.size(); ++i) {
+        lost += !ok[i];
+        bursts += !ok[i] && (i == 0 || ok[i - 1]);
+    }
+    const double rate = double(lost) / double(ok.size());
+    EXPECT_NEAR(rate, 0.01 / 0.26, 0.004);                 // p / (p + r) = 3.85%
+    EXPECT_NEAR(double(lost) / double(bursts), 4.0, 0.3);  // mean burst 1 / r
+    EXPECT_EQ(link.stats().dropped_burst, uint64_t(lost));
+    EXPECT_EQ(link.stats().dropped_loss, 0u);
+}
+
+TEST(NetLinkFaults, ReorderedPacketsAreOvertakenAndOthersKeepOrder) {
+    LinkEmulator link(parseLinkSpec("wifi,reorder=0.05:5,seed=2").value());
+    const Delivered d = sendNumbered(link, 20'000);
+    ASSERT_EQ(d.order.size(), 20'000u);  // nothing lost, each once
+    int64_t late = 0;
+    uint32_t highest = 0;
+    for (size_t k = 0; k < d.order.size(); ++k) {
+        late += k > 0 && d.order[k] < highest;
+        highest = std::max(highest, d.order[k]);
+    }
+    // Held 5 ms with packets sent every 1 ms: each held packet arrives after ~5 later ones.
+    EXPECT_NEAR(double(late) / 20'000.0, 0.05, 0.01);
+    EXPECT_EQ(uint64_t(late), link.stats().reordered);
+    std::vector<uint32_t> sorted = d.order;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+}
+
+TEST(NetLinkFaults, DuplicatesArriveRightAfterTheirOriginal) {
+    LinkEmulator link(parseLinkSpec("wifi,dup=0.1,seed=3").value());
+    const Delivered d = sendNumbered(link, 10'000);
+    const uint64_t dups = link.stats().duplicated;
+    EXPECT_NEAR(double(dups) / 10'000.0, 0.1, 0.015);
+    ASSERT_EQ(d.order.size(), 10'000u + dups);
+    uint64_t adjacent = 0;
+    for (size_t k = 1; k < d.order.size(); ++k)
+        adjacent += d.order[k] == d.order[k - 1];
+    EXPECT_EQ(adjacent, dups);
+}
+
+TEST(NetLinkFaults, SpikesDelayExactlyThePacketsSentDuringThem) {
+    // No rate, no delay: a packet arrives when sent, or 80 ms later if sent in the last 100 ms of
+    // each second (order kept, so the ones right after a spike wait for it to drain).
+    LinkEmulator link(parseLinkSpec("none,spike=1000:100:80").value());
+    const Delivered d = sendNumbered(link, 3000);
+    ASSERT_EQ(d.order.size(), 3000u);
+    for (size_t k = 0; k < d.order.size(); ++k) {
+        const uint32_t i = d.order[k];
+        ASSERT_EQ(i, k);
+        const int64_t sent_ns = int64_t(i) * 1'000'000;
+        const bool in_spike = i % 1000 >= 900;
+        const int64_t spike_end_ns = (int64_t(i) / 1000) * 1'000'000'000 + 999'000'000 + 80'000'000;
+        if (in_spike)
+            EXPECT_EQ(d.at_ns[k], sent_ns + 80'000'000) << i;
+        else if (i % 1000 < 80 && i >= 1000)
+            EXPECT_EQ(d.at_ns[k], std::max(sent_ns, spike_end_ns - 1'000'000'000)) << i;
+        else
+            EXPECT_EQ(d.at_ns[k], sent_ns) << i;
+    }
+    EXPECT_EQ(link.stats().spiked, 300u);
+}
+
+TEST(NetLinkFaults, WithoutFaultsTheLinkIsUnchangedAndBadSpecsAreRefused) {
+    // The fault options draw from their own stream: random loss picks the same packets.
+    std::vector<bool> a, b;
+    LinkEmulator plain(parseLinkSpec("wifi,loss=0.1,seed=9").value());
+    LinkEmulator with(parseLinkSpec("wifi,loss=0.1,seed=9,dup=0.2,reorder=0.1").value());
+    sendNumbered(plain, 5000, &a);
+    sendNumbered(with, 5000, &b);
+    EXPECT_EQ(a, b);
+    for (const char* bad :
+         {"wifi,ge=junk", "wifi,ge=0.1", "wifi,ge=0.1:0", "wifi,ge=1:0.5", "wifi,ge=0.1:0.2:3",
+          "wifi,ge=nan:0.5", "wifi,reorder=1", "wifi,reorder=0.1:0", "wifi,reorder=0.1:20000",
+          "wifi,reorder=-0.1", "wifi,dup=1", "wifi,dup=x", "wifi,spike=1000:100",
+          "wifi,spike=100:200:5", "wifi,spike=1000:100:0", "wifi,spike=1000:100:99999",
+          "wifi,spike=0:0:5", "wifi,spike=1000:100:80:1"}) {
+        auto c = parseLinkSpec(bad);
+        EXPECT_FALSE(c.ok()) << bad;
+        if (!c.ok()) {
+            EXPECT_NE(c.error().find("must be"), std::string::npos) << c.error();
+        }
+    }
 }
 
 }  // namespace
