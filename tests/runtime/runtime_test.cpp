@@ -292,8 +292,9 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
     for (size_t i = 1; i < r.frames.size(); ++i)
         long_gaps += r.frames[i].display_ns - r.frames[i - 1].display_ns > 150'000'000;
     EXPECT_LE(long_gaps, 2);
-    EXPECT_GT(r.stats.silent_server_frames, 30u);
-    EXPECT_GT(r.summary.frames_reused, 30);
+    // ~135 at 90 Hz; half that and less on a slow (sanitizer) build, 6 before the fix.
+    EXPECT_GT(r.stats.silent_server_frames, 15u);
+    EXPECT_GT(r.summary.frames_reused, 15);
     // Fresh frames again after the stall: the last 40 frames come from the server.
     int fresh_tail = 0;
     for (size_t i = 200; i < 240; ++i)
