@@ -76,9 +76,9 @@ expect_exit2 "server --bind localhost (names are not bound)" server "${K[@]}" --
 expect_exit2 "server --port 70000" server "${K[@]}" --port 70000 --duration-s 1
 expect_exit2 "server --profile bogus" server "${K[@]}" --port 0 --duration-s 1 --profile bogus
 
-expect_exit2 "run --codec foo" run --codec foo --frames 2 --out "$tmp/r"
-expect_exit2 "run --net rate:1e-300" run --net rate:1e-300 --frames 2 --out "$tmp/r"
-expect_exit2 "run --out under a file" run --frames 2 --out "$tmp/a_file/sub"
+expect_exit2 "run --codec foo" run --codec foo --frames 12 --warmup-frames 0 --out "$tmp/r"
+expect_exit2 "run --net rate:1e-300" run --net rate:1e-300 --frames 12 --warmup-frames 0 --out "$tmp/r"
+expect_exit2 "run --out under a file" run --frames 12 --warmup-frames 0 --out "$tmp/a_file/sub"
 
 # --- settings negotiated in the handshake -----------------------------------------------------
 "$QVR" server "${K[@]}" --port 0 --profile small --codec x264 --duration-s 120 \
