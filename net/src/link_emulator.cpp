@@ -341,10 +341,10 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         const int64_t held_ns = deliver_ns + static_cast<int64_t>(m_config.reorder_ms * 1e6);
         if (duplicate) {
             ++m_stats.duplicated;
-            m_held.push_back({packet, held_ns});
+            holdInOrder({packet, held_ns});
             m_flight_bytes += bytes;
         }
-        m_held.push_back({std::move(packet), held_ns});
+        holdInOrder({std::move(packet), held_ns});
         m_flight_bytes += bytes;
         return true;
     }
@@ -357,6 +357,14 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
     m_flight.push_back({std::move(packet), deliver_ns});
     m_flight_bytes += bytes;
     return true;
+}
+
+void LinkEmulator::holdInOrder(InFlight p) {
+    // Held packets' due times need not rise in send order (jitter, a spike ending): keep the
+    // queue sorted so deliver() and nextDeliveryNs() can read its front.
+    const auto at = std::upper_bound(m_held.begin(), m_held.end(), p.deliver_ns,
+                                     [](int64_t t, const InFlight& h) { return t < h.deliver_ns; });
+    m_held.insert(at, std::move(p));
 }
 
 void LinkEmulator::deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& out) {

@@ -108,6 +108,8 @@ private:
     int64_t firstOpportunityAtOrAfter(double t_ns) const;
     double uniform01(std::mt19937_64& rng);
     void drainQueue(int64_t now_ns);
+    struct InFlight;
+    void holdInOrder(InFlight p);
 
     struct InFlight {
         std::vector<uint8_t> bytes;
