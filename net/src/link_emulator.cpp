@@ -133,13 +133,16 @@ Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
             }
             c.seed = u;
         } else if (key == "ge") {
-            double pr[2] = {0, 0};
-            if (!parseList(value, 2, 2, pr) || pr[0] <= 0 || pr[0] >= 1 || pr[1] <= 0 ||
-                pr[1] > 1) {
-                return bad("must be P:R, P = P(good→bad) in (0, 1), R = P(bad→good) in (0, 1]");
+            double prl[3] = {0, 0, 1.0};
+            if (!parseList(value, 2, 3, prl) || prl[0] < 0 || prl[0] >= 1 || prl[1] <= 0 ||
+                prl[1] > 1 || prl[2] <= 0 || prl[2] > 1) {
+                return bad(
+                    "must be P:R[:LOSS_BAD], P = P(good→bad) in [0, 1), R = P(bad→good) in "
+                    "(0, 1], LOSS_BAD = loss in the bad state in (0, 1] (default 1)");
             }
-            c.ge_p = pr[0];
-            c.ge_r = pr[1];
+            c.ge_p = prl[0];
+            c.ge_r = prl[1];
+            c.ge_loss_bad = prl[2];
         } else if (key == "reorder") {
             double pm[2] = {0, 5.0};
             if (!parseList(value, 1, 2, pm) || pm[0] < 0 || pm[0] >= 1 || pm[1] <= 0 ||
@@ -177,12 +180,15 @@ LinkEmulator::LinkEmulator(LinkConfig config)
     : m_config(std::move(config)),
       m_loss_rng(m_config.seed * 0x9E3779B97F4A7C15ull + 1),
       m_jitter_rng(m_config.seed * 0xBF58476D1CE4E5B9ull + 2),
-      m_fault_rng(m_config.seed * 0x94D049BB133111EBull + 3) {
+      m_ge_rng(m_config.seed * 0x94D049BB133111EBull + 3),
+      m_reorder_rng(m_config.seed * 0xD6E8FEB86659FD93ull + 4),
+      m_dup_rng(m_config.seed * 0xA0761D6478BD642Full + 5) {
     QVR_CHECK(m_config.rate_bps >= 0 && m_config.delay_ms >= 0 && m_config.jitter_ms >= 0);
     QVR_CHECK(m_config.loss >= 0 && m_config.loss < 1 && m_config.queue_bytes > 0 &&
               m_config.max_in_flight_bytes > 0);
     QVR_CHECK(m_config.ge_p >= 0 && m_config.ge_p < 1 && m_config.ge_r >= 0 && m_config.ge_r <= 1 &&
-              (m_config.ge_p == 0 || m_config.ge_r > 0));
+              (m_config.ge_p == 0 || m_config.ge_r > 0) && m_config.ge_loss_bad > 0 &&
+              m_config.ge_loss_bad <= 1);
     QVR_CHECK(m_config.reorder >= 0 && m_config.reorder < 1 && m_config.reorder_ms >= 0 &&
               m_config.reorder_ms <= 10'000 && m_config.duplicate >= 0 && m_config.duplicate < 1);
     QVR_CHECK(m_config.spike_every_ms >= 0 && m_config.spike_len_ms >= 0 &&
@@ -288,17 +294,22 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         m_started = true;
         m_origin_ns = now_ns;
     }
+    // The Gilbert-Elliott chain steps on every packet, before random loss looks at it, so the
+    // bursts are the same whether or not loss= is on too.
+    bool burst_lost = false;
+    if (m_config.ge_p > 0) {
+        const double u = uniform01(m_ge_rng);
+        m_ge_bad = m_ge_bad ? !(u < m_config.ge_r) : u < m_config.ge_p;
+        burst_lost =
+            m_ge_bad && (m_config.ge_loss_bad >= 1.0 || uniform01(m_ge_rng) < m_config.ge_loss_bad);
+    }
     if (m_config.loss > 0 && uniform01(m_loss_rng) < m_config.loss) {
         ++m_stats.dropped_loss;
         return false;
     }
-    if (m_config.ge_p > 0) {
-        const double u = uniform01(m_fault_rng);
-        m_ge_bad = m_ge_bad ? !(u < m_config.ge_r) : u < m_config.ge_p;
-        if (m_ge_bad) {
-            ++m_stats.dropped_burst;
-            return false;
-        }
+    if (burst_lost) {
+        ++m_stats.dropped_burst;
+        return false;
     }
     drainQueue(now_ns);
     if (m_queue_bytes + bytes > m_config.queue_bytes ||
@@ -333,9 +344,9 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
     // Jitter never reorders: a packet leaves the delay line no earlier than the one before it.
     const int64_t deliver_ns =
         std::max(m_last_deliver_ns, static_cast<int64_t>(std::llround(departure + delay_ns)));
-    const bool duplicate = m_config.duplicate > 0 && uniform01(m_fault_rng) < m_config.duplicate &&
+    const bool duplicate = m_config.duplicate > 0 && uniform01(m_dup_rng) < m_config.duplicate &&
                            m_flight_bytes + 2 * bytes <= m_config.max_in_flight_bytes;
-    if (m_config.reorder > 0 && uniform01(m_fault_rng) < m_config.reorder) {
+    if (m_config.reorder > 0 && uniform01(m_reorder_rng) < m_config.reorder) {
         // Out of the delay line: the packets behind it keep their own times and pass it.
         ++m_stats.reordered;
         const int64_t held_ns = deliver_ns + static_cast<int64_t>(m_config.reorder_ms * 1e6);

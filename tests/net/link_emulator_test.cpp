@@ -449,6 +449,66 @@ TEST(NetLinkFaults, SpikesDelayExactlyThePacketsSentDuringThem) {
     EXPECT_EQ(link.stats().spiked, 300u);
 }
 
+TEST(NetLinkFaults, BurstLossIsIndependentOfRandomLossAndOfTheOtherFaults) {
+    // The chain steps on every packet: with loss= on too, every packet the bursts took alone
+    // is still lost, and random loss takes its share of the rest.
+    std::vector<bool> ge_only, both, ge_dup;
+    LinkEmulator a(parseLinkSpec("wifi,ge=0.01:0.25,seed=6").value());
+    LinkEmulator b(parseLinkSpec("wifi,ge=0.01:0.25,loss=0.1,seed=6").value());
+    LinkEmulator c(parseLinkSpec("wifi,ge=0.01:0.25,dup=0.3,reorder=0.2,seed=6").value());
+    sendNumbered(a, 100'000, &ge_only);
+    sendNumbered(b, 100'000, &both);
+    sendNumbered(c, 100'000, &ge_dup);
+    EXPECT_EQ(ge_only, ge_dup);  // duplication and reordering draw from streams of their own
+    int64_t burst = 0, extra = 0, survivors = 0;
+    for (size_t i = 0; i < ge_only.size(); ++i) {
+        if (!ge_only[i]) {
+            ++burst;
+            EXPECT_FALSE(both[i]) << i;
+        } else {
+            ++survivors;
+            extra += !both[i];
+        }
+    }
+    EXPECT_NEAR(double(extra) / double(survivors), 0.1, 0.005);
+    // A packet both would take is counted as random loss.
+    EXPECT_EQ(b.stats().dropped_loss + b.stats().dropped_burst, uint64_t(burst + extra));
+    EXPECT_LT(b.stats().dropped_burst, uint64_t(burst));
+}
+
+TEST(NetLinkFaults, PartialLossInTheBadStateScalesTheLongRunRate) {
+    LinkEmulator link(parseLinkSpec("none,ge=0.02:0.1:0.5,seed=8").value());
+    std::vector<bool> ok;
+    sendNumbered(link, 200'000, &ok);
+    const auto lost = std::count(ok.begin(), ok.end(), false);
+    // 0.5 · p / (p + r) = 8.33%
+    EXPECT_NEAR(double(lost) / double(ok.size()), 0.5 * 0.02 / 0.12, 0.006);
+    EXPECT_EQ(link.stats().dropped_burst, uint64_t(lost));
+}
+
+TEST(NetLinkFaults, HeldPacketsLeaveAtTheirOwnTimeEvenWhenSpikesMakeThemNonMonotonic) {
+    // Every packet held 5 ms (P just under 1; this seed holds all 3000): one sent in the last
+    // 100 ms of a second is due 85 ms after it was sent, the others 5 ms; so packets sent just
+    // after a spike overtake the held spike packets, and each copy follows its original.
+    LinkEmulator link(parseLinkSpec("none,spike=1000:100:80,reorder=0.999999:5,dup=0.3").value());
+    const Delivered d = sendNumbered(link, 3000);
+    ASSERT_EQ(link.stats().reordered, 3000u);
+    ASSERT_EQ(d.order.size(), 3000u + link.stats().duplicated);
+    std::vector<int64_t> due_ns(3000);
+    for (uint32_t i = 0; i < 3000; ++i)
+        due_ns[i] = int64_t(i) * 1'000'000 + (i % 1000 >= 900 ? 85'000'000 : 5'000'000);
+    uint64_t copies = 0;
+    for (size_t k = 0; k < d.order.size(); ++k) {
+        EXPECT_EQ(d.at_ns[k], due_ns[d.order[k]]) << "packet " << d.order[k];
+        if (k > 0) {
+            copies += d.order[k] == d.order[k - 1];
+            EXPECT_LE(due_ns[d.order[k - 1]], due_ns[d.order[k]]) << k;
+        }
+    }
+    EXPECT_EQ(copies, link.stats().duplicated);
+    EXPECT_GT(copies, 800u);
+}
+
 TEST(NetLinkFaults, WithoutFaultsTheLinkIsUnchangedAndBadSpecsAreRefused) {
     // The fault options draw from their own stream: random loss picks the same packets.
     std::vector<bool> a, b;
@@ -457,18 +517,64 @@ TEST(NetLinkFaults, WithoutFaultsTheLinkIsUnchangedAndBadSpecsAreRefused) {
     sendNumbered(plain, 5000, &a);
     sendNumbered(with, 5000, &b);
     EXPECT_EQ(a, b);
-    for (const char* bad :
-         {"wifi,ge=junk", "wifi,ge=0.1", "wifi,ge=0.1:0", "wifi,ge=1:0.5", "wifi,ge=0.1:0.2:3",
-          "wifi,ge=nan:0.5", "wifi,reorder=1", "wifi,reorder=0.1:0", "wifi,reorder=0.1:20000",
-          "wifi,reorder=-0.1", "wifi,dup=1", "wifi,dup=x", "wifi,spike=1000:100",
-          "wifi,spike=100:200:5", "wifi,spike=1000:100:0", "wifi,spike=1000:100:99999",
-          "wifi,spike=0:0:5", "wifi,spike=1000:100:80:1"}) {
+    for (const char* bad : {"wifi,ge=junk",
+                            "wifi,ge=0.1",
+                            "wifi,ge=0.1:0",
+                            "wifi,ge=1:0.5",
+                            "wifi,ge=0.1:0.2:3",
+                            "wifi,ge=nan:0.5",
+                            "wifi,ge=0.1:0.2:0",
+                            "wifi,ge=0.1:0.2:0.5:1",
+                            "wifi,ge=-0.1:0.5",
+                            "wifi,ge=0.1:",
+                            "wifi,ge=:0.5",
+                            "wifi,ge=",
+                            "wifi,ge=0.1:inf",
+                            "wifi,reorder=",
+                            "wifi,reorder=0.1:",
+                            "wifi,reorder=0.1:nan",
+                            "wifi,reorder=0.1:-5",
+                            "wifi,dup=-0.1",
+                            "wifi,dup=nan",
+                            "wifi,dup=",
+                            "wifi,spike=1000:100:-80",
+                            "wifi,spike=1000:-1:80",
+                            "wifi,spike=nan:100:80",
+                            "wifi,spike=1000::80",
+                            "wifi,spike=",
+                            "wifi,reorder=1",
+                            "wifi,reorder=0.1:0",
+                            "wifi,reorder=0.1:20000",
+                            "wifi,reorder=-0.1",
+                            "wifi,dup=1",
+                            "wifi,dup=x",
+                            "wifi,spike=1000:100",
+                            "wifi,spike=100:200:5",
+                            "wifi,spike=1000:100:0",
+                            "wifi,spike=1000:100:99999",
+                            "wifi,spike=0:0:5",
+                            "wifi,spike=1000:100:80:1"}) {
         auto c = parseLinkSpec(bad);
         EXPECT_FALSE(c.ok()) << bad;
         if (!c.ok()) {
             EXPECT_NE(c.error().find("must be"), std::string::npos) << c.error();
         }
     }
+    // The defaults and the optional parts.
+    const LinkConfig g = parseLinkSpec("wifi,ge=0.05:0.2,reorder=0.1,dup=0.02").value();
+    EXPECT_EQ(g.ge_p, 0.05);
+    EXPECT_EQ(g.ge_r, 0.2);
+    EXPECT_EQ(g.ge_loss_bad, 1.0);
+    EXPECT_EQ(g.reorder, 0.1);
+    EXPECT_EQ(g.reorder_ms, 5.0);
+    EXPECT_EQ(g.duplicate, 0.02);
+    EXPECT_TRUE(g.faulty());
+    const LinkConfig h = parseLinkSpec("none,ge=0.05:0.2:0.25,spike=500:50:30").value();
+    EXPECT_EQ(h.ge_loss_bad, 0.25);
+    EXPECT_EQ(h.spike_every_ms, 500.0);
+    EXPECT_EQ(h.spike_len_ms, 50.0);
+    EXPECT_EQ(h.spike_extra_ms, 30.0);
+    EXPECT_FALSE(parseLinkSpec("none,ge=0:0.5,reorder=0,dup=0").value().faulty());  // all off
 }
 
 }  // namespace

@@ -29,12 +29,15 @@ struct LinkConfig {
     int64_t queue_bytes = 4 << 20;               // drop-tail bottleneck buffer
     int64_t max_in_flight_bytes = 64 << 20;      // the delay line (rate × delay) is bounded too
     uint64_t seed = 1;
-    // Faults (issue 12's matrix), each off at 0; their random draws come from a stream of their
-    // own, so turning one on does not change which packets random loss or jitter pick.
+    // Faults (issue 12's matrix), each off at 0; each draws from a seeded stream of its own, so
+    // turning one on does not change which packets random loss, jitter or another fault pick.
     // Gilbert-Elliott burst loss: per packet Good→Bad with ge_p, Bad→Good with ge_r; a packet
-    // sent in Bad is lost. Long-run loss ge_p / (ge_p + ge_r), mean burst 1 / ge_r packets.
+    // sent in Bad is lost with ge_loss_bad (1: all). Long-run loss ge_loss_bad · ge_p /
+    // (ge_p + ge_r), mean Bad run 1 / ge_r packets. The chain steps on every packet sent,
+    // whether random loss took it or not: the two losses are independent.
     double ge_p = 0.0;
     double ge_r = 0.0;
+    double ge_loss_bad = 1.0;
     // With probability `reorder` a packet is held reorder_ms longer, outside the order-keeping
     // delay line: packets sent after it overtake it.
     double reorder = 0.0;
@@ -57,7 +60,8 @@ struct LinkConfig {
 // "none", "wifi" (200 Mbit/s), "lte" (100), "5g" (500) — paper Table 2 — "rate:MBPS", or
 // "trace:PATH[@MBPS]" (a Mahimahi file, rescaled to MBPS when given), followed by options
 // ",delay_ms=D", ",jitter_ms=J", ",loss=P" (0 ≤ P < 1), ",queue_kb=Q", ",seed=S", and the
-// faults ",ge=P:R" (Gilbert-Elliott), ",reorder=P[:MS]", ",dup=P", ",spike=EVERY:LEN:EXTRA" (ms).
+// faults ",ge=P:R[:LOSS_BAD]" (Gilbert-Elliott), ",reorder=P[:MS]", ",dup=P",
+// ",spike=EVERY:LEN:EXTRA" (ms).
 // A trace starts (its time 0) with the first packet sent through the link.
 Expected<LinkConfig> parseLinkSpec(const std::string& spec);
 const std::vector<std::string>& linkProfileNames();
@@ -67,7 +71,7 @@ struct LinkStats {
     uint64_t packets_delivered = 0;
     uint64_t dropped_loss = 0;   // random loss
     uint64_t dropped_queue = 0;  // the bottleneck buffer (or the delay line) was full
-    uint64_t dropped_burst = 0;  // Gilbert-Elliott: sent in the Bad state
+    uint64_t dropped_burst = 0;  // Gilbert-Elliott: sent in the Bad state (and not random loss)
     uint64_t reordered = 0;      // held back so later packets overtook it
     uint64_t duplicated = 0;     // delivered a second time
     uint64_t spiked = 0;         // sent during a delay spike
@@ -122,7 +126,9 @@ private:
     LinkConfig m_config;
     std::mt19937_64 m_loss_rng;
     std::mt19937_64 m_jitter_rng;
-    std::mt19937_64 m_fault_rng;
+    std::mt19937_64 m_ge_rng;
+    std::mt19937_64 m_reorder_rng;
+    std::mt19937_64 m_dup_rng;
     bool m_ge_bad = false;
     bool m_started = false;
     int64_t m_origin_ns = 0;       // the link's first packet: the spikes' time 0
@@ -136,7 +142,9 @@ private:
     std::deque<Queued> m_queue;  // departure times of packets still in the bottleneck
     int64_t m_queue_bytes = 0;
     std::deque<InFlight> m_flight;  // ordered by deliver_ns
-    std::deque<InFlight> m_held;    // reordered packets, ordered by deliver_ns too
+    // Reordered packets, ordered by deliver_ns too: inserted in place, since jitter and spikes
+    // make the times of successive held packets non-monotonic.
+    std::deque<InFlight> m_held;
     int64_t m_flight_bytes = 0;
     LinkStats m_stats;
 };
