@@ -70,6 +70,9 @@ expect_exit2 "server --net rate:0" server "${K[@]}" --port 0 --duration-s 1 --ne
 expect_exit2 "server --net wifi,ge=junk" server "${K[@]}" --port 0 --duration-s 1 --net wifi,ge=junk
 expect_exit2 "server --net wifi,reorder=1" server "${K[@]}" --port 0 --duration-s 1 --net wifi,reorder=1
 expect_exit2 "server --net wifi,spike=100:200:5" server "${K[@]}" --port 0 --duration-s 1 --net wifi,spike=100:200:5
+for f in ge=0.1:0 ge=0.1 dup=nan reorder=0.1:-5 spike=1000:100:20000 ge=0.1:0.2:junk; do
+    expect_exit2 "server --net wifi,$f" server "${K[@]}" --port 0 --duration-s 1 --net "wifi,$f"
+done
 expect_exit2 "server --codec foo" server "${K[@]}" --port 0 --duration-s 1 --codec foo
 expect_exit2 "server --bind 256.1.1.1" server "${K[@]}" --port 0 --duration-s 1 --bind 256.1.1.1
 expect_exit2 "server --bind localhost (names are not bound)" server "${K[@]}" --port 0 --duration-s 1 --bind localhost
@@ -78,6 +81,7 @@ expect_exit2 "server --profile bogus" server "${K[@]}" --port 0 --duration-s 1 -
 
 expect_exit2 "run --codec foo" run --codec foo --frames 12 --warmup-frames 0 --out "$tmp/r"
 expect_exit2 "run --net rate:1e-300" run --net rate:1e-300 --frames 12 --warmup-frames 0 --out "$tmp/r"
+expect_exit2 "run --net wifi,dup=1" run --net wifi,dup=1 --frames 12 --warmup-frames 0 --out "$tmp/r"
 expect_exit2 "run --out under a file" run --frames 12 --warmup-frames 0 --out "$tmp/a_file/sub"
 
 # --- settings negotiated in the handshake -----------------------------------------------------
