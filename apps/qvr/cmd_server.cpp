@@ -208,6 +208,15 @@ int runServer(const ServerCmdOptions& o) {
                                   {"fec_parity_bytes", s.net.fec_parity_bytes},
                                   {"client_loss_ppm", s.net.client_loss_ppm},
                                   {"control_drops", s.net.control_drops.total()},
+                                  {"link",
+                                   {{"packets_in", s.net.link.packets_in},
+                                    {"packets_delivered", s.net.link.packets_delivered},
+                                    {"dropped_loss", s.net.link.dropped_loss},
+                                    {"dropped_queue", s.net.link.dropped_queue},
+                                    {"dropped_burst", s.net.link.dropped_burst},
+                                    {"reordered", s.net.link.reordered},
+                                    {"duplicated", s.net.link.duplicated},
+                                    {"spiked", s.net.link.spiked}}},
                                   {"core", o.core}};
         std::ofstream f(o.stats_json);
         f << j.dump(2) << "\n";

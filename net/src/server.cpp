@@ -24,6 +24,20 @@ asio::steady_timer::time_point steadyAt(int64_t ns) {
     return asio::steady_timer::time_point(std::chrono::nanoseconds(ns));
 }
 
+// Adds what a session's link counted since `before` (every field only grows).
+void addLinkGrowth(LinkStats& total, const LinkStats& before, const LinkStats& now) {
+    total.packets_in += now.packets_in - before.packets_in;
+    total.packets_delivered += now.packets_delivered - before.packets_delivered;
+    total.dropped_loss += now.dropped_loss - before.dropped_loss;
+    total.dropped_queue += now.dropped_queue - before.dropped_queue;
+    total.dropped_burst += now.dropped_burst - before.dropped_burst;
+    total.reordered += now.reordered - before.reordered;
+    total.duplicated += now.duplicated - before.duplicated;
+    total.spiked += now.spiked - before.spiked;
+    total.bytes_in += now.bytes_in - before.bytes_in;
+    total.bytes_delivered += now.bytes_delivered - before.bytes_delivered;
+}
+
 }  // namespace
 
 struct Session;
@@ -559,7 +573,9 @@ struct Session : std::enable_shared_from_this<Session> {
             std::lock_guard lock(server.mutex);
             server.stats.packets_sent += sent;
             server.stats.packets_send_failed += failed;
-            link_stats = link.stats();
+            const LinkStats now_stats = link.stats();
+            addLinkGrowth(server.stats.link, link_stats, now_stats);
+            link_stats = now_stats;
         }
         const auto next = link.nextDeliveryNs();
         if (next && !flush_armed) {

@@ -1003,6 +1003,13 @@ TEST(NetTransport, FecAloneCompletesStreamsAtFivePercentLoss) {
     const LinkStats ls = server->linkStats(id);
     const ClientStats cs = client.stats();
     const ServerStats ss = server->stats();
+    // The server's total over its sessions' links (one session here), read in between.
+    const LinkStats ls_after = server->linkStats(id);
+    EXPECT_GE(ss.link.packets_in, ls.packets_in);
+    EXPECT_LE(ss.link.packets_in, ls_after.packets_in);
+    EXPECT_GE(ss.link.dropped_loss, ls.dropped_loss);
+    EXPECT_LE(ss.link.dropped_loss, ls_after.dropped_loss);
+    EXPECT_GT(ss.link.dropped_loss, 0u);
     const double loss = static_cast<double>(ls.dropped_loss) / static_cast<double>(ls.packets_in);
     RecordProperty("streams_complete", total.streams);
     RecordProperty("streams_decodable", total.decodable);

@@ -107,6 +107,7 @@ struct ServerStats {
     uint64_t fec_parity_packets = 0;  // parity datagrams sent (first transmissions)
     uint64_t fec_parity_bytes = 0;    // their bytes on the wire
     uint32_t client_loss_ppm = 0;     // the latest loss rate a client reported
+    LinkStats link;                   // every session's emulated link summed (its drops and faults)
 };
 
 class Server {
