@@ -346,27 +346,29 @@ bool LinkEmulator::send(std::vector<uint8_t> packet, int64_t now_ns) {
         std::max(m_last_deliver_ns, static_cast<int64_t>(std::llround(departure + delay_ns)));
     const bool duplicate = m_config.duplicate > 0 && uniform01(m_dup_rng) < m_config.duplicate &&
                            m_flight_bytes + 2 * bytes <= m_config.max_in_flight_bytes;
-    if (m_config.reorder > 0 && uniform01(m_reorder_rng) < m_config.reorder) {
-        // Out of the delay line: the packets behind it keep their own times and pass it.
+    // A reordered packet leaves the delay line: the packets behind it keep their own times and
+    // pass it.
+    const bool reordered = m_config.reorder > 0 && uniform01(m_reorder_rng) < m_config.reorder;
+    int64_t at_ns = deliver_ns;
+    if (reordered) {
         ++m_stats.reordered;
-        const int64_t held_ns = deliver_ns + static_cast<int64_t>(m_config.reorder_ms * 1e6);
-        if (duplicate) {
-            ++m_stats.duplicated;
-            holdInOrder({packet, held_ns});
-            m_flight_bytes += bytes;
-        }
-        holdInOrder({std::move(packet), held_ns});
-        m_flight_bytes += bytes;
-        return true;
+        at_ns += static_cast<int64_t>(m_config.reorder_ms * 1e6);
+    } else {
+        m_last_deliver_ns = deliver_ns;
     }
-    m_last_deliver_ns = deliver_ns;
+    const auto put = [&](std::vector<uint8_t> p) {
+        m_flight_bytes += bytes;
+        if (reordered) {
+            holdInOrder({std::move(p), at_ns});
+        } else {
+            m_flight.push_back({std::move(p), at_ns});
+        }
+    };
     if (duplicate) {
         ++m_stats.duplicated;
-        m_flight.push_back({packet, deliver_ns});
-        m_flight_bytes += bytes;
+        put(packet);  // the copy, right ahead of the original at the same time
     }
-    m_flight.push_back({std::move(packet), deliver_ns});
-    m_flight_bytes += bytes;
+    put(std::move(packet));
     return true;
 }
 
