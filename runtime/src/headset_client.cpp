@@ -204,9 +204,7 @@ public:
         // sink, and stay in the result.
         result.frames.reserve(m_frames.size());
         for (FrameTelemetry& t : m_frames) {
-            m_summary.add(t);
-            if (m_config.frame_sink)
-                m_config.frame_sink(t);
+            retire(t);
             result.frames.push_back(std::move(t));
         }
         m_frames.clear();
@@ -220,6 +218,13 @@ private:
     // A frame's telemetry by its index in the run.
     FrameTelemetry& tel(size_t ti) { return m_frames[ti - m_frames_base]; }
 
+    // A frame whose telemetry is final: into the summary and the sink.
+    void retire(const FrameTelemetry& t) {
+        m_summary.add(t);
+        if (m_config.frame_sink)
+            m_config.frame_sink(t);
+    }
+
     // With keep_frames set, frames more than that behind the newest (and never fewer than
     // kMinFramesHeld, past any frame whose late streams could still be counted) leave memory:
     // into the summary and the sink. Memory then stays flat however long the session runs.
@@ -228,9 +233,7 @@ private:
             return;
         const size_t held = std::max(keep, kMinFramesHeld);
         while (m_frames.size() > held) {
-            m_summary.add(m_frames.front());
-            if (m_config.frame_sink)
-                m_config.frame_sink(m_frames.front());
+            retire(m_frames.front());
             m_frames.pop_front();
             ++m_frames_base;
         }
