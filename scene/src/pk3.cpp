@@ -32,11 +32,16 @@ std::string normalizeGamePath(std::string path) {
     std::replace(path.begin(), path.end(), '\\', '/');
     for (char& c : path)
         c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    while (path.rfind("./", 0) == 0)
-        path.erase(0, 2);
-    while (!path.empty() && path.front() == '/')
-        path.erase(0, 1);
-    return path;
+    // Strip leading "./" and "/" in any mix ("/./a", ".//a"), so a normalized path normalizes to
+    // itself: the file system's keys are normalized once, its lookups normalize again.
+    for (;;) {
+        if (path.rfind("./", 0) == 0)
+            path.erase(0, 2);
+        else if (!path.empty() && path.front() == '/')
+            path.erase(0, 1);
+        else
+            return path;
+    }
 }
 
 Pk3Archive::~Pk3Archive() {

@@ -76,6 +76,23 @@ TEST(Pk3, LooksFilesUpCaseInsensitivelyWithLaterArchivesWinning) {
     EXPECT_THAT(fs.list("scripts/", ".shader"), ::testing::ElementsAre("scripts/x.shader"));
 }
 
+// A member named with "./" and "/" mixed at its front ("/./maps/a.bsp", found by pk3_fuzz) is
+// listed under a name that finds it again: normalizing a normalized path changes nothing.
+TEST(Pk3, MixedLeadingDotSlashAndSlashNormalizeOnce) {
+    for (const char* name : {"/./maps/a.bsp", ".//maps/a.bsp", "/.//./MAPS\\a.bsp"}) {
+        SCOPED_TRACE(name);
+        EXPECT_EQ(normalizeGamePath(name), "maps/a.bsp");
+    }
+    TempDir dir;
+    writeZip(dir.file("m.pk3"), {{"/./maps/a.bsp", bytesOf("abc")}});
+    GameFileSystem fs;
+    ASSERT_TRUE(fs.addPk3(dir.file("m.pk3")).ok());
+    const auto listed = fs.list("", "");
+    ASSERT_THAT(listed, ::testing::ElementsAre("maps/a.bsp"));
+    EXPECT_TRUE(fs.exists(listed[0]));
+    ASSERT_TRUE(fs.read(listed[0]).has_value());
+}
+
 TEST(Pk3, CorruptArchivesAndMissingDirectoriesAreErrors) {
     auto a = Pk3Archive::fromBytes(bytesOf("PK\3\4 definitely not a zip"), "junk.pk3");
     ASSERT_FALSE(a.ok());
