@@ -86,7 +86,8 @@ expect_exit2 "run --out under a file" run --frames 12 --warmup-frames 0 --out "$
 
 # --- settings negotiated in the handshake -----------------------------------------------------
 "$QVR" server "${K[@]}" --port 0 --profile small --codec x264 --duration-s 120 \
-    --stats-json "$tmp/server_stats.json" >"$tmp/server_out.txt" 2>"$tmp/server_err.txt" &
+    --stats-json "$tmp/server_stats.json" --stamps-csv "$tmp/stamps.csv" \
+    >"$tmp/server_out.txt" 2>"$tmp/server_err.txt" &
 server_pid=$!
 port=
 for _ in $(seq 1 200); do
@@ -139,7 +140,16 @@ assert d['control_forged'] == 0 and d['control_replayed'] == 0, d
     "$QVR" client "${K[@]}" --connect "127.0.0.1:$port" --frames 100000 --profile small \
         --out "$tmp/int" >"$tmp/int_out.txt" 2>"$tmp/int_err.txt" &
     client_pid=$!
-    sleep 4
+    # SIGINT only once the server has sent this client 20 layers (a stamps line each, flushed
+    # every frame), not after a fixed sleep: the client installs its handler just before its
+    # first frame and a background job of a script ignores SIGINT until then, so a slow start (an
+    # ASan build takes longer than 4 s) lost the signal and the client ran its 100000 frames
+    # until ctest's timeout.
+    stamps_before=$(wc -l <"$tmp/stamps.csv")
+    for _ in $(seq 1 1200); do
+        [ "$(wc -l <"$tmp/stamps.csv")" -ge $((stamps_before + 20)) ] && break
+        sleep 0.1
+    done
     kill -INT "$client_pid"
     wait "$client_pid"
     rc=$?
