@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The second of the README's two commands: install what is missing, build everything with
 # warnings as errors, and run the whole default test suite (long soaks carry the label "soak"
-# and run only with QVR_SOAK=1).
+# and run only with QVR_SOAK=1). Then the same suite again built with AddressSanitizer +
+# UBSan (the asan preset; QVR_SANITIZERS=0 skips it, CI never does). Any failure in either
+# suite, a sanitizer report included, fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/deps.sh
@@ -16,4 +18,11 @@ if [ "${QVR_SOAK:-0}" = 1 ]; then
     ctest --test-dir "build/$preset" --output-on-failure -j "$(nproc)"
 else
     ctest --preset "$preset" -j "$(nproc)"
+fi
+# The sanitizer suite (docs/FUZZING.md §Sanitizers): after the default one, so a plain failure
+# is reported before the ~25 minutes the asan build and suite take. Soaks stay out of it.
+if [ "$preset" = dev ] && [ "${QVR_SANITIZERS:-1}" != 0 ]; then
+    cmake --preset asan
+    cmake --build --preset asan -j "$(nproc)"
+    ctest --preset asan -j "$(nproc)"
 fi
