@@ -2,8 +2,9 @@
 # The second of the README's two commands: install what is missing, build everything with
 # warnings as errors, and run the whole default test suite (long soaks carry the label "soak"
 # and run only with QVR_SOAK=1). Then the same suite again built with AddressSanitizer +
-# UBSan (the asan preset; QVR_SANITIZERS=0 skips it, CI never does). Any failure in either
-# suite, a sanitizer report included, fails the script.
+# UBSan (the asan preset), and the network and runtime tests built with ThreadSanitizer (the
+# tsan preset); QVR_SANITIZERS=0 skips both, CI never does. Any failure in any suite, a
+# sanitizer report included, fails the script.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/deps.sh
@@ -25,4 +26,9 @@ if [ "$preset" = dev ] && [ "${QVR_SANITIZERS:-1}" != 0 ]; then
     cmake --preset asan
     cmake --build --preset asan -j "$(nproc)"
     ctest --preset asan -j "$(nproc)"
+    # ThreadSanitizer over the network and runtime tests (the threaded parts: transport, render
+    # server, headset pipeline); ~5 min more. Only their two test binaries are built.
+    cmake --preset tsan
+    cmake --build --preset tsan -j "$(nproc)" --target net_tests runtime_tests
+    ctest --preset tsan -j "$(nproc)"
 fi

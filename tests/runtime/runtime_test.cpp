@@ -274,6 +274,12 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
     // headset keeps scanning out at its own rate, re-warping the newest layers it has, and shows
     // fresh frames again once the server resumes. (Before: every frame of the stall waited the
     // whole 250 ms wait limit, a 4 Hz display.)
+#if defined(__SANITIZE_THREAD__)
+    // Under ThreadSanitizer every frame of this build takes longer than the 150 ms gap the test
+    // counts (222 of 240 were long gaps): it measures the display's cadence, which TSan's
+    // slowdown erases. It runs in the default and asan suites.
+    GTEST_SKIP() << "display cadence is not measurable under ThreadSanitizer";
+#endif
     RenderServerConfig sc = serverConfig("none", "raw");
     std::atomic<int> served{0};
     sc.on_frame = [&served](const ServerFrameStamps&) {
