@@ -207,9 +207,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
     };
 
     // Bits per layer pixel at scale s: the calibration's law when it has one, else the trace's.
-    auto bitsPerPx = [&](const WorkloadFrame& wf, double scale) {
+    auto bitsPerPx = [&](const WorkloadFrame& wf, double scale, bool outer) {
         if (c.bits_per_px_at_1 > 0.0)
-            return c.bits_per_px_at_1 * std::pow(std::max(scale, 1.0), c.bits_scale_exponent);
+            return c.bitsPerPx(scale, outer);
         return bitsPerPixelAt(header, wf, scale);
     };
     // Pixels UCA reads (every layer of both eyes at its own resolution).
@@ -239,14 +239,14 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         const double total_tris = sumTotal(wf.triangles_per_ring);
         std::vector<LayerJob> jobs;
         if (whole_frame) {
-            const double bytes = bitsPerPx(wf, 1.0) * eye_px / 8.0;
+            const double bytes = bitsPerPx(wf, 1.0, false) * eye_px / 8.0;
             // The whole frame at scale 1 is the all-local plan's fovea view, no hole.
             for (int eye = 0; eye < 2; ++eye)
                 jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true});
         } else {
             const PeripheryBytes pb = {
-                2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1) / 8.0,
-                2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2) / 8.0};
+                2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1, false) / 8.0,
+                2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2, true) / 8.0};
             const double mid_tris =
                 sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e2_deg);
             for (int eye = 0; eye < 2; ++eye) {

@@ -2,6 +2,8 @@
 // the caller's, and typos or out-of-range values are errors naming the file.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "qvr/sim/hardware.h"
 
 namespace qvr {
@@ -50,6 +52,10 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.decode = {0.25, 6.0, 0.0};
     c.server_frame_ms = 1.5;
     c.packet_overhead_bytes = 60.0;
+    c.bits_per_px_at_1 = 0.3;
+    c.bits_scale_exponent = 0.25;
+    c.bits_outer_per_px_at_1 = 0.125;
+    c.bits_outer_scale_exponent = 0.5;
     auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
     ASSERT_TRUE(hw.ok()) << hw.error();
     EXPECT_TRUE(hw->runtime_pipeline);
@@ -59,13 +65,23 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.decode.ms_per_mpx, 6.0);
     EXPECT_EQ(hw->runtime.server_frame_ms, 1.5);
     EXPECT_EQ(hw->runtime.packet_overhead_bytes, 60.0);
+    EXPECT_EQ(hw->runtime.bits_outer_per_px_at_1, 0.125);
+    EXPECT_EQ(hw->runtime.bits_outer_scale_exponent, 0.5);
+    // The middle (and whole frame) read their law, the outer its own; without one, the middle's.
+    EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, false), 0.3 * std::pow(4.0, 0.25));
+    EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, true), 0.125 * 2.0);
+    RuntimeCosts one_law = c;
+    one_law.bits_outer_per_px_at_1 = 0.0;
+    EXPECT_DOUBLE_EQ(one_law.bitsPerPx(4.0, true), one_law.bitsPerPx(4.0, false));
     EXPECT_FALSE(defaultHardware(500.0).runtime_pipeline);
     auto paper = parseHardwareConfig("[runtime]\npipeline = \"paper\"\n", "p.toml", 500.0);
     ASSERT_TRUE(paper.ok()) << paper.error();
     EXPECT_FALSE(paper->runtime_pipeline);
-    for (const char* bad : {"[runtime]\npipeline = \"fast\"\n", "[runtime]\nfovea_base_ms = -1\n",
-                            "[runtime]\nuca_per_mpx = 1\n", "[runtime]\npacket_payload_bytes = 0\n",
-                            "[runtime]\ndecode_ms_per_mpx = \"x\"\n"}) {
+    for (const char* bad :
+         {"[runtime]\npipeline = \"fast\"\n", "[runtime]\nfovea_base_ms = -1\n",
+          "[runtime]\nuca_per_mpx = 1\n", "[runtime]\npacket_payload_bytes = 0\n",
+          "[runtime]\ndecode_ms_per_mpx = \"x\"\n", "[runtime]\nbits_outer_per_px_at_1 = -0.1\n",
+          "[runtime]\nbits_outer_scale_exponent = 9\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
         EXPECT_FALSE(r.ok()) << bad;
         if (!r.ok()) {

@@ -91,6 +91,33 @@ TEST(RuntimeModel, LocalRunsAtItsRenderPlusUcaRoundedToVsync) {
         EXPECT_NEAR(std::fmod(f.display_ms + 1e-9, kSlotMs), 0.0, 1e-6);
 }
 
+TEST(RuntimeModel, TheMiddleAndOuterLayersTakeTheirOwnBitsLaw) {
+    // ffr at 5°: every frame sends both eyes' middle layer at its law and outer layer at its own
+    // (a calibration measures the outer at ~0.6× the middle's bits per pixel at one scale).
+    RuntimeCosts c = flatCosts(1.0, 1.0, 1.0);
+    c.bits_per_px_at_1 = 0.4;
+    c.bits_scale_exponent = 0.3;
+    c.bits_outer_per_px_at_1 = 0.1;
+    c.bits_outer_scale_exponent = 0.5;
+    const WorkloadTrace trace = flatTrace(20);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(Gaze{}, 5.0);
+    ASSERT_GT(plan.middle_pixels, 0);
+    ASSERT_GT(plan.outer_pixels, 0);
+    const double expected = 2.0 *
+                            (double(plan.middle_pixels) * 0.4 * std::pow(plan.s1, 0.3) +
+                             double(plan.outer_pixels) * 0.1 * std::pow(plan.s2, 0.5)) /
+                            8.0;
+    const RuntimeRunResult r = run(Design::Ffr, c, 2, 20);
+    EXPECT_NEAR(r.summary.bytes_per_frame_mean, expected, 1e-6 * expected);
+    // Without an outer law the outer takes the middle's.
+    c.bits_outer_per_px_at_1 = 0.0;
+    const double one_law = 2.0 *
+                           (double(plan.middle_pixels) * 0.4 * std::pow(plan.s1, 0.3) +
+                            double(plan.outer_pixels) * 0.4 * std::pow(plan.s2, 0.3)) /
+                           8.0;
+    EXPECT_NEAR(run(Design::Ffr, c, 2, 20).summary.bytes_per_frame_mean, one_law, 1e-6 * one_law);
+}
+
 TEST(RuntimeModel, ServerBoundRemoteRunsAtTheServersRate) {
     // Two full-frame layers of 100 ms on the server: 200 ms a frame. With two frames in flight
     // the server never idles, so scan-outs follow it exactly; with one it idles while the headset

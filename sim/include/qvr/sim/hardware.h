@@ -3,6 +3,9 @@
 // control logic, and a multi-GPU render server. Every constant's source is in docs/MODEL.md.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <string>
 #include <string_view>
 
@@ -107,6 +110,17 @@ struct RuntimeCosts {
     // s. 0: take bits per pixel from the workload trace instead.
     double bits_per_px_at_1 = 0.0;
     double bits_scale_exponent = 0.0;
+    // The outer layer's own law (bits_outer_per_px_at_1 > 0); 0: the one above for both. At the
+    // same scale the outer layer takes ~0.6× the middle's bits per pixel (measured, MODEL.md §8).
+    double bits_outer_per_px_at_1 = 0.0;
+    double bits_outer_scale_exponent = 0.0;
+    // Bits per layer pixel of a P-frame at scale s of the middle (or whole-frame) or outer layer.
+    double bitsPerPx(double scale, bool outer) const {
+        const bool own = outer && bits_outer_per_px_at_1 > 0.0;
+        return (own ? bits_outer_per_px_at_1 : bits_per_px_at_1) *
+               std::pow(std::max(scale, 1.0),
+                        own ? bits_outer_scale_exponent : bits_scale_exponent);
+    }
     // Server, one core (render thread): per layer render and encode, and per request.
     LinearCost server_render{2.0, 60.0, 0.01};
     LinearCost encode{0.5, 12.0, 0.0};
@@ -155,6 +169,7 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             decision_base_ms, decision_ms_per_ktri, fovea_base_ms, fovea_ms_per_mpx,
 //             fovea_ms_per_ktri, decode_base_ms, decode_ms_per_mpx, uca_base_ms, uca_ms_per_mpx,
 //             frame_overhead_ms, bits_per_px_at_1 (0…100), bits_scale_exponent (−4…4),
+//             bits_outer_per_px_at_1 (0…100), bits_outer_scale_exponent (−4…4),
 //             server_render_base_ms, server_render_ms_per_mpx,
 //             server_render_ms_per_ktri, encode_base_ms, encode_ms_per_mpx, server_frame_ms,
 //             link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536)
