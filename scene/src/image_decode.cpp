@@ -46,6 +46,9 @@ Expected<SceneTexture> decodeImage(std::span<const uint8_t> bytes, const std::st
             fmt::format("{}: not a decodable image ({})", name, stbi_failure_reason()));
     if (w <= 0 || h <= 0 || w > kMaxDecodedImageSide || h > kMaxDecodedImageSide)
         return makeError(fmt::format("{}: image size {}x{} out of range", name, w, h));
+    if (int64_t{w} * h > kMaxDecodedImagePixels)
+        return makeError(fmt::format("{}: image size {}x{} over the {} pixel limit", name, w, h,
+                                     kMaxDecodedImagePixels));
     stbi_uc* pixels = stbi_load_from_memory(data, len, &w, &h, &comp, 4);
     if (pixels == nullptr)
         return makeError(fmt::format("{}: decode failed ({})", name, stbi_failure_reason()));

@@ -194,6 +194,32 @@ TEST(Pk3, LoadsALevelWithTexturesAndShaderScriptsFromAPk3) {
     EXPECT_EQ(scene->spawns.size(), 2u);
 }
 
+// A texture whose header claims 8192×8192 in a few bytes (stb_image decodes what the data does
+// not hold as zeros: found by bsp_fuzz as a 34-byte TGA that took 256 MB and seconds) is refused
+// like an undecodable one: the level loads, the shader has no image.
+TEST(Pk3, ATextureClaimingMorePixelsThanTheLimitIsRefused) {
+    std::vector<uint8_t> bomb = test::makeTga(2, 2, std::vector<uint8_t>(16, 255));
+    bomb[12] = 0x00;  // width 8192
+    bomb[13] = 0x20;
+    bomb[14] = 0x00;  // height 8192
+    bomb[15] = 0x20;
+    TempDir dir;
+    writeZip(dir.file("level.pk3"),
+             {{"maps/tiny.bsp", test::makeSampleBsp().bytes()}, {"textures/test/wall.tga", bomb}});
+    SceneLoadOptions o;
+    o.openarena_dir = "/nonexistent";
+    o.patch_level = 2;
+    const auto scene = loadScene(dir.file("level.pk3"), o);
+    ASSERT_TRUE(scene.ok()) << scene.error();
+    EXPECT_TRUE(scene->textures.empty());
+    // The same level with a real 2×2 texture there keeps it (the limit is not what refused it).
+    writeZip(dir.file("ok.pk3"), {{"maps/tiny.bsp", test::makeSampleBsp().bytes()},
+                                  {"textures/test/wall.tga", sampleTga()}});
+    const auto ok = loadScene(dir.file("ok.pk3"), o);
+    ASSERT_TRUE(ok.ok()) << ok.error();
+    EXPECT_EQ(ok->textures.size(), 1u);
+}
+
 TEST(Pk3, APk3SceneMustHoldExactlyOneLevel) {
     TempDir dir;
     const auto bsp = test::makeSampleBsp().bytes();
