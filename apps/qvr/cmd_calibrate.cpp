@@ -168,7 +168,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 5;
+    constexpr int kCalibrationVersion = 6;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -383,8 +383,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // motion of a run. Each sequence starts fresh encoders (below): frame 0 is their key frame,
     // frame 1 the first P-frame, which refers to that key frame and costs ~25% fewer bits than
     // the P-frames after it (measured over 15 steps: the middle's 0.33 bits per pixel at step 1
-    // against 0.40–0.48 from step 2 on, the outer's 0.25 against 0.29–0.35). The costs are
-    // sampled from frame 2 on, the codec's steady state a run lives in.
+    // against 0.40–0.48 from step 2 on, the outer's 0.25 against 0.29–0.35). The times are
+    // sampled from frame 2 on; the bits come from the longer codec pass below.
     const int sequence = 6;
     const int first_sampled = 2;
     const double frame_ms = 1000.0 / profile->refresh_hz;
@@ -460,11 +460,6 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                         if (sampled && !enc->is_keyframe) {
                             encode.push_back({enc->encode_ms, double(rect.pixels()), 0});
                             decode.push_back({dec_ms, double(rect.pixels()), 0});
-                            if (!enc->bytes.empty())
-                                bits[middle ? 0 : 1].push_back(
-                                    {std::log(std::max(rect.scale, 1.0)),
-                                     std::log(8.0 * double(enc->bytes.size()) /
-                                              double(rect.pixels()))});
                         }
                     }
                 }
@@ -510,6 +505,54 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             uca.push_back({msSince(t0), 2.0 * eye_px, 0});
         }
         log(fmt::format("  full frame {}/{}\n", pi + 1, o.quick ? 1 : 2));
+    }
+    // The codec's bits, as a run at a steady e1 spends them: one encoder per stream carried over
+    // the consecutive frames of a default run's span (its motion's first 120 frames, 1/refresh
+    // apart), P-frames from the run's warm-up (10 frames) on. The six-frame sequences above, each
+    // from fresh encoders, saw only the first P-frames after a key frame and under-predicted a
+    // steady run's periphery by 12–14% (docs/MODEL.md §8, calibration version 6).
+    {
+        const int bits_frames = o.quick ? 40 : 120;
+        const int warmup = 10;
+        for (double e1 : e1s) {
+            chains = {};
+            for (int step = 0; step < bits_frames; ++step) {
+                const double t_ms = frame_ms * step;
+                const Pose head = poseAt(inputs->traces.motion, t_ms);
+                const Gaze gaze = gazeAt(inputs->traces.gaze, t_ms);
+                const LayerPlan plan = planner.plan(gaze, e1);
+                for (int eye = 0; eye < 2; ++eye) {
+                    const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+                    for (int li = 0; li < 2; ++li) {
+                        const bool middle = li == 0;
+                        const LayerRect& rect = middle ? layers.middle : layers.outer;
+                        if (rect.empty())
+                            continue;
+                        const LayerKind kind = middle ? LayerKind::kMiddle : LayerKind::kOuter;
+                        if (auto st = renderLayer(r, *profile, plan, head, static_cast<Eye>(eye),
+                                                  kind, image, CameraOptions{}, holes);
+                            !st)
+                            return makeError("layer render: " + st.error());
+                        Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
+                        if (!ch.enc) {
+                            auto e = makeVideoEncoder(codec);
+                            if (!e)
+                                return makeError("codec: " + e.error());
+                            ch.enc = std::move(*e);
+                        }
+                        auto enc = ch.enc->encode(image);
+                        if (!enc)
+                            return makeError("encode: " + enc.error());
+                        if (step >= warmup && !enc->is_keyframe && !enc->bytes.empty())
+                            bits[middle ? 0 : 1].push_back(
+                                {std::log(std::max(rect.scale, 1.0)),
+                                 std::log(8.0 * double(enc->bytes.size()) /
+                                          double(rect.pixels()))});
+                    }
+                }
+            }
+            log(fmt::format("  codec: {} frames at e1 = {} deg\n", bits_frames, e1));
+        }
     }
     // Bits per pixel: log-linear least squares, b·s^γ, for the middle and the outer layer apart.
     auto fitBits = [](const std::vector<BitsSample>& samples, double& b, double& gamma) {
