@@ -20,8 +20,8 @@ extern "C" {
 }
 
 #include "backends.h"
-#include "qvr/codec/canvas_policy.h"
 #include "qvr/codec/frame_header.h"
+#include "qvr/core/canvas_policy.h"
 
 namespace qvr::detail {
 

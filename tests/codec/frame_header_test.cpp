@@ -9,7 +9,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "qvr/codec/canvas_policy.h"
+#include "qvr/core/canvas_policy.h"
 
 namespace qvr {
 namespace {

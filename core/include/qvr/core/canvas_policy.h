@@ -19,6 +19,9 @@ public:
     CanvasSize next(int width, int height);
     bool changed() const { return m_changed; }
     CanvasSize current() const { return m_canvas; }
+    // The canvas a stream that starts at a width×height layer gets: the layer plus headroom,
+    // aligned — what a steady layer codes into.
+    CanvasSize snugFor(int width, int height) const { return snug(width, height, m_headroom); }
 
 private:
     CanvasSize snug(int width, int height, double headroom) const;

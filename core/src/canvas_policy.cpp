@@ -1,6 +1,6 @@
 // Canvas sizing for layer streams whose frames change size with e1 (paper §3.1–3.2); see
 // docs/CODEC.md for why padding into a canvas beats an IDR per size change.
-#include "qvr/codec/canvas_policy.h"
+#include "qvr/core/canvas_policy.h"
 
 #include <algorithm>
 #include <cmath>
