@@ -292,15 +292,16 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
         runOn(headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 240));
     ASSERT_EQ(r.frames.size(), 240u);
     // The first frame into the stall waits the limit (nothing yet says the server stopped);
-    // after it the display keeps its rate (before: six 250 ms gaps in a row). One more long
-    // gap is allowed for a loaded test machine's scheduling.
+    // after it the display keeps its rate (before: six 250 ms gaps in a row). Two more long
+    // gaps are allowed for a loaded test machine's scheduling.
     int long_gaps = 0;
     for (size_t i = 1; i < r.frames.size(); ++i)
         long_gaps += r.frames[i].display_ns - r.frames[i - 1].display_ns > 150'000'000;
-    EXPECT_LE(long_gaps, 2);
-    // ~135 at 90 Hz; half that and less on a slow (sanitizer) build, 6 before the fix.
-    EXPECT_GT(r.stats.silent_server_frames, 15u);
-    EXPECT_GT(r.summary.frames_reused, 15);
+    EXPECT_LE(long_gaps, 3);
+    // ~135 at 90 Hz; 27 on an ASan build, 13 (3 long gaps) on an ASan build with a calibration
+    // and a compile beside it on two cores; 6 before the fix, each frame waiting the limit.
+    EXPECT_GT(r.stats.silent_server_frames, 8u);
+    EXPECT_GT(r.summary.frames_reused, 8);
     // Fresh frames again after the stall: the last 40 frames come from the server.
     int fresh_tail = 0;
     for (size_t i = 200; i < 240; ++i)
