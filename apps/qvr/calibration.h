@@ -44,8 +44,10 @@ struct Calibration {
     std::string command;
     double seconds = 0.0;
     double load_avg_before = 0.0;
-    int bits_samples = 0;  // P-frames the bits-per-pixel law was fitted on
-    nlohmann::json links;  // the emulator's profiles
+    int bits_samples = 0;        // P-frames the bits-per-pixel law was fitted on
+    int padding_samples = 0;     // P-frame pairs the padding ratio was fitted on
+    nlohmann::json codec_by_e1;  // per calibration e1: median P-frame bits, key-frame ratios
+    nlohmann::json links;        // the emulator's profiles
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included
 };

@@ -168,7 +168,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 6;
+    constexpr int kCalibrationVersion = 7;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -216,6 +216,12 @@ nlohmann::json Calibration::toJson() const {
             {"bits_outer_per_px_at_1", costs.bits_outer_per_px_at_1},
             {"bits_outer_scale_exponent", costs.bits_outer_scale_exponent},
             {"bits_samples", bits_samples},
+            {"keyframe_bits_ratio", costs.keyframe_bits_ratio},
+            {"keyframe_outer_bits_ratio", costs.keyframe_outer_bits_ratio},
+            {"padding_bits_ratio", costs.padding_bits_ratio},
+            {"keyframe_periodic_bits_ratio", costs.keyframe_periodic_bits_ratio},
+            {"padding_samples", padding_samples},
+            {"codec_by_e1", codec_by_e1},
             {"packet_payload_bytes", costs.packet_payload_bytes},
             {"packet_overhead_bytes", costs.packet_overhead_bytes}};
 }
@@ -235,6 +241,12 @@ std::string Calibration::toToml() const {
         "# bits per layer pixel: middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}, over {} P-frames\n",
         costs.bits_per_px_at_1, costs.bits_scale_exponent, costs.bits_outer_per_px_at_1,
         costs.bits_outer_scale_exponent, bits_samples);
+    s += fmt::format(
+        "# key frame of a new encoder: {:.2f}x a P-frame's bits (middle), {:.2f}x (outer); "
+        "periodic: {:.2f}x; padding beyond the snug canvas: {:.3f} of a layer pixel's bits per "
+        "pixel, over {} P-frame pairs\n",
+        costs.keyframe_bits_ratio, costs.keyframe_outer_bits_ratio,
+        costs.keyframe_periodic_bits_ratio, costs.padding_bits_ratio, padding_samples);
     return s + runtimeCostsToml(costs);
 }
 
@@ -511,12 +523,36 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // apart), P-frames from the run's warm-up (10 frames) on. The six-frame sequences above, each
     // from fresh encoders, saw only the first P-frames after a key frame and under-predicted a
     // steady run's periphery by 12–14% (docs/MODEL.md §8, calibration version 6).
+    // Beside each stream's encoder runs a second one fed the same frames after one first image
+    // 1.25× as wide and high, so it codes them into a larger canvas, as a run's stream does after
+    // e1 grew: per frame, its bytes over the first one's give the cost of padding (the canvas
+    // model's padding_bits_ratio); each chain's first frame, its IDR, over the median of its
+    // P-frames gives the key-frame ratio (calibration version 7).
+    struct PadSample {
+        double extra, ratio;  // canvas pixels over the snug canvas's − 1; bytes over the snug's
+    };
+    std::vector<PadSample> pad;
+    std::array<std::vector<double>, 2> key_ratio;  // a new encoder's IDR: middle, outer
+    std::vector<double> periodic_ratio;            // the IDR at keyint_frames, both kinds
+    nlohmann::json codec_by_e1 = nlohmann::json::array();
     {
+        // One frame past keyint_frames when the pass reaches it: the periodic IDR of a running
+        // stream costs less than a new encoder's first frame (3.9× against 7× a P-frame at
+        // e1 = 5°, measured in a default run).
         const int bits_frames = o.quick ? 40 : 120;
+        const int pass_frames = codec.keyint_frames == bits_frames ? bits_frames + 1 : bits_frames;
         const int warmup = 10;
+        std::array<Chain, 4> padded;
+        ImageRgba8 big;
         for (double e1 : e1s) {
             chains = {};
-            for (int step = 0; step < bits_frames; ++step) {
+            padded = {};
+            std::array<double, 4> idr_bytes{};
+            std::array<double, 4> periodic_bytes{};
+            std::array<std::vector<double>, 4> p_bytes;
+            std::array<std::vector<double>, 2> bits_px;  // this e1's P-frames: middle, outer
+            std::array<double, 2> scale{};
+            for (int step = 0; step < pass_frames; ++step) {
                 const double t_ms = frame_ms * step;
                 const Pose head = poseAt(inputs->traces.motion, t_ms);
                 const Gaze gaze = gazeAt(inputs->traces.gaze, t_ms);
@@ -543,16 +579,108 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                         auto enc = ch.enc->encode(image);
                         if (!enc)
                             return makeError("encode: " + enc.error());
-                        if (step >= warmup && !enc->is_keyframe && !enc->bytes.empty())
+                        const size_t sid = static_cast<size_t>(eye * 2 + li);
+                        if (step == 0 && enc->is_keyframe)
+                            idr_bytes[sid] = double(enc->bytes.size());
+                        if (step > 0 && step == codec.keyint_frames && enc->is_keyframe)
+                            periodic_bytes[sid] = double(enc->bytes.size());
+                        if (step >= bits_frames)
+                            continue;  // only the periodic IDR is taken from the extra frame
+                        if (step >= warmup && !enc->is_keyframe && !enc->bytes.empty()) {
+                            bits_px[size_t(li)].push_back(8.0 * double(enc->bytes.size()) /
+                                                          double(rect.pixels()));
+                            scale[size_t(li)] = rect.scale;
                             bits[middle ? 0 : 1].push_back(
                                 {std::log(std::max(rect.scale, 1.0)),
                                  std::log(8.0 * double(enc->bytes.size()) /
                                           double(rect.pixels()))});
+                            p_bytes[sid].push_back(double(enc->bytes.size()));
+                        }
+                        Chain& pc = padded[sid];
+                        if (!pc.enc) {
+                            auto e = makeVideoEncoder(codec);
+                            if (!e)
+                                return makeError("codec: " + e.error());
+                            pc.enc = std::move(*e);
+                            // The first image: the layer in the top-left of one 1.25× larger.
+                            big.resize(image.width() * 5 / 4, image.height() * 5 / 4);
+                            for (int y = 0; y < image.height(); ++y)
+                                std::copy_n(image.row(y), image.strideElems(), big.row(y));
+                            if (auto first = pc.enc->encode(big); !first)
+                                return makeError("encode: " + first.error());
+                        }
+                        auto penc = pc.enc->encode(image);
+                        if (!penc)
+                            return makeError("encode: " + penc.error());
+                        const double snug_px =
+                            double(ch.enc->canvasWidth()) * double(ch.enc->canvasHeight());
+                        const double extra = double(pc.enc->canvasWidth()) *
+                                                 double(pc.enc->canvasHeight()) /
+                                                 std::max(1.0, snug_px) -
+                                             1.0;
+                        if (step >= warmup && !enc->is_keyframe && !penc->is_keyframe &&
+                            !enc->bytes.empty() && extra > 0.05)
+                            pad.push_back(
+                                {extra, double(penc->bytes.size()) / double(enc->bytes.size())});
                     }
                 }
             }
+            std::array<double, 4> open_r{}, periodic_r{};
+            for (size_t sid = 0; sid < 4; ++sid) {
+                std::vector<double>& v = p_bytes[sid];
+                if (v.empty())
+                    continue;
+                std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+                if (idr_bytes[sid] > 0.0) {
+                    open_r[sid] = idr_bytes[sid] / v[v.size() / 2];
+                    key_ratio[sid % 2].push_back(open_r[sid]);
+                }
+                if (periodic_bytes[sid] > 0.0) {
+                    periodic_r[sid] = periodic_bytes[sid] / v[v.size() / 2];
+                    periodic_ratio.push_back(periodic_r[sid]);
+                }
+            }
+            auto med = [](std::vector<double> v) {
+                if (v.empty())
+                    return 0.0;
+                std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+                return v[v.size() / 2];
+            };
+            codec_by_e1.push_back({{"e1_deg", e1},
+                                   {"middle_scale", scale[0]},
+                                   {"middle_bits_per_px_median", med(bits_px[0])},
+                                   {"outer_scale", scale[1]},
+                                   {"outer_bits_per_px_median", med(bits_px[1])},
+                                   {"keyframe_ratio_per_stream", open_r},
+                                   {"periodic_keyframe_ratio_per_stream", periodic_r}});
             log(fmt::format("  codec: {} frames at e1 = {} deg\n", bits_frames, e1));
         }
+    }
+    // The canvas the runtime's encoders use, and what its key frames and padding cost.
+    cal.costs.canvas_align_px = codec.canvas_align_px;
+    cal.costs.canvas_headroom = codec.canvas_headroom;
+    cal.costs.canvas_shrink_ratio = codec.canvas_shrink_ratio;
+    cal.costs.canvas_shrink_after_frames = codec.canvas_shrink_after_frames;
+    cal.costs.keyint_frames = codec.keyint_frames;
+    auto median = [](std::vector<double> v) {
+        if (v.empty())
+            return 0.0;
+        std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    };
+    cal.costs.keyframe_bits_ratio = median(key_ratio[0]);
+    cal.costs.keyframe_outer_bits_ratio = median(key_ratio[1]);
+    cal.costs.keyframe_periodic_bits_ratio = median(periodic_ratio);
+    cal.codec_by_e1 = std::move(codec_by_e1);
+    {
+        // Least squares through the origin: bytes ratio − 1 = ρ · extra canvas share.
+        double sxy = 0.0, sxx = 0.0;
+        for (const PadSample& ps : pad) {
+            sxy += ps.extra * (ps.ratio - 1.0);
+            sxx += ps.extra * ps.extra;
+        }
+        cal.costs.padding_bits_ratio = sxx > 0.0 ? std::clamp(sxy / sxx, 0.0, 10.0) : 0.0;
+        cal.padding_samples = static_cast<int>(pad.size());
     }
     // Bits per pixel: log-linear least squares, b·s^γ, for the middle and the outer layer apart.
     auto fitBits = [](const std::vector<BitsSample>& samples, double& b, double& gamma) {
@@ -644,6 +772,15 @@ int runCalibrate(CalibrateCmdOptions& o) {
         "average {:.2f} before\n",
         cal->costs.frame_overhead_ms, cal->costs.packet_payload_bytes,
         cal->costs.packet_overhead_bytes, cal->seconds, cal->load_avg_before);
+    fmt::print(
+        "  codec: P-frame bits per layer pixel middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}; key "
+        "frame {:.2f}x / {:.2f}x a P-frame (new encoder), {:.2f}x (periodic); padding {:.3f} of a "
+        "layer pixel's bits ({} pairs)\n",
+        cal->costs.bits_per_px_at_1, cal->costs.bits_scale_exponent,
+        cal->costs.bits_outer_per_px_at_1, cal->costs.bits_outer_scale_exponent,
+        cal->costs.keyframe_bits_ratio, cal->costs.keyframe_outer_bits_ratio,
+        cal->costs.keyframe_periodic_bits_ratio, cal->costs.padding_bits_ratio,
+        cal->padding_samples);
     {
         std::ofstream f(o.out);
         f << cal->toToml();

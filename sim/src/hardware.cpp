@@ -122,6 +122,24 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
         r.number("runtime.packet_payload_bytes", rc.packet_payload_bytes, 1.0, 65536.0);
     rc.packet_overhead_bytes =
         r.number("runtime.packet_overhead_bytes", rc.packet_overhead_bytes, 0.0, 65536.0);
+    rc.canvas_align_px = r.integer("runtime.canvas_align_px", rc.canvas_align_px, 2, 256);
+    if (rc.canvas_align_px % 2 != 0)
+        return makeError(std::string(source_name) + ": runtime.canvas_align_px must be even, got " +
+                         std::to_string(rc.canvas_align_px));
+    rc.canvas_headroom = r.number("runtime.canvas_headroom", rc.canvas_headroom, 0.0, 1.0);
+    rc.canvas_shrink_ratio =
+        r.number("runtime.canvas_shrink_ratio", rc.canvas_shrink_ratio, 0.0, 1.0);
+    rc.canvas_shrink_after_frames =
+        r.integer("runtime.canvas_shrink_after_frames", rc.canvas_shrink_after_frames, 1, 100000);
+    rc.keyint_frames = r.integer("runtime.keyint_frames", rc.keyint_frames, 0, 100000);
+    rc.keyframe_bits_ratio =
+        r.number("runtime.keyframe_bits_ratio", rc.keyframe_bits_ratio, 0.0, 1000.0);
+    rc.keyframe_outer_bits_ratio =
+        r.number("runtime.keyframe_outer_bits_ratio", rc.keyframe_outer_bits_ratio, 0.0, 1000.0);
+    rc.keyframe_periodic_bits_ratio = r.number("runtime.keyframe_periodic_bits_ratio",
+                                               rc.keyframe_periodic_bits_ratio, 0.0, 1000.0);
+    rc.padding_bits_ratio =
+        r.number("runtime.padding_bits_ratio", rc.padding_bits_ratio, 0.0, 10.0);
     if (auto st = r.finish(); !st)
         return makeError(st.error());
     return hw;
@@ -164,6 +182,15 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("link_delay_ms", c.link_delay_ms);
     put("packet_payload_bytes", c.packet_payload_bytes);
     put("packet_overhead_bytes", c.packet_overhead_bytes);
+    s += fmt::format("canvas_align_px = {}\n", c.canvas_align_px);
+    put("canvas_headroom", c.canvas_headroom);
+    put("canvas_shrink_ratio", c.canvas_shrink_ratio);
+    s += fmt::format("canvas_shrink_after_frames = {}\n", c.canvas_shrink_after_frames);
+    s += fmt::format("keyint_frames = {}\n", c.keyint_frames);
+    put("keyframe_bits_ratio", c.keyframe_bits_ratio);
+    put("keyframe_outer_bits_ratio", c.keyframe_outer_bits_ratio);
+    put("keyframe_periodic_bits_ratio", c.keyframe_periodic_bits_ratio);
+    put("padding_bits_ratio", c.padding_bits_ratio);
     return s;
 }
 

@@ -16,6 +16,7 @@
 
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
+#include "qvr/core/canvas_policy.h"
 #include "qvr/foveation/layer_plan.h"
 
 namespace qvr {
@@ -26,7 +27,7 @@ struct Stream {
     int64_t frame = 0;
     double rx_ms = 0.0;  // last packet arrived
     double payload_bytes = 0.0;
-    double pixels = 0.0;  // decoded layer pixels
+    double pixels = 0.0;  // pixels the decoder works on (the canvas)
     double goodput_bps = 0.0;
     bool decoded = false;
 };
@@ -47,7 +48,53 @@ struct LayerJob {
     double triangles = 0.0;
     double bytes = 0.0;
     bool middle = true;
+    int stream = 0;  // eye × {middle or whole frame, outer}: the encoder it goes through
+    int width = 0, height = 0;
 };
+
+}  // namespace
+
+StreamCodecModel::StreamCodecModel(const RuntimeCosts& costs) : m_costs(costs) {
+    if (enabled())
+        for (int k = 0; k < kStreams; ++k)
+            m_streams.push_back({CanvasPolicy(costs.canvas_align_px, costs.canvas_headroom,
+                                              costs.canvas_shrink_ratio,
+                                              costs.canvas_shrink_after_frames, kMaxSidePx),
+                                 -1});
+}
+
+double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes) {
+    m_last_key = false;
+    m_last_canvas_share = 1.0;
+    if (!enabled() || width < 1 || height < 1 || stream < 0 || stream >= kStreams)
+        return p_bytes;
+    State& st = m_streams[static_cast<size_t>(stream)];
+    const CanvasSize canvas =
+        st.canvas.next(std::min(width, kMaxSidePx), std::min(height, kMaxSidePx));
+    const CanvasSize snug =
+        st.canvas.snugFor(std::min(width, kMaxSidePx), std::min(height, kMaxSidePx));
+    // The bits law is a P-frame's in a snug canvas: each pixel beyond it costs padding_bits_ratio
+    // of a layer pixel's bits (fewer when the layer grew into its headroom).
+    const double extra = double(canvas.width) * double(canvas.height) /
+                             std::max(1.0, double(snug.width) * double(snug.height)) -
+                         1.0;
+    m_last_canvas_share = extra + 1.0;
+    const double p = p_bytes * std::max(0.5, 1.0 + m_costs.padding_bits_ratio * extra);
+    const bool opened = st.since_key < 0 || st.canvas.changed();  // a new encoder
+    const bool periodic =
+        !opened && m_costs.keyint_frames > 0 && st.since_key + 1 >= m_costs.keyint_frames;
+    st.since_key = opened || periodic ? 0 : st.since_key + 1;
+    m_last_key = opened || periodic;
+    if (!m_last_key)
+        return p;
+    if (periodic && m_costs.keyframe_periodic_bits_ratio > 0.0)
+        return p * m_costs.keyframe_periodic_bits_ratio;
+    const bool outer = stream % 2 == 1;
+    return p * (outer && m_costs.keyframe_outer_bits_ratio > 0.0 ? m_costs.keyframe_outer_bits_ratio
+                                                                 : m_costs.keyframe_bits_ratio);
+}
+
+namespace {
 
 double nearestRankP99(std::vector<double> v) {
     if (v.empty())
@@ -229,6 +276,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         return kind == 0 ? rings_both_eyes / 2.0 : serverLayerTriangles(rings_both_eyes, scale);
     };
 
+    // Each stream's encoder, its canvas and key frames (docs/MODEL.md §8).
+    StreamCodecModel codecs(c);
+
     // Renders, encodes and sends frame j's layers from `start`.
     auto serve = [&](int64_t j, double start) {
         FrameState& fs = state[static_cast<size_t>(j)];
@@ -242,7 +292,8 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
             const double bytes = bitsPerPx(wf, 1.0, false) * eye_px / 8.0;
             // The whole frame at scale 1 is the all-local plan's fovea view, no hole.
             for (int eye = 0; eye < 2; ++eye)
-                jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true});
+                jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true,
+                                eye * 2, header.profile.width_px, header.profile.height_px});
         } else {
             const PeripheryBytes pb = {
                 2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1, false) / 8.0,
@@ -254,16 +305,22 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
                 if (!e.middle.empty())
                     jobs.push_back({double(e.middle.pixels()),
                                     drawn(j, fs.plan, eye, 1, mid_tris, e.middle.scale),
-                                    pb.middle / 2.0, true});
+                                    pb.middle / 2.0, true, eye * 2, e.middle.width_px,
+                                    e.middle.height_px});
                 if (!e.outer.empty())
                     jobs.push_back({double(e.outer.pixels()),
                                     drawn(j, fs.plan, eye, 2, total_tris, e.outer.scale),
-                                    pb.outer / 2.0, false});
+                                    pb.outer / 2.0, false, eye * 2 + 1, e.outer.width_px,
+                                    e.outer.height_px});
             }
         }
-        for (const LayerJob& job : jobs) {
+        for (LayerJob& job : jobs) {
+            job.bytes = codecs.bytes(job.stream, job.width, job.height, job.bytes);
+            // The codec works on the whole canvas: its encode and decode laws were measured in
+            // snug ones.
+            const double coded_px = job.pixels * codecs.lastCanvasShare();
             const double render = c.server_render.at(job.pixels, job.triangles);
-            const double encode = c.encode.at(job.pixels, 0.0);
+            const double encode = c.encode.at(coded_px, 0.0);
             t += render + encode;
             server_busy_total += render + encode;
             const double send = std::max(link_free, t);
@@ -273,7 +330,7 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
             s.frame = j;
             s.rx_ms = link_free + c.link_delay_ms;
             s.payload_bytes = job.bytes;
-            s.pixels = job.pixels;
+            s.pixels = coded_px;
             s.goodput_bps = tr.duration_ms > 0 ? job.bytes * 8.0 / (tr.duration_ms * 1e-3) : 0.0;
             streams.push_back(s);
             if (job.middle)

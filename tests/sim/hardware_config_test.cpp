@@ -56,6 +56,15 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.bits_scale_exponent = 0.25;
     c.bits_outer_per_px_at_1 = 0.125;
     c.bits_outer_scale_exponent = 0.5;
+    c.canvas_align_px = 8;
+    c.canvas_headroom = 0.25;
+    c.canvas_shrink_ratio = 0.375;
+    c.canvas_shrink_after_frames = 12;
+    c.keyint_frames = 60;
+    c.keyframe_bits_ratio = 6.5;
+    c.keyframe_outer_bits_ratio = 5.25;
+    c.keyframe_periodic_bits_ratio = 3.5;
+    c.padding_bits_ratio = 0.5;
     auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
     ASSERT_TRUE(hw.ok()) << hw.error();
     EXPECT_TRUE(hw->runtime_pipeline);
@@ -67,6 +76,15 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.packet_overhead_bytes, 60.0);
     EXPECT_EQ(hw->runtime.bits_outer_per_px_at_1, 0.125);
     EXPECT_EQ(hw->runtime.bits_outer_scale_exponent, 0.5);
+    EXPECT_EQ(hw->runtime.canvas_align_px, 8);
+    EXPECT_EQ(hw->runtime.canvas_headroom, 0.25);
+    EXPECT_EQ(hw->runtime.canvas_shrink_ratio, 0.375);
+    EXPECT_EQ(hw->runtime.canvas_shrink_after_frames, 12);
+    EXPECT_EQ(hw->runtime.keyint_frames, 60);
+    EXPECT_EQ(hw->runtime.keyframe_bits_ratio, 6.5);
+    EXPECT_EQ(hw->runtime.keyframe_outer_bits_ratio, 5.25);
+    EXPECT_EQ(hw->runtime.keyframe_periodic_bits_ratio, 3.5);
+    EXPECT_EQ(hw->runtime.padding_bits_ratio, 0.5);
     // The middle (and whole frame) read their law, the outer its own; without one, the middle's.
     EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, false), 0.3 * std::pow(4.0, 0.25));
     EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, true), 0.125 * 2.0);
@@ -81,7 +99,11 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
          {"[runtime]\npipeline = \"fast\"\n", "[runtime]\nfovea_base_ms = -1\n",
           "[runtime]\nuca_per_mpx = 1\n", "[runtime]\npacket_payload_bytes = 0\n",
           "[runtime]\ndecode_ms_per_mpx = \"x\"\n", "[runtime]\nbits_outer_per_px_at_1 = -0.1\n",
-          "[runtime]\nbits_outer_scale_exponent = 9\n"}) {
+          "[runtime]\nbits_outer_scale_exponent = 9\n", "[runtime]\ncanvas_align_px = 7\n",
+          "[runtime]\ncanvas_align_px = 0\n", "[runtime]\ncanvas_headroom = 2\n",
+          "[runtime]\nkeyint_frames = -1\n", "[runtime]\nkeyframe_bits_ratio = -3\n",
+          "[runtime]\npadding_bits_ratio = 11\n", "[runtime]\nkeyframe_periodic_bits_ratio = -1\n",
+          "[runtime]\ncanvas_shrink_after_frames = 0\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
         EXPECT_FALSE(r.ok()) << bad;
         if (!r.ok()) {

@@ -118,6 +118,67 @@ TEST(RuntimeModel, TheMiddleAndOuterLayersTakeTheirOwnBitsLaw) {
     EXPECT_NEAR(run(Design::Ffr, c, 2, 20).summary.bytes_per_frame_mean, one_law, 1e-6 * one_law);
 }
 
+// The canvas model (calibration version 7): a key frame at each stream's first frame and every
+// keyint_frames-th, the padding of a canvas larger than the snug one, an IDR when a layer outgrows
+// its canvas.
+RuntimeCosts canvasCosts() {
+    RuntimeCosts c = flatCosts(1.0, 1.0, 1.0);
+    c.bits_per_px_at_1 = 0.4;
+    c.keyint_frames = 10;
+    c.keyframe_bits_ratio = 6.0;
+    c.keyframe_outer_bits_ratio = 4.0;
+    c.keyframe_periodic_bits_ratio = 3.0;
+    c.padding_bits_ratio = 0.5;
+    return c;
+}
+
+TEST(RuntimeModel, EveryStreamSendsAKeyFrameFirstAndEveryKeyintFrames) {
+    // ffr at 5°: the layers never change size, so the canvas is the snug one and only the
+    // IDRs differ from the P-frames: each new encoder's first (frame 0: 6× the middle's P-frame,
+    // 4× the outer's) and the periodic ones (frames 10, 20: 3×).
+    const RuntimeCosts c = canvasCosts();
+    const WorkloadTrace trace = flatTrace(30);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(Gaze{}, 5.0);
+    const double middle = 2.0 * double(plan.middle_pixels) * 0.4 / 8.0;  // both eyes; γ = 0
+    const double outer = 2.0 * double(plan.outer_pixels) * 0.4 / 8.0;
+    const RuntimeRunResult r = run(Design::Ffr, c, 2, 30);
+    ASSERT_EQ(r.frames.size(), 30u);
+    for (const RuntimeFrame& f : r.frames) {
+        const double want = f.index == 0        ? 6.0 * middle + 4.0 * outer
+                            : f.index % 10 == 0 ? 3.0 * (middle + outer)
+                                                : middle + outer;
+        EXPECT_NEAR(f.bytes, want, 1e-6 * want) << "frame " << f.index;
+    }
+    // Without a key-frame ratio every frame is the P-frame (calibrations before version 7).
+    RuntimeCosts off = c;
+    off.keyframe_bits_ratio = 0.0;
+    for (const RuntimeFrame& f : run(Design::Ffr, off, 2, 30).frames)
+        EXPECT_NEAR(f.bytes, middle + outer, 1e-6 * (middle + outer));
+}
+
+TEST(RuntimeModel, APaddedCanvasCostsItsPaddingAndOutgrowingItAKeyFrame) {
+    RuntimeCosts c = canvasCosts();
+    c.keyint_frames = 0;
+    StreamCodecModel m(c);
+    // 200×100: the snug canvas is 224×112 (+10%, to 16). The first frame is its IDR.
+    EXPECT_NEAR(m.bytes(0, 200, 100, 1000.0), 6000.0, 1e-9);
+    EXPECT_TRUE(m.lastWasKey());
+    EXPECT_NEAR(m.bytes(0, 200, 100, 1000.0), 1000.0, 1e-9);
+    EXPECT_FALSE(m.lastWasKey());
+    // 150×80 covers 0.48 of the canvas: it stays 224×112 (for 30 frames), whose snug one would
+    // be 176×96: each extra pixel costs half a layer pixel's bits.
+    const double extra = 224.0 * 112.0 / (176.0 * 96.0) - 1.0;
+    EXPECT_NEAR(m.bytes(0, 150, 80, 1000.0), 1000.0 * (1.0 + 0.5 * extra), 1e-9);
+    EXPECT_FALSE(m.lastWasKey());
+    EXPECT_NEAR(m.lastCanvasShare(), 1.0 + extra, 1e-12);  // the codec's work: the canvas
+    // The other streams have encoders of their own: their first frames are IDRs (outer: 4×).
+    EXPECT_NEAR(m.bytes(1, 150, 80, 1000.0), 4000.0, 1e-9);
+    // Outgrowing the canvas reopens the encoder: an IDR of the new snug canvas.
+    EXPECT_NEAR(m.bytes(0, 230, 100, 1000.0), 6000.0, 1e-9);
+    EXPECT_TRUE(m.lastWasKey());
+    EXPECT_NEAR(m.bytes(0, 230, 100, 1000.0), 1000.0, 1e-9);
+}
+
 TEST(RuntimeModel, ServerBoundRemoteRunsAtTheServersRate) {
     // Two full-frame layers of 100 ms on the server: 200 ms a frame. With two frames in flight
     // the server never idles, so scan-outs follow it exactly; with one it idles while the headset

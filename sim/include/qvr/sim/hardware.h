@@ -121,6 +121,25 @@ struct RuntimeCosts {
                std::pow(std::max(scale, 1.0),
                         own ? bits_outer_scale_exponent : bits_scale_exponent);
     }
+    // Each stream's canvas and key frames as the x264 encoder makes them (codec/video_codec.h
+    // CodecConfig, core/canvas_policy.h), replayed per stream: a P-frame in a canvas larger than
+    // the snug one the bits law was measured in pays padding_bits_ratio of a layer pixel's bits
+    // for each extra canvas pixel (relative to the snug canvas); a canvas change, and every
+    // keyint_frames-th frame of an encoder, is an IDR of keyframe_bits_ratio (middle or whole
+    // frame) or keyframe_outer_bits_ratio (outer) times the P-frame's bits (a new encoder's first
+    // frame; the periodic one keyframe_periodic_bits_ratio). keyframe_bits_ratio
+    // 0: no canvas model (every frame a P-frame of a snug canvas, calibration version ≤ 6).
+    int canvas_align_px = 16;
+    double canvas_headroom = 0.10;
+    double canvas_shrink_ratio = 0.5;
+    int canvas_shrink_after_frames = 30;
+    int keyint_frames = 120;  // 0: no periodic IDR
+    double keyframe_bits_ratio = 0.0;
+    double keyframe_outer_bits_ratio = 0.0;
+    // The periodic IDR of a running encoder (keyint_frames) costs less than a new encoder's
+    // first frame; 0: the new encoder's ratio.
+    double keyframe_periodic_bits_ratio = 0.0;
+    double padding_bits_ratio = 0.0;
     // Server, one core (render thread): per layer render and encode, and per request.
     LinearCost server_render{2.0, 60.0, 0.01};
     LinearCost encode{0.5, 12.0, 0.0};
@@ -172,7 +191,11 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             bits_outer_per_px_at_1 (0…100), bits_outer_scale_exponent (−4…4),
 //             server_render_base_ms, server_render_ms_per_mpx,
 //             server_render_ms_per_ktri, encode_base_ms, encode_ms_per_mpx, server_frame_ms,
-//             link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536)
+//             link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536);
+//             canvas_align_px (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio (0…1),
+//             canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
+//             keyframe_bits_ratio, keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio
+//             (0…1000), padding_bits_ratio (0…10)
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "qvr/core/canvas_policy.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/sim/design.h"
 #include "qvr/sim/hardware.h"
@@ -97,6 +98,35 @@ struct RuntimeSummary {
 struct RuntimeRunResult {
     std::vector<RuntimeFrame> frames;
     RuntimeSummary summary;
+};
+
+// Each stream's encoder as the runtime's x264 streams run it (RuntimeCosts' canvas model): the
+// canvas of CanvasPolicy, an IDR at the first frame, at every canvas change and every
+// keyint_frames-th frame, padding beyond the snug canvas charged at padding_bits_ratio. Without a
+// key-frame ratio (a calibration before version 7) every frame is the bits law's P-frame.
+class StreamCodecModel {
+public:
+    static constexpr int kStreams = 4;  // eye × {middle or whole frame, outer}: 2·eye + kind
+    static constexpr int kMaxSidePx = 8192;
+    explicit StreamCodecModel(const RuntimeCosts& costs);
+    bool enabled() const { return m_costs.keyframe_bits_ratio > 0.0; }
+    // The bytes of `stream`'s next frame: a width×height layer whose P-frame in a snug canvas
+    // takes p_bytes.
+    double bytes(int stream, int width, int height, double p_bytes);
+    bool lastWasKey() const { return m_last_key; }
+    // The last frame's canvas pixels over its snug canvas's (1 without the model): the codec's
+    // work, and its encode and decode time, scale with the canvas.
+    double lastCanvasShare() const { return m_last_canvas_share; }
+
+private:
+    struct State {
+        CanvasPolicy canvas;
+        int since_key = -1;  // frames since the last IDR; −1: none yet
+    };
+    RuntimeCosts m_costs;
+    std::vector<State> m_streams;
+    bool m_last_key = false;
+    double m_last_canvas_share = 1.0;
 };
 
 // Replays `trace` through the runtime's pipeline on `link` (a constant rate or a trace; the
