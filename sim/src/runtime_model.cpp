@@ -40,6 +40,7 @@ struct FrameState {
     double received_bytes = 0.0;
     double middle_bytes = 0.0, outer_bytes = 0.0;
     bool served = false;
+    bool closed = false;  // its pending entry is gone: later streams are not counted
 };
 
 // A layer the server renders and sends: its pixels, the triangles in its view, its bytes.
@@ -236,6 +237,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
     double busy = 0.0;  // busy time since the previous frame finished
     double last_e1_deg = 5.0;
     double last_complete_rx_ms = 0.0;
+    // The newest stream the headset took from the transport (the session's start before any):
+    // a server silent for a whole wait limit makes the runtime wait one refresh instead.
+    double last_stream_ms = 0.0;
     int64_t last_slot = -1;  // the newest scan-out's vsync slot index
     double ack_goodput_bps = 0.0;
     // Server and link.
@@ -363,8 +367,13 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         FrameState& fs = state[static_cast<size_t>(s.frame)];
         RuntimeFrame& rf = result.frames[static_cast<size_t>(s.frame)];
         fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
-        fs.received_bytes += s.payload_bytes;
-        rf.bytes += s.payload_bytes;
+        last_stream_ms = hs;
+        // The runtime counts a frame's bytes while it holds a pending entry: until the frame
+        // after it has been shown. Streams that arrive later are decoded but not counted.
+        if (!fs.closed) {
+            fs.received_bytes += s.payload_bytes;
+            rf.bytes += s.payload_bytes;
+        }
         if (++fs.decoded == fs.expected) {
             rf.remote_done_ms = hs;
             last_complete_rx_ms = std::max(last_complete_rx_ms, fs.last_rx_ms);
@@ -453,8 +462,13 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         bool have_current = fs.expected == 0;
         if (fs.expected > 0) {
             const double service_start = std::max(rf.request_ms, last_complete_rx_ms);
+            // A server that has delivered no stream for a whole wait limit: wait one refresh
+            // (the runtime's silent_server_frames, docs/RUNTIME.md step 5).
+            const bool silent = rf.local_end_ms - last_stream_ms > config.wait_limit_ms;
             const double deadline =
-                std::max({rf.local_end_ms, rf.pose_ms, service_start}) + config.wait_limit_ms;
+                silent
+                    ? std::max(rf.local_end_ms, rf.pose_ms) + period_ms
+                    : std::max({rf.local_end_ms, rf.pose_ms, service_start}) + config.wait_limit_ms;
             for (;;) {
                 advanceServer(deadline);  // no request is sent while the headset waits
                 if (fs.decoded == fs.expected || hs >= deadline)
@@ -474,6 +488,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         }
         // 6. UCA with the newest pose; a late frame re-warps older layers.
         rf.reused = !have_current;
+        // The runtime drops the pending entries of frames shown before this one.
+        for (int64_t k = i - 1; k >= 0 && !state[static_cast<size_t>(k)].closed; --k)
+            state[static_cast<size_t>(k)].closed = true;
         rf.uca_start_ms = hs;
         // What UCA reads: this frame's layers, or for a reused frame the older ones it re-warps
         // (same plan shape).
@@ -527,6 +544,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         finish(ahead.front());
         ahead.pop_front();
     }
+    // A frame the server rendered after the headset had shown it (reused) was still served.
+    for (int64_t i = 0; i < n_frames; ++i)
+        result.frames[static_cast<size_t>(i)].served = state[static_cast<size_t>(i)].served;
 
     // Summary, as summarizeRun (runtime/telemetry.cpp) computes it.
     RuntimeSummary& s = result.summary;

@@ -232,6 +232,39 @@ TEST(RuntimeModel, AFrameLaterThanTheWaitLimitIsReused) {
     EXPECT_NEAR(late.frames[0].uca_start_ms - late.frames[0].request_ms, 230.0, 1e-6);
 }
 
+TEST(RuntimeModel, ASilentServerCostsOneWaitLimitThenOneRefreshPerFrame) {
+    // ffr against a server that needs 1 s per layer: the first frame waits the 250 ms limit
+    // (nothing says the server is stalled yet); every later frame before the first stream
+    // arrives waits one refresh, as the runtime's headset does once the server has sent nothing
+    // for a whole limit (silent_server_frames).
+    const RuntimeRunResult r = run(Design::Ffr, flatCosts(1.0, 1.0, 1000.0), 1, 40);
+    EXPECT_NEAR(r.frames[0].uca_start_ms - r.frames[0].local_end_ms, 250.0, 1e-6);
+    int silent = 0;
+    for (size_t k = 1; k < r.frames.size() && r.frames[k].uca_start_ms < 1000.0; ++k) {
+        EXPECT_NEAR(r.frames[k].uca_start_ms - r.frames[k].local_end_ms, kSlotMs, 1e-6) << k;
+        EXPECT_TRUE(r.frames[k].reused);
+        ++silent;
+    }
+    EXPECT_GT(silent, 20);  // waiting the limit every time: 3 frames before 1 s
+}
+
+TEST(RuntimeModel, BytesArrivingAfterTheNextFrameIsShownAreNotCounted) {
+    // remote, one frame in flight, 400 ms per whole-frame layer: frame 0 is reused at the
+    // 250 ms limit; frame 1, with the server silent for a whole limit, is shown a refresh later
+    // and the runtime drops frame 0's pending entry. Frame 0's streams arrive at 400 and 800 ms:
+    // decoded, not counted. With 200 ms per layer its first stream comes at 200 ms, while it
+    // waits, and its second at 400 ms, while frame 1 waits the limit: both counted.
+    const RuntimeRunResult late = run(Design::Remote, flatCosts(0.0, 1.0, 400.0), 1, 10);
+    ASSERT_TRUE(late.frames[0].reused);
+    ASSERT_LT(late.frames[1].uca_start_ms, 400.0);
+    EXPECT_TRUE(late.frames[0].served);
+    EXPECT_EQ(late.frames[0].bytes, 0.0);
+    const RuntimeRunResult in_wait = run(Design::Remote, flatCosts(0.0, 1.0, 200.0), 1, 10);
+    const double stream_bytes = 320.0 * 360.0 * 0.1 / 8.0;  // the trace's 0.1 bits per pixel
+    ASSERT_TRUE(in_wait.frames[0].reused);
+    EXPECT_NEAR(in_wait.frames[0].bytes, 2.0 * stream_bytes, 1e-6);
+}
+
 TEST(RuntimeModel, TheServersQueueKeepsTheNewestRequests) {
     // A server far slower than the wait limit with two frames in flight: the headset moves on
     // with reused frames and its requests pile up; the queue (2) drops the oldest.
