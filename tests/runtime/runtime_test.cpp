@@ -8,12 +8,14 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <memory>
 #include <mutex>
 #include <numeric>
 #include <thread>
+#include <vector>
 
 #include "qvr/net/auth.h"
 #include "qvr/net/protocol.h"
@@ -292,12 +294,20 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
         runOn(headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 240));
     ASSERT_EQ(r.frames.size(), 240u);
     // The first frame into the stall waits the limit (nothing yet says the server stopped);
-    // after it the display keeps its rate (before: six 250 ms gaps in a row). Two more long
-    // gaps are allowed for a loaded test machine's scheduling.
-    int long_gaps = 0;
+    // after it the display keeps its rate (before: six gaps in a row each 250 ms longer than
+    // the display's usual one). A gap is long when it exceeds the run's median gap by 200 ms:
+    // on an ASan build a frame alone takes ~120 ms, so a fixed 150 ms counted ordinary frames
+    // (8 in an idle CI run). Two more long gaps are allowed for a loaded machine's scheduling.
+    std::vector<int64_t> gaps;
     for (size_t i = 1; i < r.frames.size(); ++i)
-        long_gaps += r.frames[i].display_ns - r.frames[i - 1].display_ns > 150'000'000;
-    EXPECT_LE(long_gaps, 3);
+        gaps.push_back(r.frames[i].display_ns - r.frames[i - 1].display_ns);
+    std::vector<int64_t> sorted = gaps;
+    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    const int64_t median_gap = sorted[sorted.size() / 2];
+    int long_gaps = 0;
+    for (int64_t g : gaps)
+        long_gaps += g > median_gap + 200'000'000;
+    EXPECT_LE(long_gaps, 3) << "median gap " << median_gap / 1'000'000 << " ms";
     // ~135 at 90 Hz; 27 on an ASan build, 13 (3 long gaps) on an ASan build with a calibration
     // and a compile beside it on two cores; 6 before the fix, each frame waiting the limit.
     EXPECT_GT(r.stats.silent_server_frames, 8u);
