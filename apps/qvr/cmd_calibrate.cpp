@@ -532,6 +532,12 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         double extra, ratio;  // canvas pixels over the snug canvas's − 1; bytes over the snug's
     };
     std::vector<PadSample> pad;
+    auto median = [](std::vector<double> v) {  // 0 for none
+        if (v.empty())
+            return 0.0;
+        std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+        return v[v.size() / 2];
+    };
     std::array<std::vector<double>, 2> key_ratio;  // a new encoder's IDR: middle, outer
     std::vector<double> periodic_ratio;            // the IDR at keyint_frames, both kinds
     nlohmann::json codec_by_e1 = nlohmann::json::array();
@@ -640,17 +646,11 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                     periodic_ratio.push_back(periodic_r[sid]);
                 }
             }
-            auto med = [](std::vector<double> v) {
-                if (v.empty())
-                    return 0.0;
-                std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-                return v[v.size() / 2];
-            };
             codec_by_e1.push_back({{"e1_deg", e1},
                                    {"middle_scale", scale[0]},
-                                   {"middle_bits_per_px_median", med(bits_px[0])},
+                                   {"middle_bits_per_px_median", median(bits_px[0])},
                                    {"outer_scale", scale[1]},
-                                   {"outer_bits_per_px_median", med(bits_px[1])},
+                                   {"outer_bits_per_px_median", median(bits_px[1])},
                                    {"keyframe_ratio_per_stream", open_r},
                                    {"periodic_keyframe_ratio_per_stream", periodic_r}});
             log(fmt::format("  codec: {} frames at e1 = {} deg\n", bits_frames, e1));
@@ -662,12 +662,6 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     cal.costs.canvas_shrink_ratio = codec.canvas_shrink_ratio;
     cal.costs.canvas_shrink_after_frames = codec.canvas_shrink_after_frames;
     cal.costs.keyint_frames = codec.keyint_frames;
-    auto median = [](std::vector<double> v) {
-        if (v.empty())
-            return 0.0;
-        std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-        return v[v.size() / 2];
-    };
     cal.costs.keyframe_bits_ratio = median(key_ratio[0]);
     cal.costs.keyframe_outer_bits_ratio = median(key_ratio[1]);
     cal.costs.keyframe_periodic_bits_ratio = median(periodic_ratio);
