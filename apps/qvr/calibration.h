@@ -30,7 +30,7 @@ struct CalibratedPart {
     std::string name;
     std::string what;  // what one sample is
     int samples = 0;
-    LinearCost cost;
+    PartCost cost;
     double median_ms = 0.0, min_ms = 0.0, max_ms = 0.0;    // of the samples
     double residual_rms_pct = 0.0;                         // RMS of (measured − fit) / measured
     std::vector<std::array<double, 3>> samples_ms_px_tri;  // every sample, in the JSON
@@ -58,6 +58,10 @@ Expected<Calibration> runCalibration(const CalibrateOptions& options);
 // cached calibration of `qvr run` is stored under it.
 std::string calibrationCacheKey(const CalibrateOptions& options);
 std::string calibrationCachePath(const CalibrateOptions& options);
+// A part's fitted law as text: "a + b·Mpx + c·ktri" or "k·Mpx^p·ktri^q", with its whole-frame
+// scale.
+std::string costLawText(const PartCost& cost);
+
 std::string machineDescriptionLine();
 
 }  // namespace qvr::cli

@@ -30,6 +30,7 @@
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
 #include "qvr/runtime/workload_probe.h"
+#include "qvr/sim/cost_fit.h"
 #include "qvr/sim/runtime_model.h"
 
 namespace qvr::cli {
@@ -42,78 +43,10 @@ double msSince(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-struct Sample {
-    double ms = 0.0;
-    double pixels = 0.0;
-    double triangles = 0.0;
-};
-
-// Weighted least squares of ms on [1, Mpx, ktri] over the features `use` selects; a negative slope
-// is dropped and the rest refitted (a cost cannot fall with size).
-LinearCost fit(const std::vector<Sample>& s, bool use_px, bool use_tri) {
-    for (;;) {
-        std::vector<std::function<double(const Sample&)>> f = {[](const Sample&) { return 1.0; }};
-        if (use_px)
-            f.push_back([](const Sample& x) { return x.pixels * 1e-6; });
-        if (use_tri)
-            f.push_back([](const Sample& x) { return x.triangles * 1e-3; });
-        const size_t k = f.size();
-        std::vector<std::vector<double>> a(k, std::vector<double>(k + 1, 0.0));
-        // Weighted by 1/ms²: relative errors count, so a 1 ms fovea weighs as much as a 200 ms
-        // full frame (the model must predict both).
-        for (const Sample& x : s) {
-            const double w = 1.0 / std::max(x.ms * x.ms, 0.01);
-            for (size_t i = 0; i < k; ++i) {
-                for (size_t j = 0; j < k; ++j)
-                    a[i][j] += w * f[i](x) * f[j](x);
-                a[i][k] += w * f[i](x) * x.ms;
-            }
-        }
-        // Ridge-free Gaussian elimination with partial pivoting; a singular column gets 0.
-        std::vector<double> beta(k, 0.0);
-        for (size_t c = 0; c < k; ++c) {
-            size_t p = c;
-            for (size_t r = c + 1; r < k; ++r)
-                if (std::fabs(a[r][c]) > std::fabs(a[p][c]))
-                    p = r;
-            std::swap(a[c], a[p]);
-            if (std::fabs(a[c][c]) < 1e-12)
-                continue;
-            for (size_t r = 0; r < k; ++r) {
-                if (r == c)
-                    continue;
-                const double m = a[r][c] / a[c][c];
-                for (size_t j = c; j <= k; ++j)
-                    a[r][j] -= m * a[c][j];
-            }
-        }
-        for (size_t c = 0; c < k; ++c)
-            beta[c] = std::fabs(a[c][c]) < 1e-12 ? 0.0 : a[c][k] / a[c][c];
-        LinearCost cost;
-        cost.base_ms = beta[0];
-        size_t idx = 1;
-        if (use_px)
-            cost.ms_per_mpx = beta[idx++];
-        if (use_tri)
-            cost.ms_per_ktri = beta[idx++];
-        if (use_tri && cost.ms_per_ktri < 0) {
-            use_tri = false;
-            continue;
-        }
-        if (use_px && cost.ms_per_mpx < 0) {
-            use_px = false;
-            continue;
-        }
-        if (cost.base_ms < 0) {
-            // Through the origin is the closest a cost can come.
-            cost.base_ms = 0.0;
-        }
-        return cost;
-    }
-}
+using Sample = CostSample;
 
 CalibratedPart summarise(const std::string& name, const std::string& what,
-                         const std::vector<Sample>& s, const LinearCost& cost) {
+                         const std::vector<Sample>& s, const PartCost& cost) {
     CalibratedPart p;
     p.name = name;
     p.what = what;
@@ -122,17 +55,13 @@ CalibratedPart summarise(const std::string& name, const std::string& what,
     if (s.empty())
         return p;
     std::vector<double> ms;
-    double sq = 0.0;
-    for (const Sample& x : s) {
+    for (const Sample& x : s)
         ms.push_back(x.ms);
-        const double r = x.ms > 0 ? (x.ms - cost.at(x.pixels, x.triangles)) / x.ms : 0.0;
-        sq += r * r;
-    }
     std::sort(ms.begin(), ms.end());
     p.median_ms = ms[ms.size() / 2];
     p.min_ms = ms.front();
     p.max_ms = ms.back();
-    p.residual_rms_pct = 100.0 * std::sqrt(sq / double(s.size()));
+    p.residual_rms_pct = costResidualRmsPct(s, cost);
     for (const Sample& x : s)
         p.samples_ms_px_tri.push_back({x.ms, x.pixels, x.triangles});
     return p;
@@ -162,13 +91,24 @@ std::string utcNow() {
 
 }  // namespace
 
+std::string costLawText(const PartCost& c) {
+    std::string s = c.power_coef_ms > 0.0
+                        ? fmt::format("{:.4g}·Mpx^{:.3f}·ktri^{:.3f}", c.power_coef_ms,
+                                      c.px_exponent, c.tri_exponent)
+                        : fmt::format("{:.3f} + {:.3f}·Mpx + {:.4f}·ktri", c.base_ms, c.ms_per_mpx,
+                                      c.ms_per_ktri);
+    if (c.full_frame_scale != 1.0)
+        s += fmt::format("; whole frame {:.3f}×", c.full_frame_scale);
+    return s;
+}
+
 std::string machineDescriptionLine() {
     return fmt::format("{} × {}", runtime::onlineCores(), cpuModel());
 }
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 7;
+    constexpr int kCalibrationVersion = 8;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -198,6 +138,11 @@ nlohmann::json Calibration::toJson() const {
                               {"base_ms", p.cost.base_ms},
                               {"ms_per_mpx", p.cost.ms_per_mpx},
                               {"ms_per_ktri", p.cost.ms_per_ktri},
+                              {"law", p.cost.power_coef_ms > 0.0 ? "power" : "linear"},
+                              {"power_coef_ms", p.cost.power_coef_ms},
+                              {"px_exponent", p.cost.px_exponent},
+                              {"tri_exponent", p.cost.tri_exponent},
+                              {"full_frame_scale", p.cost.full_frame_scale},
                               {"median_ms", p.median_ms},
                               {"min_ms", p.min_ms},
                               {"max_ms", p.max_ms},
@@ -234,9 +179,10 @@ std::string Calibration::toToml() const {
     s += "# machine: " + machine + "\n";
     for (const CalibratedPart& p : parts)
         s += fmt::format(
-            "# {:14} {:3} samples ({}): median {:.2f} ms [{:.2f}, {:.2f}], fit residual "
-            "{:.0f}% RMS\n",
-            p.name, p.samples, p.what, p.median_ms, p.min_ms, p.max_ms, p.residual_rms_pct);
+            "# {:14} {:3} samples ({}): median {:.2f} ms [{:.2f}, {:.2f}], {} ms, fit "
+            "residual {:.0f}% RMS\n",
+            p.name, p.samples, p.what, p.median_ms, p.min_ms, p.max_ms, costLawText(p.cost),
+            p.residual_rms_pct);
     s += fmt::format(
         "# bits per layer pixel: middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}, over {} P-frames\n",
         costs.bits_per_px_at_1, costs.bits_scale_exponent, costs.bits_outer_per_px_at_1,
@@ -338,7 +284,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             decision.push_back({msSince(t0), 0.0, 0.0});
             (void)wf;
         }
-    cal.costs.decision = fit(decision, false, false);
+    cal.costs.decision = fitPartCost(decision, {.use_px = false, .use_tri = false});
     cal.parts.push_back(
         summarise("decision", "cluster ring counts, both eyes", decision, cal.costs.decision));
     log(fmt::format("  decision: {} samples\n", decision.size()));
@@ -505,9 +451,9 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 return makeError("full render: " + st.error());
             const double ms = msSince(t0);
             const double tris = drawnTriangles(full, p.head, eye, LayerKind::kFovea);
-            fovea.push_back({ms, eye_px, tris});
+            fovea.push_back({ms, eye_px, tris, true});
             // The server's whole-frame layer is the same view at scale 1.
-            server.push_back({ms, eye_px, tris});
+            server.push_back({ms, eye_px, tris, true});
         }
         for (int rep_i = 0; rep_i < 2; ++rep_i) {
             const auto t0 = Clock::now();
@@ -698,11 +644,15 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         fitBits(bits[1], cal.costs.bits_outer_per_px_at_1, cal.costs.bits_outer_scale_exponent);
         cal.bits_samples += static_cast<int>(bits[1].size());
     }
-    cal.costs.fovea = fit(fovea, true, true);
-    cal.costs.server_render = fit(server, true, true);
-    cal.costs.encode = fit(encode, true, false);
-    cal.costs.decode = fit(decode, true, false);
-    cal.costs.uca = fit(uca, true, false);
+    // The render passes may follow the power law (llvmpipe's fovea pass is not linear over
+    // 3 kpx … 4 Mpx); the whole frame gets its own scale (MODEL.md §8).
+    const CostFitOptions render_fit{.use_px = true, .use_tri = true, .allow_power = true};
+    const CostFitOptions px_only{.use_px = true, .use_tri = false, .allow_power = false};
+    cal.costs.fovea = fitPartCost(fovea, render_fit);
+    cal.costs.server_render = fitPartCost(server, render_fit);
+    cal.costs.encode = fitPartCost(encode, px_only);
+    cal.costs.decode = fitPartCost(decode, px_only);
+    cal.costs.uca = fitPartCost(uca, px_only);
     cal.parts.push_back(
         summarise("fovea/local", "one eye's fovea or full-frame pass", fovea, cal.costs.fovea));
     cal.parts.push_back(summarise("server render",
@@ -754,13 +704,11 @@ int runCalibrate(CalibrateCmdOptions& o) {
         return 2;
     }
     cal->command = o.command_line;
-    fmt::print("  {:14} {:>7} {:>9} {:>9} {:>9} {:>10} {:>10} {:>10} {:>9}\n", "part", "samples",
-               "median", "min", "max", "base ms", "ms/Mpx", "ms/ktri", "fit RMS");
+    fmt::print("  {:14} {:>7} {:>9} {:>9} {:>9} {:>8}  {}\n", "part", "samples", "median", "min",
+               "max", "fit RMS", "law (ms)");
     for (const CalibratedPart& p : cal->parts)
-        fmt::print(
-            "  {:14} {:>7} {:>9.2f} {:>9.2f} {:>9.2f} {:>10.3f} {:>10.3f} {:>10.4f} {:>8.0f}%\n",
-            p.name, p.samples, p.median_ms, p.min_ms, p.max_ms, p.cost.base_ms, p.cost.ms_per_mpx,
-            p.cost.ms_per_ktri, p.residual_rms_pct);
+        fmt::print("  {:14} {:>7} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.0f}%  {}\n", p.name, p.samples,
+                   p.median_ms, p.min_ms, p.max_ms, p.residual_rms_pct, costLawText(p.cost));
     fmt::print(
         "  frame overhead (plan) {:.3f} ms; packets {} + {} bytes; took {:.0f} s, load "
         "average {:.2f} before\n",

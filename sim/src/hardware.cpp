@@ -94,11 +94,21 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     auto cost = [&](const char* key, double& v) {
         v = r.number(std::string("runtime.") + key, v, 0.0, 10000.0);
     };
+    // A render part's power law and whole-frame scale (PartCost).
+    auto powerLaw = [&](const std::string& part, PartCost& pc) {
+        pc.power_coef_ms =
+            r.number("runtime." + part + "_power_coef_ms", pc.power_coef_ms, 0.0, 10000.0);
+        pc.px_exponent = r.number("runtime." + part + "_px_exponent", pc.px_exponent, -4.0, 4.0);
+        pc.tri_exponent = r.number("runtime." + part + "_tri_exponent", pc.tri_exponent, -4.0, 4.0);
+        pc.full_frame_scale =
+            r.number("runtime." + part + "_full_frame_scale", pc.full_frame_scale, 0.01, 100.0);
+    };
     cost("decision_base_ms", rc.decision.base_ms);
     cost("decision_ms_per_ktri", rc.decision.ms_per_ktri);
     cost("fovea_base_ms", rc.fovea.base_ms);
     cost("fovea_ms_per_mpx", rc.fovea.ms_per_mpx);
     cost("fovea_ms_per_ktri", rc.fovea.ms_per_ktri);
+    powerLaw("fovea", rc.fovea);
     cost("decode_base_ms", rc.decode.base_ms);
     cost("decode_ms_per_mpx", rc.decode.ms_per_mpx);
     cost("uca_base_ms", rc.uca.base_ms);
@@ -114,6 +124,7 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     cost("server_render_base_ms", rc.server_render.base_ms);
     cost("server_render_ms_per_mpx", rc.server_render.ms_per_mpx);
     cost("server_render_ms_per_ktri", rc.server_render.ms_per_ktri);
+    powerLaw("server_render", rc.server_render);
     cost("encode_base_ms", rc.encode.base_ms);
     cost("encode_ms_per_mpx", rc.encode.ms_per_mpx);
     cost("server_frame_ms", rc.server_frame_ms);
@@ -159,11 +170,18 @@ namespace qvr {
 std::string runtimeCostsToml(const RuntimeCosts& c) {
     std::string s = "[runtime]\npipeline = \"runtime\"\n";
     auto put = [&](const char* key, double v) { s += fmt::format("{} = {:.6g}\n", key, v); };
+    auto putLaw = [&](const std::string& part, const PartCost& pc) {
+        put((part + "_power_coef_ms").c_str(), pc.power_coef_ms);
+        put((part + "_px_exponent").c_str(), pc.px_exponent);
+        put((part + "_tri_exponent").c_str(), pc.tri_exponent);
+        put((part + "_full_frame_scale").c_str(), pc.full_frame_scale);
+    };
     put("decision_base_ms", c.decision.base_ms);
     put("decision_ms_per_ktri", c.decision.ms_per_ktri);
     put("fovea_base_ms", c.fovea.base_ms);
     put("fovea_ms_per_mpx", c.fovea.ms_per_mpx);
     put("fovea_ms_per_ktri", c.fovea.ms_per_ktri);
+    putLaw("fovea", c.fovea);
     put("decode_base_ms", c.decode.base_ms);
     put("decode_ms_per_mpx", c.decode.ms_per_mpx);
     put("uca_base_ms", c.uca.base_ms);
@@ -176,6 +194,7 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("server_render_base_ms", c.server_render.base_ms);
     put("server_render_ms_per_mpx", c.server_render.ms_per_mpx);
     put("server_render_ms_per_ktri", c.server_render.ms_per_ktri);
+    putLaw("server_render", c.server_render);
     put("encode_base_ms", c.encode.base_ms);
     put("encode_ms_per_mpx", c.encode.ms_per_mpx);
     put("server_frame_ms", c.server_frame_ms);

@@ -323,7 +323,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
             // The codec works on the whole canvas: its encode and decode laws were measured in
             // snug ones.
             const double coded_px = job.pixels * codecs.lastCanvasShare();
-            const double render = c.server_render.at(job.pixels, job.triangles);
+            const double render = whole_frame
+                                      ? c.server_render.atFullFrame(job.pixels, job.triangles)
+                                      : c.server_render.at(job.pixels, job.triangles);
             const double encode = c.encode.at(coded_px, 0.0);
             t += render + encode;
             server_busy_total += render + encode;
@@ -450,9 +452,11 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
                            : sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e1_deg);
             for (int eye = 0; eye < 2; ++eye) {
                 const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
-                if (!e.fovea.empty())
-                    work(
-                        c.fovea.at(double(e.fovea.pixels()), drawn(i, fs.plan, eye, 0, tris, 1.0)));
+                if (e.fovea.empty())
+                    continue;
+                const double px = double(e.fovea.pixels());
+                const double drawn_tris = drawn(i, fs.plan, eye, 0, tris, 1.0);
+                work(local_only ? c.fovea.atFullFrame(px, drawn_tris) : c.fovea.at(px, drawn_tris));
             }
         }
         rf.local_end_ms = hs;

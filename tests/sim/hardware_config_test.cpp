@@ -65,6 +65,11 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.keyframe_outer_bits_ratio = 5.25;
     c.keyframe_periodic_bits_ratio = 3.5;
     c.padding_bits_ratio = 0.5;
+    c.server_render.power_coef_ms = 3.5;
+    c.server_render.px_exponent = 0.5;
+    c.server_render.tri_exponent = 0.75;
+    c.server_render.full_frame_scale = 1.75;
+    c.fovea.full_frame_scale = 0.875;
     auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
     ASSERT_TRUE(hw.ok()) << hw.error();
     EXPECT_TRUE(hw->runtime_pipeline);
@@ -85,6 +90,16 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.keyframe_outer_bits_ratio, 5.25);
     EXPECT_EQ(hw->runtime.keyframe_periodic_bits_ratio, 3.5);
     EXPECT_EQ(hw->runtime.padding_bits_ratio, 0.5);
+    // A render part's power law and whole-frame scale.
+    EXPECT_EQ(hw->runtime.server_render.power_coef_ms, 3.5);
+    EXPECT_EQ(hw->runtime.server_render.px_exponent, 0.5);
+    EXPECT_EQ(hw->runtime.server_render.tri_exponent, 0.75);
+    EXPECT_EQ(hw->runtime.server_render.full_frame_scale, 1.75);
+    EXPECT_DOUBLE_EQ(hw->runtime.server_render.at(4e6, 9e3), 3.5 * 2.0 * std::pow(9.0, 0.75));
+    EXPECT_DOUBLE_EQ(hw->runtime.server_render.atFullFrame(4e6, 9e3),
+                     1.75 * 3.5 * 2.0 * std::pow(9.0, 0.75));
+    EXPECT_EQ(hw->runtime.fovea.power_coef_ms, 0.0);  // linear: the law above
+    EXPECT_DOUBLE_EQ(hw->runtime.fovea.atFullFrame(1e6, 8e3), 0.875 * (3.5 + 41.0 + 1.0));
     // The middle (and whole frame) read their law, the outer its own; without one, the middle's.
     EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, false), 0.3 * std::pow(4.0, 0.25));
     EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, true), 0.125 * 2.0);
@@ -103,7 +118,10 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
           "[runtime]\ncanvas_align_px = 0\n", "[runtime]\ncanvas_headroom = 2\n",
           "[runtime]\nkeyint_frames = -1\n", "[runtime]\nkeyframe_bits_ratio = -3\n",
           "[runtime]\npadding_bits_ratio = 11\n", "[runtime]\nkeyframe_periodic_bits_ratio = -1\n",
-          "[runtime]\ncanvas_shrink_after_frames = 0\n"}) {
+          "[runtime]\ncanvas_shrink_after_frames = 0\n", "[runtime]\nfovea_full_frame_scale = 0\n",
+          "[runtime]\nserver_render_px_exponent = 5\n",
+          "[runtime]\nserver_render_power_coef_ms = -2\n",
+          "[runtime]\nfovea_tri_exponent = \"x\"\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
         EXPECT_FALSE(r.ok()) << bad;
         if (!r.ok()) {

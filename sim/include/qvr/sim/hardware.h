@@ -86,13 +86,27 @@ struct FixedLatencies {
 
 // ---- The runtime pipeline model (runtime_model.h): this machine's costs, from `qvr calibrate`.
 
-// A linear cost a + b·x + c·y in ms; what `qvr calibrate` fits by least squares.
-struct LinearCost {
+// One part's cost in ms for a pass over `pixels` drawing `triangles`: the linear law
+// a + b·Mpx + c·ktri, or, when power_coef_ms > 0, the power law k·Mpx^p·ktri^q (llvmpipe's
+// fovea pass is not linear in either over 3 kpx … 4 Mpx: MODEL.md §8). A whole frame (local's
+// pass, remote's layer) costs full_frame_scale × the law: the law is fitted to the fovea and
+// periphery layers, the whole frame is measured on its own. `qvr calibrate` fits all of it.
+struct PartCost {
     double base_ms = 0.0;
-    double ms_per_mpx = 0.0;   // per million pixels
-    double ms_per_ktri = 0.0;  // per thousand triangles (as the scene's BVH counts them)
+    double ms_per_mpx = 0.0;     // per million pixels
+    double ms_per_ktri = 0.0;    // per thousand triangles (as the scene's BVH counts them)
+    double power_coef_ms = 0.0;  // > 0: the power law replaces the linear one
+    double px_exponent = 0.0;
+    double tri_exponent = 0.0;
+    double full_frame_scale = 1.0;
     double at(double pixels, double triangles) const {
+        if (power_coef_ms > 0.0)
+            return power_coef_ms * std::pow(std::max(pixels * 1e-6, 1e-6), px_exponent) *
+                   std::pow(std::max(triangles * 1e-3, 0.01), tri_exponent);
         return base_ms + ms_per_mpx * pixels * 1e-6 + ms_per_ktri * triangles * 1e-3;
+    }
+    double atFullFrame(double pixels, double triangles) const {
+        return full_frame_scale * at(pixels, triangles);
     }
 };
 
@@ -101,11 +115,11 @@ struct LinearCost {
 // runtime` run); a calibration replaces every one of them.
 struct RuntimeCosts {
     // Headset, one core.
-    LinearCost decision{0.5, 0.0, 0.04};  // BVH ring counts to e1 + 6°: triangles counted
-    LinearCost fovea{2.0, 50.0, 0.02};    // one eye's fovea (or full frame) render pass
-    LinearCost decode{0.3, 4.0, 0.0};     // one stream, per decoded layer pixel
-    LinearCost uca{5.0, 1.3, 0.0};        // one frame: base + per layer pixel read (both eyes)
-    double frame_overhead_ms = 0.5;       // per frame: pumps, telemetry, bookkeeping
+    PartCost decision{0.5, 0.0, 0.04};  // BVH ring counts to e1 + 6°: triangles counted
+    PartCost fovea{2.0, 50.0, 0.02};    // one eye's fovea (or full frame) render pass
+    PartCost decode{0.3, 4.0, 0.0};     // one stream, per decoded layer pixel
+    PartCost uca{5.0, 1.3, 0.0};        // one frame: base + per layer pixel read (both eyes)
+    double frame_overhead_ms = 0.5;     // per frame: pumps, telemetry, bookkeeping
     // The codec's P-frame size on the calibration's scene: bits per layer pixel b·s^γ at scale
     // s. 0: take bits per pixel from the workload trace instead.
     double bits_per_px_at_1 = 0.0;
@@ -141,8 +155,8 @@ struct RuntimeCosts {
     double keyframe_periodic_bits_ratio = 0.0;
     double padding_bits_ratio = 0.0;
     // Server, one core (render thread): per layer render and encode, and per request.
-    LinearCost server_render{2.0, 60.0, 0.01};
-    LinearCost encode{0.5, 12.0, 0.0};
+    PartCost server_render{2.0, 60.0, 0.01};
+    PartCost encode{0.5, 12.0, 0.0};
     double server_frame_ms = 0.0;
     // Link: media packets carry this much payload and this much header on the wire.
     double packet_payload_bytes = 1200.0;
@@ -186,14 +200,16 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //   [latency] sensor_ms, display_ms (0…1000)
 //   [runtime] pipeline ("paper" or "runtime"); every cost in ms, 0…10000:
 //             decision_base_ms, decision_ms_per_ktri, fovea_base_ms, fovea_ms_per_mpx,
-//             fovea_ms_per_ktri, decode_base_ms, decode_ms_per_mpx, uca_base_ms, uca_ms_per_mpx,
-//             frame_overhead_ms, bits_per_px_at_1 (0…100), bits_scale_exponent (−4…4),
-//             bits_outer_per_px_at_1 (0…100), bits_outer_scale_exponent (−4…4),
-//             server_render_base_ms, server_render_ms_per_mpx,
-//             server_render_ms_per_ktri, encode_base_ms, encode_ms_per_mpx, server_frame_ms,
-//             link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536);
-//             canvas_align_px (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio (0…1),
-//             canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
+//             fovea_ms_per_ktri, fovea_power_coef_ms, fovea_px_exponent, fovea_tri_exponent
+//             (−4…4), fovea_full_frame_scale (0.01…100), decode_base_ms, decode_ms_per_mpx,
+//             uca_base_ms, uca_ms_per_mpx, frame_overhead_ms, bits_per_px_at_1 (0…100),
+//             bits_scale_exponent (−4…4), bits_outer_per_px_at_1 (0…100), bits_outer_scale_exponent
+//             (−4…4), server_render_base_ms, server_render_ms_per_mpx, server_render_ms_per_ktri,
+//             server_render_power_coef_ms, server_render_px_exponent, server_render_tri_exponent
+//             (−4…4), server_render_full_frame_scale (0.01…100), encode_base_ms, encode_ms_per_mpx,
+//             server_frame_ms, link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes
+//             (0…65536); canvas_align_px (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio
+//             (0…1), canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
 //             keyframe_bits_ratio, keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio
 //             (0…1000), padding_bits_ratio (0…10)
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,

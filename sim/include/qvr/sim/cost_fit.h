@@ -1,0 +1,41 @@
+// Fitting one part's cost (hardware.h PartCost) to timed micro-benchmark samples: what
+// `qvr calibrate` does for every part of the runtime (docs/MODEL.md §8).
+#pragma once
+
+#include <vector>
+
+#include "qvr/sim/hardware.h"
+
+namespace qvr {
+
+// One timed pass: its time, the pixels it shaded and the triangles it drew; full_frame marks a
+// whole frame (local's pass, remote's layer), which gets its own scale rather than weighing on
+// the law.
+struct CostSample {
+    double ms = 0.0;
+    double pixels = 0.0;
+    double triangles = 0.0;
+    bool full_frame = false;
+};
+
+struct CostFitOptions {
+    bool use_px = true;
+    bool use_tri = true;
+    // Also fit the power law k·Mpx^p·ktri^q and keep it where its residual is smaller.
+    bool allow_power = false;
+};
+
+// Fits the law to the samples that are not whole frames. The linear law: least squares weighted
+// by 1/ms² (relative errors count, so a 1 ms fovea weighs as much as a 100 ms one); a negative
+// slope is dropped and a negative intercept fixed at 0, the rest refitted each time (a cost
+// cannot fall with size, nor be negative for a small pass). With allow_power, also the power
+// law by least squares on logs; the law with the smaller RMS relative residual over those
+// samples is kept. full_frame_scale is the median of measured / law over the whole-frame
+// samples (1 without any). No samples: a zero cost.
+PartCost fitPartCost(const std::vector<CostSample>& samples, const CostFitOptions& options);
+
+// RMS of (measured − predicted) / measured over the samples, in percent; whole frames are
+// predicted with the cost's full_frame_scale.
+double costResidualRmsPct(const std::vector<CostSample>& samples, const PartCost& cost);
+
+}  // namespace qvr
