@@ -163,7 +163,9 @@ Expected<ServerProcess> ServerProcess::start(const std::string& executable,
     const auto deadline =
         std::chrono::steady_clock::now() + std::chrono::milliseconds(ready_timeout_ms);
     for (;;) {
-        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        // Rounded up: truncated, the last fraction of a millisecond read as 0 left and the
+        // child was declared silent up to 1 ms before its timeout (CI saw 299 of 300 ms).
+        const auto left = std::chrono::ceil<std::chrono::milliseconds>(
                               deadline - std::chrono::steady_clock::now())
                               .count();
         if (left <= 0) {
