@@ -164,6 +164,27 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
              v.latency < best.latency - m_config.period_tie * best.latency))
             best = v;
     }
+    // The window sees only ±max_delta. Where the period is flat across it — a link so slow
+    // that R exceeds L at every e1 short of the whole view, so each step of the window saves
+    // less than the tie — the search would stay put although the all-local cover (or another
+    // far e1) is much faster. Look over the whole range on a coarse grid as well, and when a
+    // far e1 beats the window's best by more than the tie, head for it one window step a frame.
+    {
+        Eval far = best;
+        const double top = std::max(lo, hi);
+        for (double e = lo;; e = std::min(top, e + kFarStepDeg)) {
+            const Eval v = evaluate(e);
+            if (v.period < far.period)
+                far = v;
+            if (e >= top)
+                break;
+        }
+        if (far.period < best.period - m_config.period_tie * best.period) {
+            const double toward = std::clamp(far.e1, m_e1_deg - m_config.max_delta_deg,
+                                             m_e1_deg + m_config.max_delta_deg);
+            best = evaluate(std::clamp(toward, lo, top));
+        }
+    }
     m_e1_deg = best.e1;
     Decision d;
     d.e1_deg = best.e1;

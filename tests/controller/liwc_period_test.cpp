@@ -167,6 +167,31 @@ TEST(LiwcPeriodObjective, DriftsToTheSmallestFoveaWhenTRemoteDoesNotFallWithE1) 
     }
 }
 
+// The same flat T_remote, but far above what the headset takes for the whole view (a link too
+// slow for any periphery: every frame arrives at the wait limit). Each step of the ±5° window
+// changes the period by nothing, so only a look past the window finds the all-local cover,
+// where there is no T_remote at all; LIWC must walk there and stay.
+TEST(LiwcPeriodObjective, LeavesAFlatPeriodForTheAllLocalCoverWhenTRemoteExceedsIt) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.remote_constant_ms = 500.0;
+    truth.noise = 0.05;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    // The whole view costs the headset ~51 ms: a tenth of T_remote.
+    ASSERT_LT(truth.localMs(f, 100.0), 60.0);
+    for (int depth : {1, 2}) {
+        LiwcConfig c = periodConfig();
+        LiwcPolicy liwc(h, c);
+        const std::vector<Decision> d = run(liwc, truth, planner, f, 120, depth, 13);
+        for (size_t i = 80; i < d.size(); ++i) {
+            EXPECT_FALSE(planner.plan(f.gaze, d[i].e1_deg).hasRemote())
+                << "depth " << depth << " frame " << i << " e1 " << d[i].e1_deg;
+            EXPECT_EQ(d[i].t_remote_pred_ms, 0.0) << "depth " << depth << " frame " << i;
+        }
+    }
+}
+
 // T_local rises and T_remote falls with e1: the period max(T_local, T_remote) is smallest where
 // they cross. The crossing is computed here from the made-up machine on a fine grid.
 TEST(LiwcPeriodObjective, SettlesNearTheCrossingWhenLocalRisesAndRemoteFalls) {

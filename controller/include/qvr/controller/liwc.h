@@ -98,6 +98,7 @@ private:
     void updateGpuRates(double triangles, double pixels, double t_local_ms);
     void remember(const Decision& d);
     static constexpr size_t kMaxPendingDecisions = 8;
+    static constexpr double kFarStepDeg = 2.5;  // the coarse grid decidePeriod also scans
     // Per-frame quantities every candidate shares: computed once in decide().
     void prepareFrame(const WorkloadFrame& frame) const;
     double localMs(double e1_deg) const;
