@@ -2,6 +2,7 @@
 #include "qvr/net/stream_assembler.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <utility>
 
@@ -54,8 +55,13 @@ bool StreamAssembler::coveredElsewhere(const Stream& s, uint32_t seq) const {
                        [&](const Finished& f) { return in(f.first_seq, f.last_seq); });
 }
 
-void StreamAssembler::nackMissingData(Stream& s, const Partial& p, int64_t now_ns) {
-    for (uint32_t i = 0; i < p.packet_count; ++i) {
+void StreamAssembler::nackMissingData(Stream& s, const Partial& p, int64_t now_ns,
+                                      int max_outstanding) {
+    int outstanding = 0;  // this frame's packets asked for and not yet come
+    for (const Missing& m : s.missing)
+        if (seqAfter(m.seq, p.first_seq) >= 0 && seqAfter(m.seq, p.last_seq) <= 0)
+            ++outstanding;
+    for (uint32_t i = 0; i < p.packet_count && outstanding < max_outstanding; ++i) {
         const uint32_t want = p.first_seq + i;
         if (p.have[i] || static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream ||
             std::any_of(s.missing.begin(), s.missing.end(),
@@ -64,6 +70,7 @@ void StreamAssembler::nackMissingData(Stream& s, const Partial& p, int64_t now_n
         }
         s.missing.push_back({want, now_ns, 1});
         s.nack_now.push_back(want);
+        ++outstanding;
     }
 }
 
@@ -123,6 +130,26 @@ void StreamAssembler::declareLost(uint8_t stream_id, std::map<uint32_t, Partial>
     release(stream_id);
 }
 
+void StreamAssembler::samplePacketGap(int64_t gap_ns) {
+    // RFC 6298's smoothing, on the gaps between consecutive packets of one frame.
+    const double g = static_cast<double>(std::max<int64_t>(gap_ns, 0));
+    if (!m_gap_sampled) {
+        m_gap_sampled = true;
+        m_gap_mean_ns = g;
+        m_gap_dev_ns = g / 2.0;
+        return;
+    }
+    m_gap_dev_ns = 0.75 * m_gap_dev_ns + 0.25 * std::fabs(m_gap_mean_ns - g);
+    m_gap_mean_ns = 0.875 * m_gap_mean_ns + 0.125 * g;
+}
+
+int64_t StreamAssembler::tailNackNs() const {
+    const double paced = m_gap_mean_ns + 4.0 * m_gap_dev_ns;
+    const double cap = std::max<double>(static_cast<double>(m_limits.tail_nack_ns),
+                                        static_cast<double>(m_limits.tail_nack_max_ns));
+    return static_cast<int64_t>(std::clamp(paced, static_cast<double>(m_limits.tail_nack_ns), cap));
+}
+
 void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
     QVR_CHECK(packet.header.stream_id < kMaxStreams);
     accept(packet, now_ns);
@@ -136,12 +163,14 @@ void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
 
     // Sequence gaps: packets that never came. A late packet (negative distance) fills no gap
     // count back in; reordering on the emulated link cannot happen (it keeps order).
+    bool consecutive = false;  // the packet right after the stream's newest: a pacing sample
     if (!s.has_seq) {
         s.has_seq = true;
         s.next_seq = h.seq + 1;
         m_window_expected += 1;
     } else {
         const int64_t d = seqAfter(h.seq, s.next_seq);
+        consecutive = d == 0;
         if (d >= 0) {
             m_window_expected += static_cast<uint32_t>(d) + 1;
             m_window_lost += static_cast<uint32_t>(d);
@@ -274,6 +303,9 @@ void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
         ++p.data_have;
         p.bytes_received += h.payload_bytes;
     }
+    if (consecutive && p.received > 0) {
+        samplePacketGap(now_ns - std::max(p.first_rx_ns, p.last_rx_ns));
+    }
     ++p.received;
     p.last_rx_ns = now_ns;
     ++m_stats.packets_accepted;
@@ -361,8 +393,13 @@ void StreamAssembler::expire(int64_t now_ns) {
             const auto next = std::next(it);
             const bool silent = now_ns - std::max(it->second.first_rx_ns, it->second.last_rx_ns) >
                                 m_limits.frame_timeout_ns;
-            const bool too_old = m_limits.retransmit && now_ns - it->second.first_rx_ns >
-                                                            m_limits.retransmit_loss_timeout_ns;
+            // With retransmission, a frame is lost once nothing of it (data or an answered
+            // NACK) came for retransmit_loss_timeout_ns. Not since its first packet: on a slow
+            // link a frame larger than rate × timeout would never complete, and every key
+            // frame asked for in its place would be lost the same way.
+            const bool too_old = m_limits.retransmit &&
+                                 now_ns - std::max(it->second.first_rx_ns, it->second.last_rx_ns) >
+                                     m_limits.retransmit_loss_timeout_ns;
             if (silent || too_old) {
                 declareLost(id, it);
             }
@@ -373,8 +410,10 @@ void StreamAssembler::expire(int64_t now_ns) {
         }
         // A stalled partial frame: its tail was lost, and nothing after it shows the gap.
         for (const auto& [frame_id, p] : partials) {
-            if (now_ns - std::max(p.first_rx_ns, p.last_rx_ns) >= m_limits.tail_nack_ns) {
-                nackMissingData(s, p, now_ns);
+            if (now_ns - std::max(p.first_rx_ns, p.last_rx_ns) >= tailNackNs()) {
+                // A stall is not proof of loss: ask for the next few packets, not the whole
+                // tail (most of a large frame's tail may still be in the bottleneck queue).
+                nackMissingData(s, p, now_ns, m_limits.tail_nack_packets);
             }
         }
         // Ask again for what a retransmission did not bring; give up after the last try.

@@ -279,6 +279,96 @@ TEST(NetStreamAssembler, RetransmitModeDeclaresLossByTime) {
     EXPECT_TRUE(a.awaitingKeyFrame(0));
 }
 
+// A frame larger than the link carries in the loss timeout is not lost while it keeps coming:
+// a 40-packet key frame at one packet per 20 ms (0.8 s, ~2 Mbit/s) completes. Counted from its
+// first packet, it was lost at 100 ms, and so was every key frame asked for in its place: no
+// remote frame at all arrived on the ATT trace (docs/MODEL.md §8, the remote-on-ATT cell).
+TEST(NetStreamAssembler, RetransmitModeKeepsAFrameThatIsStillArriving) {
+    AssemblerLimits limits;
+    limits.retransmit = true;
+    limits.retransmit_loss_timeout_ns = 100'000'000;
+    StreamAssembler a(limits);
+    uint32_t seq = 0;
+    const auto bytes = frameBytes(40 * kMediaChunkBytes, 3);
+    const auto f = packetizeStream(1, seq, 1, 0, true, bytes);
+    ASSERT_EQ(f.size(), 40u);
+    int64_t now = 0;
+    for (const auto& p : f) {
+        feed(a, p, now);
+        now += 20'000'000;
+        a.expire(now - 1);
+        EXPECT_TRUE(a.takeLost().empty()) << now;
+    }
+    const auto done = a.takeCompleted();
+    ASSERT_EQ(done.size(), 1u);
+    EXPECT_EQ(done[0].bytes, bytes);
+    EXPECT_TRUE(done[0].decodable);
+    EXPECT_EQ(a.takeLossMask(), 0u);
+    EXPECT_FALSE(a.awaitingKeyFrame(0));
+}
+
+// A bursty link (the Mahimahi traces: 2 ms and 12 ms delivery gaps in turn) must not make the
+// client NACK every queued tail: the tail wait follows the packets' pace. A tail that really
+// was lost is still asked for, within tail_nack_max_ns.
+TEST(NetStreamAssembler, TailNacksFollowTheLinksPace) {
+    AssemblerLimits limits;
+    limits.retransmit = true;
+    StreamAssembler a(limits);
+    EXPECT_EQ(a.tailNackNs(), limits.tail_nack_ns);  // nothing seen yet: the floor
+    uint32_t seq = 0;
+    int64_t now = 0;
+    uint64_t nacked_after_learning = 0;
+    for (uint32_t frame = 1; frame <= 10; ++frame) {
+        const auto f =
+            packetizeStream(1, seq, frame, 0, frame == 1, frameBytes(20 * kMediaChunkBytes, frame));
+        for (size_t i = 0; i < f.size(); ++i) {
+            // Expire every millisecond up to the packet, as the client's timer does.
+            const int64_t gap = i == 0 ? 30'000'000 : (i % 2 ? 2'000'000 : 12'000'000);
+            for (int64_t t = now + 1'000'000; t < now + gap; t += 1'000'000)
+                a.expire(t);
+            now += gap;
+            if (frame == 3)
+                nacked_after_learning = a.stats().packets_nacked;
+            feed(a, f[i], now);
+        }
+        a.takeNacks();
+    }
+    EXPECT_EQ(a.takeCompleted().size(), 10u);
+    EXPECT_TRUE(a.takeLost().empty());
+    // Learnt within the first frames; none after (a fixed 5 ms NACKed the tail at every 12 ms
+    // gap: ~10 packets a frame).
+    EXPECT_GT(a.tailNackNs(), 12'000'000);
+    EXPECT_LE(a.tailNackNs(), limits.tail_nack_max_ns);
+    EXPECT_EQ(a.stats().packets_nacked, nacked_after_learning);
+    // A lost tail: 5 of 20 packets never come; it is NACKed once the paced wait has passed.
+    const auto f = packetizeStream(1, seq, 11, 0, false, frameBytes(20 * kMediaChunkBytes, 11));
+    for (size_t i = 0; i < 15; ++i) {
+        now += i % 2 ? 2'000'000 : 12'000'000;
+        feed(a, f[i], now);
+    }
+    a.expire(now + a.tailNackNs() - 1'000'000);
+    EXPECT_TRUE(a.takeNacks().empty());
+    a.expire(now + a.tailNackNs());
+    const auto nacks = a.takeNacks();
+    ASSERT_EQ(nacks.size(), 1u);
+    EXPECT_EQ(nacks[0].first_seq, seq - 5u);  // packetizeStream left seq past the frame
+    EXPECT_EQ(nacks[0].missing_mask, 0b11111u);
+    // A long stalled tail is asked for a few packets at a time (tail_nack_packets), not whole:
+    // most of it may still be queued in the bottleneck.
+    const auto big = packetizeStream(1, seq, 12, 0, false, frameBytes(40 * kMediaChunkBytes, 12));
+    for (size_t i = 0; i < 10; ++i) {
+        now += i % 2 ? 2'000'000 : 12'000'000;
+        feed(a, big[i], now);
+    }
+    a.expire(now + a.tailNackNs());
+    // (Frame 11's tail, asked for again, may come in the same batch.)
+    const auto batch = a.takeNacks();
+    const auto it = std::find_if(batch.begin(), batch.end(),
+                                 [&](const Nack& n) { return n.first_seq == seq - 30u; });
+    ASSERT_NE(it, batch.end());
+    EXPECT_EQ(it->missing_mask, 0xFFu);  // packets 10..17 of 40
+}
+
 TEST(NetThroughputEstimator, BytesOverFirstSendToLastAck) {
     ThroughputEstimator est(0.5);
     // Frame 1: two streams of 1 MB sent at t = 0; acks at 40 ms and 80 ms → 2 MB / 80 ms.

@@ -21,15 +21,24 @@ struct AssemblerLimits {
     int64_t frame_timeout_ns = 250'000'000;  // or once it saw no packet for this long
     // Selective retransmission: gaps are NACKed (again after nack_retry_ns, at most
     // max_nack_tries times) instead of being losses at once; a frame is then lost only when
-    // retransmit_loss_timeout_ns passed since its first packet (the reorder-window rule is off,
-    // since retransmitted packets arrive far behind the newest).
+    // it received nothing for retransmit_loss_timeout_ns (the reorder-window rule is off,
+    // since retransmitted packets arrive far behind the newest). A frame still arriving is not
+    // lost however long it takes: a whole-frame key frame of ~1 MB needs ~1.7 s at 4.6 Mbit/s.
     bool retransmit = false;
     int64_t nack_retry_ns = 30'000'000;
     int max_nack_tries = 2;
     int64_t retransmit_loss_timeout_ns = 100'000'000;
     // A partial frame that got nothing for this long has lost its tail (no later packet on the
-    // stream reveals a gap): its missing packets are NACKed.
+    // stream reveals a gap): its missing packets are NACKed. "This long" follows the link's
+    // pace like TCP's RTO: the smoothed gap between consecutive packets of a frame plus four
+    // times its deviation, within [tail_nack_ns, tail_nack_max_ns]. A fixed 5 ms NACKed every
+    // queued tail on a bursty link (the ATT trace has 37 delivery gaps > 5 ms a second), and
+    // the answers, as large as the media, halved what the link had left for it.
     int64_t tail_nack_ns = 5'000'000;
+    int64_t tail_nack_max_ns = 50'000'000;
+    // A stalled frame has at most this many of its packets NACKed at a time: a 1 MB key frame
+    // stalled by a delivery gap had its whole queued tail (hundreds of packets) sent again.
+    int tail_nack_packets = 8;
     int max_missing_per_stream = 512;  // tracked gap packets; more are left to loss
 };
 
@@ -103,6 +112,9 @@ public:
     // Recent packet loss on all streams, from sequence gaps (parity included): an EWMA over
     // windows of kLossWindowPackets sequence numbers; what the client reports for FEC sizing.
     double lossRate() const { return m_loss_rate; }
+    // How long a partial frame may go without a packet before its tail is NACKed (the link's
+    // pace, AssemblerLimits::tail_nack_ns).
+    int64_t tailNackNs() const;
     static constexpr uint32_t kLossWindowPackets = 256;
     const AssemblerStats& stats() const { return m_stats; }
     int64_t bufferedBytes() const { return m_buffered_bytes; }
@@ -161,13 +173,20 @@ private:
     void tryFec(Partial& p, int block);
     // Gap sequence numbers a frame with parity may still make good, or a finished frame's.
     bool coveredElsewhere(const Stream& s, uint32_t seq) const;
-    void nackMissingData(Stream& s, const Partial& p, int64_t now_ns);
+    // NACKs a frame's missing data packets, keeping at most max_outstanding of them asked for.
+    void nackMissingData(Stream& s, const Partial& p, int64_t now_ns,
+                         int max_outstanding = 1 << 30);
     // Hands out held frames that no earlier partial frame or NACKed packet precedes.
     void release(uint8_t stream_id);
     void declareLost(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
+    void samplePacketGap(int64_t gap_ns);
     bool isFinished(const Stream& s, uint32_t frame_id) const;
 
     AssemblerLimits m_limits;
+    // The link's pace: smoothed gap between consecutive packets of a frame, and its deviation.
+    bool m_gap_sampled = false;
+    double m_gap_mean_ns = 0.0;
+    double m_gap_dev_ns = 0.0;
     std::array<Stream, kMaxStreams> m_streams;
     int64_t m_buffered_bytes = 0;
     std::vector<CompletedStream> m_completed;
