@@ -34,6 +34,7 @@ struct CalibratedPart {
     double median_ms = 0.0, min_ms = 0.0, max_ms = 0.0;    // of the samples
     double residual_rms_pct = 0.0;                         // RMS of (measured − fit) / measured
     std::vector<std::array<double, 3>> samples_ms_px_tri;  // every sample, in the JSON
+    std::vector<int> samples_full_frame;                   // 1 where that sample is a whole frame
 };
 
 struct Calibration {
@@ -48,6 +49,12 @@ struct Calibration {
     int padding_samples = 0;     // P-frame pairs the padding ratio was fitted on
     nlohmann::json codec_by_e1;  // per calibration e1: median P-frame bits, key-frame ratios
     nlohmann::json links;        // the emulator's profiles
+    // The co-running measurement behind costs.corun_slowdown (0 when not measured).
+    double corun_alone_ms = 0.0;
+    double corun_shared_ms = 0.0;
+    int corun_samples = 0;  // block pairs
+    double corun_ratio_min = 0.0, corun_ratio_max = 0.0;
+    std::string corun_note = "not measured";
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included
 };

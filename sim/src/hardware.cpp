@@ -151,6 +151,7 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                                rc.keyframe_periodic_bits_ratio, 0.0, 1000.0);
     rc.padding_bits_ratio =
         r.number("runtime.padding_bits_ratio", rc.padding_bits_ratio, 0.0, 10.0);
+    rc.corun_slowdown = r.number("runtime.corun_slowdown", rc.corun_slowdown, 1.0, 4.0);
     if (auto st = r.finish(); !st)
         return makeError(st.error());
     return hw;
@@ -210,6 +211,7 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("keyframe_outer_bits_ratio", c.keyframe_outer_bits_ratio);
     put("keyframe_periodic_bits_ratio", c.keyframe_periodic_bits_ratio);
     put("padding_bits_ratio", c.padding_bits_ratio);
+    put("corun_slowdown", c.corun_slowdown);
     return s;
 }
 

@@ -186,8 +186,56 @@ Expected<Design> runtimeDesignByName(const std::string& name) {
     return makeError("runtime model: unknown design '" + name + "' (local, remote, ffr, sw, qvr)");
 }
 
-RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
-                                 Link& link) {
+double coRunEnd(double start, double work, const std::vector<BusySpan>& other, double slowdown) {
+    if (!(work > 0.0))
+        return start;
+    if (!(slowdown > 1.0) || other.empty())
+        return start + work;
+    // The first span still running at `start`.
+    auto it = std::upper_bound(other.begin(), other.end(), start,
+                               [](double t, const BusySpan& b) { return t < b.end; });
+    double t = start;
+    double left = work;
+    for (; it != other.end(); ++it) {
+        if (t < it->start) {  // alone until the other side's next span
+            if (left <= it->start - t)
+                return t + left;
+            left -= it->start - t;
+            t = it->start;
+        }
+        const double shared = it->end - t;  // both busy: 1 / slowdown of the pace
+        if (left * slowdown <= shared)
+            return t + left * slowdown;
+        left -= shared / slowdown;
+        t = it->end;
+    }
+    return t + left;
+}
+
+namespace {
+
+// What one pass of the replay had each side busy with (for the next pass's co-running).
+struct CoRunLog {
+    std::vector<BusySpan> headset, server;
+};
+
+void logSpan(std::vector<BusySpan>& spans, double start, double end) {
+    if (!(end > start))
+        return;
+    if (!spans.empty() && start <= spans.back().end) {  // touching or (rounding) overlapping
+        spans.back().end = std::max(spans.back().end, end);
+        return;
+    }
+    spans.push_back({start, end});
+}
+
+// The co-running passes stop when no frame's scan-out-ready time (UCA's end) moves by more than
+// kCoRunSettledMs from the pass before, or after kCoRunMaxPasses.
+constexpr double kCoRunSettledMs = 0.01;
+constexpr int kCoRunMaxPasses = 24;
+
+RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig& config,
+                              Link& link, const CoRunLog* previous, CoRunLog* log) {
     const WorkloadHeader& header = trace.header;
     const RuntimeCosts& c = config.costs;
     const DesignTraits& traits = traitsOf(config.design);
@@ -252,9 +300,23 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
     int served_frames = 0;
     size_t next_undecoded = 0;
 
+    // Work on one side runs slower where the previous pass had the other side busy.
+    const double slowdown = previous ? c.corun_slowdown : 1.0;
+    static const std::vector<BusySpan> kNone;
+    const std::vector<BusySpan>& server_spans = previous ? previous->server : kNone;
+    const std::vector<BusySpan>& headset_spans = previous ? previous->headset : kNone;
     auto work = [&](double ms) {
-        hs += ms;
-        busy += ms;
+        const double end = coRunEnd(hs, ms, server_spans, slowdown);
+        if (log)
+            logSpan(log->headset, hs, end);
+        busy += end - hs;
+        hs = end;
+    };
+    auto serverWork = [&](double start, double ms) {
+        const double end = coRunEnd(start, ms, headset_spans, slowdown);
+        if (log)
+            logSpan(log->server, start, end);
+        return end;
     };
 
     // Bits per layer pixel at scale s: the calibration's law when it has one, else the trace's.
@@ -289,7 +351,7 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         const WorkloadFrame& wf = trace.frames[static_cast<size_t>(j)];
         fs.served = true;
         ++served_frames;
-        double t = start + c.server_frame_ms;
+        double t = serverWork(start, c.server_frame_ms);
         const double total_tris = sumTotal(wf.triangles_per_ring);
         std::vector<LayerJob> jobs;
         if (whole_frame) {
@@ -327,8 +389,9 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
                                       ? c.server_render.atFullFrame(job.pixels, job.triangles)
                                       : c.server_render.at(job.pixels, job.triangles);
             const double encode = c.encode.at(coded_px, 0.0);
-            t += render + encode;
-            server_busy_total += render + encode;
+            const double layer_start = t;
+            t = serverWork(t, render + encode);
+            server_busy_total += t - layer_start;
             const double send = std::max(link_free, t);
             const LinkTransfer tr = link.transfer(send, job.bytes / c.payloadShare());
             link_free = send + tr.duration_ms;
@@ -593,6 +656,29 @@ RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimCon
         result.frames.back().display_ms - result.frames[static_cast<size_t>(skip)].display_ms;
     if (counted > 1 && span > 0)
         s.fps_mean = (n - 1.0) * 1000.0 / span;
+    return result;
+}
+
+}  // namespace
+
+RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
+                                 Link& link) {
+    if (!(config.costs.corun_slowdown > 1.0))
+        return simulatePass(trace, config, link, nullptr, nullptr);
+    CoRunLog previous;
+    RuntimeRunResult result = simulatePass(trace, config, link, nullptr, &previous);
+    for (int pass = 0; pass < kCoRunMaxPasses; ++pass) {
+        CoRunLog next;
+        RuntimeRunResult again = simulatePass(trace, config, link, &previous, &next);
+        double moved = 0.0;
+        for (size_t k = 0; k < again.frames.size() && k < result.frames.size(); ++k)
+            moved = std::max(moved,
+                             std::fabs(again.frames[k].uca_end_ms - result.frames[k].uca_end_ms));
+        result = std::move(again);
+        previous = std::move(next);
+        if (moved <= kCoRunSettledMs)
+            break;
+    }
     return result;
 }
 

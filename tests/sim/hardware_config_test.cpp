@@ -65,6 +65,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.keyframe_outer_bits_ratio = 5.25;
     c.keyframe_periodic_bits_ratio = 3.5;
     c.padding_bits_ratio = 0.5;
+    c.corun_slowdown = 1.125;
     c.server_render.power_coef_ms = 3.5;
     c.server_render.px_exponent = 0.5;
     c.server_render.tri_exponent = 0.75;
@@ -90,6 +91,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.keyframe_outer_bits_ratio, 5.25);
     EXPECT_EQ(hw->runtime.keyframe_periodic_bits_ratio, 3.5);
     EXPECT_EQ(hw->runtime.padding_bits_ratio, 0.5);
+    EXPECT_EQ(hw->runtime.corun_slowdown, 1.125);
     // A render part's power law and whole-frame scale.
     EXPECT_EQ(hw->runtime.server_render.power_coef_ms, 3.5);
     EXPECT_EQ(hw->runtime.server_render.px_exponent, 0.5);
@@ -110,18 +112,27 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     auto paper = parseHardwareConfig("[runtime]\npipeline = \"paper\"\n", "p.toml", 500.0);
     ASSERT_TRUE(paper.ok()) << paper.error();
     EXPECT_FALSE(paper->runtime_pipeline);
-    for (const char* bad :
-         {"[runtime]\npipeline = \"fast\"\n", "[runtime]\nfovea_base_ms = -1\n",
-          "[runtime]\nuca_per_mpx = 1\n", "[runtime]\npacket_payload_bytes = 0\n",
-          "[runtime]\ndecode_ms_per_mpx = \"x\"\n", "[runtime]\nbits_outer_per_px_at_1 = -0.1\n",
-          "[runtime]\nbits_outer_scale_exponent = 9\n", "[runtime]\ncanvas_align_px = 7\n",
-          "[runtime]\ncanvas_align_px = 0\n", "[runtime]\ncanvas_headroom = 2\n",
-          "[runtime]\nkeyint_frames = -1\n", "[runtime]\nkeyframe_bits_ratio = -3\n",
-          "[runtime]\npadding_bits_ratio = 11\n", "[runtime]\nkeyframe_periodic_bits_ratio = -1\n",
-          "[runtime]\ncanvas_shrink_after_frames = 0\n", "[runtime]\nfovea_full_frame_scale = 0\n",
-          "[runtime]\nserver_render_px_exponent = 5\n",
-          "[runtime]\nserver_render_power_coef_ms = -2\n",
-          "[runtime]\nfovea_tri_exponent = \"x\"\n"}) {
+    for (const char* bad : {"[runtime]\npipeline = \"fast\"\n",
+                            "[runtime]\nfovea_base_ms = -1\n",
+                            "[runtime]\nuca_per_mpx = 1\n",
+                            "[runtime]\npacket_payload_bytes = 0\n",
+                            "[runtime]\ndecode_ms_per_mpx = \"x\"\n",
+                            "[runtime]\nbits_outer_per_px_at_1 = -0.1\n",
+                            "[runtime]\nbits_outer_scale_exponent = 9\n",
+                            "[runtime]\ncanvas_align_px = 7\n",
+                            "[runtime]\ncanvas_align_px = 0\n",
+                            "[runtime]\ncanvas_headroom = 2\n",
+                            "[runtime]\nkeyint_frames = -1\n",
+                            "[runtime]\nkeyframe_bits_ratio = -3\n",
+                            "[runtime]\npadding_bits_ratio = 11\n",
+                            "[runtime]\nkeyframe_periodic_bits_ratio = -1\n",
+                            "[runtime]\ncanvas_shrink_after_frames = 0\n",
+                            "[runtime]\nfovea_full_frame_scale = 0\n",
+                            "[runtime]\nserver_render_px_exponent = 5\n",
+                            "[runtime]\ncorun_slowdown = 0.9\n",
+                            "[runtime]\ncorun_slowdown = 5\n",
+                            "[runtime]\nserver_render_power_coef_ms = -2\n",
+                            "[runtime]\nfovea_tri_exponent = \"x\"\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
         EXPECT_FALSE(r.ok()) << bad;
         if (!r.ok()) {

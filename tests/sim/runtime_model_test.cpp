@@ -221,6 +221,42 @@ TEST(RuntimeModel, TwoFramesInFlightOverlapAsFarAsTheShorterStageAllows) {
     EXPECT_NEAR(hb1.summary.headset_busy_ms_mean, 85.0, 1e-6);
 }
 
+TEST(RuntimeModel, CoRunEndSlowsOnlyWhereTheOtherSideIsBusy) {
+    const std::vector<BusySpan> other{{10.0, 20.0}, {30.0, 40.0}};
+    // Nothing of the other side's in the way, or no slowdown: the work's own length.
+    EXPECT_DOUBLE_EQ(coRunEnd(0.0, 5.0, other, 2.0), 5.0);
+    EXPECT_DOUBLE_EQ(coRunEnd(40.0, 5.0, other, 2.0), 45.0);
+    EXPECT_DOUBLE_EQ(coRunEnd(12.0, 5.0, other, 1.0), 17.0);
+    EXPECT_DOUBLE_EQ(coRunEnd(12.0, 0.0, other, 2.0), 12.0);
+    // Inside a span: twice as long at a slowdown of 2.
+    EXPECT_DOUBLE_EQ(coRunEnd(12.0, 3.0, other, 2.0), 18.0);
+    // 5 ms alone to 10, 5 ms of work in 10 ms shared to 20, 2 ms alone to 22.
+    EXPECT_DOUBLE_EQ(coRunEnd(5.0, 12.0, other, 2.0), 22.0);
+    // Across both spans: 10 alone, 5 in [10, 20], 10 alone, 5 in [30, 40], 3 alone.
+    EXPECT_DOUBLE_EQ(coRunEnd(0.0, 33.0, other, 2.0), 43.0);
+}
+
+TEST(RuntimeModel, CoRunningSlowsWhatOverlapsAndNothingElse) {
+    // One frame in flight, ffr: the server's four 15 ms layers (60 ms) start with the headset's
+    // two 20 ms fovea passes (40 ms). At a slowdown of 1.25 both run at 0.8 of their pace while
+    // both work: the fovea ends at 50 ms, by when the server has done 40 ms of its 60; its last
+    // 20 ms run alone (to 70 ms); then 5 ms of UCA with the server idle: 75 ms, then vsync.
+    RuntimeCosts c = flatCosts(20.0, 5.0, 15.0);
+    c.corun_slowdown = 1.25;
+    const RuntimeRunResult one = run(Design::Ffr, c, 1);
+    EXPECT_NEAR(one.summary.fps_mean, 1000.0 / slots(75.0), 1e-6);
+    // The passes approach the fixed point from both sides; after them it is within 0.1 ms.
+    for (size_t k = 10; k < one.frames.size(); ++k) {
+        EXPECT_NEAR(one.frames[k].t_local_ms, 50.0, 0.1) << k;
+        EXPECT_NEAR(one.frames[k].uca_end_ms - one.frames[k].pose_ms, 75.0, 0.1) << k;
+    }
+    // local has no server to run beside: unchanged.
+    RuntimeCosts l = flatCosts(30.0, 5.0, 0.0);
+    const double alone = run(Design::Local, l, 2).summary.fps_mean;
+    l.corun_slowdown = 2.0;
+    EXPECT_DOUBLE_EQ(run(Design::Local, l, 2).summary.fps_mean, alone);
+}
+
 TEST(RuntimeModel, AFrameLaterThanTheWaitLimitIsReused) {
     // One frame in flight, server 2 × 120 ms = 240 ms: in time for a 250 ms limit...
     const RuntimeRunResult in_time = run(Design::Remote, flatCosts(0.0, 1.0, 120.0), 1, 30);

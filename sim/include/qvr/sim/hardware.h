@@ -162,6 +162,11 @@ struct RuntimeCosts {
     double packet_payload_bytes = 1200.0;
     double packet_overhead_bytes = 48.0;
     double link_delay_ms = 0.0;  // one way
+    // The two cores at once: work on one side while the other side is busy takes this many
+    // times as long as alone (both sides slow alike; measured by `qvr calibrate` as a layer
+    // render's median with a second core rendering without pause over its median alone). 1: the
+    // sides do not disturb each other. docs/MODEL.md §8 "Co-running".
+    double corun_slowdown = 1.0;
     double payloadShare() const {
         return packet_payload_bytes / (packet_payload_bytes + packet_overhead_bytes);
     }
@@ -211,7 +216,7 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             (0…65536); canvas_align_px (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio
 //             (0…1), canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
 //             keyframe_bits_ratio, keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio
-//             (0…1000), padding_bits_ratio (0…10)
+//             (0…1000), padding_bits_ratio (0…10), corun_slowdown (1…4)
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);

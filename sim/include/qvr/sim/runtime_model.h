@@ -129,9 +129,23 @@ private:
     double m_last_canvas_share = 1.0;
 };
 
+// One side's busy spans, ms, in time order and disjoint.
+struct BusySpan {
+    double start = 0.0, end = 0.0;
+};
+
+// When `work` ms of one side's work that starts at `start` ends, if it runs `slowdown` times
+// slower while the other side is busy (`other`, disjoint and in time order) and at full speed
+// otherwise.
+double coRunEnd(double start, double work, const std::vector<BusySpan>& other, double slowdown);
+
 // Replays `trace` through the runtime's pipeline on `link` (a constant rate or a trace; the
 // caller gives it the link emulator's rate and no noise, efficiency 1: the payload share of a
-// packet is applied here). Deterministic.
+// packet is applied here). Deterministic. With costs.corun_slowdown > 1 the replay runs more than
+// once: each pass slows the headset's work where the previous pass had the server busy and the
+// server's where it had the headset busy (a fixed point of the two cores' mutual slowdown,
+// docs/MODEL.md §8 "Co-running"); `link` must then time every transfer from its start alone, as
+// makeRuntimeLink's do.
 RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
                                  Link& link);
 
