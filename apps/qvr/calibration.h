@@ -52,8 +52,8 @@ struct Calibration {
     // The co-running measurement behind costs.corun_slowdown (0 when not measured).
     double corun_alone_ms = 0.0;
     double corun_shared_ms = 0.0;
-    int corun_samples = 0;  // block pairs
-    double corun_ratio_min = 0.0, corun_ratio_max = 0.0;
+    int corun_samples = 0;                                // paired renders
+    double corun_ratio_min = 0.0, corun_ratio_max = 0.0;  // their ratios' p10 and p90
     std::string corun_note = "not measured";
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included

@@ -7,12 +7,20 @@
 #include "cli_parse.h"
 #include "commands.h"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -176,9 +184,9 @@ nlohmann::json Calibration::toJson() const {
             {"corun_slowdown", costs.corun_slowdown},
             {"corun_alone_ms", corun_alone_ms},
             {"corun_shared_ms", corun_shared_ms},
-            {"corun_block_pairs", corun_samples},
-            {"corun_ratio_min", corun_ratio_min},
-            {"corun_ratio_max", corun_ratio_max},
+            {"corun_paired_renders", corun_samples},
+            {"corun_ratio_p10", corun_ratio_min},
+            {"corun_ratio_p90", corun_ratio_max},
             {"corun_note", corun_note}};
 }
 
@@ -218,6 +226,157 @@ double poseTimeMs(int k) {
     return 50.0 + 290.0 * k;
 }
 }  // namespace
+
+// The other core's work for the co-running measurement: `qvr corun-load` in a child process,
+// pinned to its core, rendering the whole view while told to be busy ("1" on its stdin, "0" to
+// pause); it exits when its stdin closes.
+class CoRunLoad {
+public:
+    static Expected<std::unique_ptr<CoRunLoad>> start(const CalibrateOptions& o, int core) {
+        std::error_code ec;
+        const std::string exe = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+        if (ec)
+            return makeError("cannot find this executable: " + ec.message());
+        int to_child[2], from_child[2];
+        if (pipe2(to_child, O_CLOEXEC) != 0)
+            return makeError(std::string("pipe: ") + std::strerror(errno));
+        if (pipe2(from_child, O_CLOEXEC) != 0) {
+            ::close(to_child[0]);
+            ::close(to_child[1]);
+            return makeError(std::string("pipe: ") + std::strerror(errno));
+        }
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_adddup2(&actions, to_child[0], STDIN_FILENO);
+        posix_spawn_file_actions_adddup2(&actions, from_child[1], STDOUT_FILENO);
+        std::vector<std::string> args{
+            exe,         "corun-load",        "--scene",  o.scene,
+            "--profile", o.profile,           "--lod-px", fmt::format("{}", o.lod_px),
+            "--core",    std::to_string(core)};
+        std::vector<char*> argv;
+        for (std::string& a : args)
+            argv.push_back(a.data());
+        argv.push_back(nullptr);
+        pid_t pid = -1;
+        const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+        posix_spawn_file_actions_destroy(&actions);
+        ::close(to_child[0]);
+        ::close(from_child[1]);
+        auto load = std::unique_ptr<CoRunLoad>(new CoRunLoad(pid, to_child[1], from_child[0]));
+        if (rc != 0) {
+            load->m_pid = -1;
+            return makeError("cannot start " + exe + ": " + std::strerror(rc));
+        }
+        // Its ready line, once the scene is loaded (a minute at most).
+        std::string line;
+        char c = 0;
+        for (;;) {
+            pollfd pfd{load->m_out, POLLIN, 0};
+            if (::poll(&pfd, 1, 60'000) <= 0)
+                return makeError("the load process was not ready within 60 s");
+            if (::read(load->m_out, &c, 1) != 1)
+                return makeError("the load process ended before it was ready");
+            if (c == '\n')
+                break;
+            line += c;
+        }
+        if (line != "ready")
+            return makeError("the load process: " + line);
+        return load;
+    }
+    // Busy renders until told otherwise; the answer line comes once the first render under way
+    // after "1" has finished, or at once after "0" (the current render finishes first).
+    Status setBusy(bool busy) {
+        const char cmd[2] = {busy ? '1' : '0', '\n'};
+        if (::write(m_in, cmd, 2) != 2)
+            return makeError("cannot write to the load process");
+        char c = 0;
+        pollfd pfd{m_out, POLLIN, 0};
+        if (::poll(&pfd, 1, 60'000) <= 0 || ::read(m_out, &c, 1) != 1)
+            return makeError("the load process did not answer");
+        return {};
+    }
+    void stop() {
+        if (m_in >= 0)
+            ::close(m_in);
+        m_in = -1;
+        if (m_pid > 0) {
+            int status = 0;
+            for (int k = 0; k < 500 && ::waitpid(m_pid, &status, WNOHANG) == 0; ++k)
+                std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            if (::waitpid(m_pid, &status, WNOHANG) == 0) {
+                ::kill(m_pid, SIGKILL);
+                ::waitpid(m_pid, &status, 0);
+            }
+        }
+        m_pid = -1;
+    }
+    ~CoRunLoad() {
+        stop();
+        if (m_out >= 0)
+            ::close(m_out);
+    }
+
+private:
+    CoRunLoad(pid_t pid, int in, int out) : m_pid(pid), m_in(in), m_out(out) {}
+    pid_t m_pid;
+    int m_in;
+    int m_out;
+};
+
+// `qvr corun-load`: the child CoRunLoad starts.
+int runCoRunLoad(const CalibrateOptions& o) {
+    using namespace qvr::runtime;
+    if (auto st = pinCurrentThread(o.core); !st) {
+        std::printf("%s\n", st.error().c_str());
+        return 2;
+    }
+    auto profile = runtimeProfileByName(o.profile);
+    auto inputs = profile
+                      ? loadHeadsetInputs(o.scene, "default", "model", profile->refresh_hz, 400, 7)
+                      : Expected<HeadsetInputs>(makeError(profile.error()));
+    if (!inputs) {
+        std::printf("%s\n", inputs.error().c_str());
+        return 2;
+    }
+    GlRendererOptions gl;
+    gl.lod_error_px = o.lod_px;
+    auto renderer = glRendererFactory(gl)();
+    if (!renderer || !(*renderer)->upload(*inputs->scene)) {
+        std::printf("%s\n", renderer ? "cannot upload the scene" : renderer.error().c_str());
+        return 2;
+    }
+    const LayerPlanner planner(*profile);
+    const Pose head = poseAt(inputs->traces.motion, poseTimeMs(0));
+    const LayerPlan whole = planner.plan(gazeAt(inputs->traces.gaze, poseTimeMs(0)), 180.0);
+    ImageRgba8 img;
+    std::printf("ready\n");
+    std::fflush(stdout);
+    bool busy = false;
+    bool answer = false;
+    for (;;) {
+        pollfd pfd{STDIN_FILENO, POLLIN, 0};
+        const int n = ::poll(&pfd, 1, busy ? 0 : 100);
+        if (n > 0) {
+            char c = 0;
+            if (::read(STDIN_FILENO, &c, 1) != 1)
+                return 0;  // the parent is done
+            if (c == '0' || c == '1') {
+                busy = c == '1';
+                answer = true;
+            }
+        }
+        if (busy) {
+            if (!renderLayer(**renderer, *profile, whole, head, Eye::kLeft, LayerKind::kFovea, img))
+                return 1;
+        }
+        if (answer) {  // after the first render when busy: the load is under way
+            std::printf("k");
+            std::fflush(stdout);
+            answer = false;
+        }
+    }
+}
 
 Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     using namespace qvr::runtime;
@@ -685,103 +844,71 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             cal.links[name] = {{"rate_bps", lc->rate_bps}, {"delay_ms", lc->delay_ms}};
     }
     // 5. The two cores at once. In a run the headset and the server work at the same time, each
-    // on its core; on a machine whose cores share a physical core or a host's time, each is then
-    // slower than alone, which no part timed alone shows (the runtime's periphery layers render
-    // 5-20% slower than this calibration's law on a 2-core KVM guest: docs/MODEL.md §8
-    // "Co-running"). Measured here on this process's core: the same periphery layers rendered
-    // alone and while a thread on another core renders the whole view without pause.
+    // on its core and in its own process; on a machine whose cores share a physical core or a
+    // host's time, each is then slower than alone, which no part timed alone shows (the
+    // runtime's periphery layers render 5-20% slower than this calibration's law on a 2-core
+    // KVM guest: docs/MODEL.md §8 "Co-running"). Measured here: the same periphery layers
+    // rendered on this core alone and while a second process (`qvr corun-load`), pinned to
+    // another core, renders the whole view without pause. A process, not a thread: llvmpipe
+    // serialises the rasterisation of contexts that share its screen (a thread here made this
+    // core's 6 ms layers wait up to 170 ms for the other's whole frame).
     {
         const int cores = onlineCores();
         const int other = cores > 1 ? (o.core == cores - 1 ? 0 : cores - 1) : -1;
         if (other < 0) {
             cal.corun_note = "one core: no co-running to measure";
         } else {
-            std::atomic<bool> busy{false}, quit{false}, ready{false};
-            std::string co_error;
-            std::thread co([&] {
-                if (auto st = pinCurrentThread(other); !st)
-                    co_error = st.error();
-                auto co_renderer = glRendererFactory(gl)();
-                if (co_error.empty() && !co_renderer)
-                    co_error = co_renderer.error();
-                if (co_error.empty())
-                    if (auto st = (*co_renderer)->upload(*inputs->scene); !st)
-                        co_error = st.error();
-                ready = true;
-                if (!co_error.empty())
-                    return;
-                const LayerPlan whole = planner.plan(poses[0].gaze, 180.0);
-                ImageRgba8 img;
-                while (!quit) {
-                    if (!busy) {
-                        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-                        continue;
-                    }
-                    if (auto st = renderLayer(**co_renderer, *profile, whole, poses[0].head,
-                                              Eye::kLeft, LayerKind::kFovea, img);
-                        !st) {
-                        co_error = st.error();
-                        return;
-                    }
-                }
-            });
-            while (!ready)
-                std::this_thread::sleep_for(std::chrono::milliseconds(1));
-            // Pairs of blocks, alone then shared: the slowdown comes and goes with what the
-            // host does (single pairs measured 1.00x to 1.37x within a minute on a KVM guest), so
-            // the mean over the pairs, the run's expected slowdown, and their spread.
-            constexpr int kPairs = 12;
-            std::vector<double> ratios, alone_all, shared_all;
-            const LayerPlan plan = planner.plan(poses[0].gaze, 10.0);
-            for (int pair = 0; pair < kPairs && co_error.empty(); ++pair) {
-                std::array<std::vector<double>, 2> ms;
-                for (int with = 0; with < 2; ++with) {
-                    busy = with == 1;
-                    if (with == 1)
-                        std::this_thread::sleep_for(std::chrono::milliseconds(20));  // under way
-                    for (const PoseSample& p : poses)
-                        for (LayerKind kind : {LayerKind::kMiddle, LayerKind::kOuter}) {
-                            const auto t0 = Clock::now();
-                            if (auto st = renderLayer(r, *profile, plan, p.head, Eye::kLeft, kind,
-                                                      image, CameraOptions{}, holes);
-                                !st) {
-                                quit = true;
-                                co.join();
-                                return makeError("co-run render: " + st.error());
-                            }
-                            ms[static_cast<size_t>(with)].push_back(msSince(t0));
-                        }
-                }
-                busy = false;
-                for (auto& v : ms)
-                    std::sort(v.begin(), v.end());
-                const double a = ms[0][ms[0].size() / 2], b = ms[1][ms[1].size() / 2];
-                ratios.push_back(b / std::max(1e-6, a));
-                alone_all.push_back(a);
-                shared_all.push_back(b);
-            }
-            quit = true;
-            co.join();
-            if (!co_error.empty() || ratios.empty()) {
-                cal.corun_note = "not measured: the second core's renderer: " + co_error;
+            auto load = CoRunLoad::start(o, other);
+            if (!load) {
+                cal.corun_note = "not measured: " + load.error();
             } else {
+                // Pairs of blocks, alone then shared, over the same layers: each layer's time
+                // beside the load over its time alone in the same pair. The slowdown comes and
+                // goes with what the host does, so many pairs, and their geometric mean.
+                constexpr int kPairs = 12;
+                std::vector<double> ratios, alone_all, shared_all;
+                const LayerPlan plan = planner.plan(poses[0].gaze, 10.0);
+                for (int pair = 0; pair < kPairs; ++pair) {
+                    std::array<std::vector<double>, 2> ms;
+                    for (int with = 0; with < 2; ++with) {
+                        if (auto st = (*load)->setBusy(with == 1); !st)
+                            return makeError("co-run load: " + st.error());
+                        for (const PoseSample& p : poses)
+                            for (LayerKind kind : {LayerKind::kMiddle, LayerKind::kOuter}) {
+                                const auto t0 = Clock::now();
+                                if (auto st = renderLayer(r, *profile, plan, p.head, Eye::kLeft,
+                                                          kind, image, CameraOptions{}, holes);
+                                    !st)
+                                    return makeError("co-run render: " + st.error());
+                                ms[static_cast<size_t>(with)].push_back(msSince(t0));
+                            }
+                    }
+                    for (size_t j = 0; j < ms[0].size(); ++j) {
+                        ratios.push_back(ms[1][j] / std::max(1e-6, ms[0][j]));
+                        alone_all.push_back(ms[0][j]);
+                        shared_all.push_back(ms[1][j]);
+                    }
+                }
+                (*load)->stop();
+                double log_sum = 0.0;
+                for (double x : ratios)
+                    log_sum += std::log(x);
+                const double mean = std::exp(log_sum / double(ratios.size()));
                 std::sort(ratios.begin(), ratios.end());
                 std::sort(alone_all.begin(), alone_all.end());
                 std::sort(shared_all.begin(), shared_all.end());
-                double mean = 0.0;
-                for (double x : ratios)
-                    mean += x / double(ratios.size());
                 cal.corun_alone_ms = alone_all[alone_all.size() / 2];
                 cal.corun_shared_ms = shared_all[shared_all.size() / 2];
                 cal.corun_samples = static_cast<int>(ratios.size());
-                cal.corun_ratio_min = ratios.front();
-                cal.corun_ratio_max = ratios.back();
+                cal.corun_ratio_min = ratios[ratios.size() / 10];
+                cal.corun_ratio_max = ratios[ratios.size() * 9 / 10];
                 cal.costs.corun_slowdown = std::clamp(mean, 1.0, 4.0);
                 cal.corun_note = fmt::format(
                     "periphery layers {:.2f} ms alone, {:.2f} ms with core {} rendering "
-                    "(medians); slowdown x{:.3f} (mean of {} block pairs, {:.2f}-{:.2f})",
+                    "(medians); slowdown x{:.3f} (geometric mean of {} paired renders, p10-p90 "
+                    "{:.2f}-{:.2f})",
                     cal.corun_alone_ms, cal.corun_shared_ms, other, cal.costs.corun_slowdown,
-                    ratios.size(), ratios.front(), ratios.back());
+                    ratios.size(), cal.corun_ratio_min, cal.corun_ratio_max);
             }
         }
         log("  co-running: " + cal.corun_note + "\n");
@@ -893,5 +1020,17 @@ static Registered registerCalibrate(CLI::App& app) {
 }
 
 QVR_REGISTER_COMMAND(91, registerCalibrate);
+static Registered registerCoRunLoad(CLI::App& app) {
+    auto o = std::make_shared<CalibrateOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "corun-load", "qvr calibrate's second-core load (internal: renders while told to)");
+    cmd->group("");  // not listed: qvr calibrate starts it
+    cmd->add_option("--scene", o->scene)->required();
+    cmd->add_option("--profile", o->profile)->required();
+    cmd->add_option("--lod-px", o->lod_px)->check(CLI::Range(0.0, 16.0));
+    cmd->add_option("--core", o->core)->required()->check(CLI::Range(0, 4095));
+    return {cmd, [o] { return runCoRunLoad(*o); }};
+}
+QVR_REGISTER_COMMAND(92, registerCoRunLoad);
 
 }  // namespace qvr::cli
