@@ -605,9 +605,12 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         log(fmt::format("  pose {}/{}: fovea, periphery layers, codec, UCA\n", pi + 1,
                         poses.size()));
     }
-    // The full frame: local's render and remote's server layer (1 or 2 poses: ~0.2 s a view),
-    // and UCA over a full-resolution layer (local's fovea, remote's whole frame).
-    for (size_t pi = 0; pi < (o.quick ? 1u : 2u); ++pi) {
+    // The full frame: local's render and remote's server layer, and UCA over a full-resolution
+    // layer (local's fovea, remote's whole frame), at every pose (~0.1-0.2 s a view). Their
+    // median is the whole frame's scale: from the 4 samples of 2 poses (2 in --quick) one slow
+    // moment of the host moved it from 1.02 to 1.14 between two calibrations of the room three
+    // hours apart, and local's predicted FPS 13-18% low in every run after (docs/MODEL.md §8).
+    for (size_t pi = 0; pi < poses.size(); ++pi) {
         const PoseSample& p = poses[pi];
         const LayerPlan full = planner.plan(p.gaze, 180.0);
         auto frame = std::make_shared<LayerFrame>();
@@ -633,7 +636,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 return makeError("UCA: " + rep.error());
             uca.push_back({msSince(t0), 2.0 * eye_px, 0});
         }
-        log(fmt::format("  full frame {}/{}\n", pi + 1, o.quick ? 1 : 2));
+        log(fmt::format("  full frame {}/{}\n", pi + 1, poses.size()));
     }
     // The codec's bits, as a run at a steady e1 spends them: one encoder per stream carried over
     // the consecutive frames of a default run's span (its motion's first 120 frames, 1/refresh
