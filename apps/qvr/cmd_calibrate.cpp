@@ -288,7 +288,20 @@ public:
     // after "1" has finished, or at once after "0" (the current render finishes first).
     Status setBusy(bool busy) {
         const char cmd[2] = {busy ? '1' : '0', '\n'};
-        if (::write(m_in, cmd, 2) != 2)
+        // A load process that died has closed its end: the write must fail with EPIPE, not
+        // raise SIGPIPE and end the calibration. SIGPIPE is blocked for this thread while it
+        // writes, and one it raised is taken back.
+        sigset_t pipe_set, old_set;
+        sigemptyset(&pipe_set);
+        sigaddset(&pipe_set, SIGPIPE);
+        pthread_sigmask(SIG_BLOCK, &pipe_set, &old_set);
+        const ssize_t written = ::write(m_in, cmd, 2);
+        if (written != 2 && errno == EPIPE) {
+            const timespec zero{0, 0};
+            sigtimedwait(&pipe_set, nullptr, &zero);
+        }
+        pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
+        if (written != 2)
             return makeError("cannot write to the load process");
         char c = 0;
         pollfd pfd{m_out, POLLIN, 0};
@@ -871,11 +884,15 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 constexpr int kPairs = 12;
                 std::vector<double> ratios, alone_all, shared_all;
                 const LayerPlan plan = planner.plan(poses[0].gaze, 10.0);
-                for (int pair = 0; pair < kPairs; ++pair) {
+                // A load that fails leaves co-running unmeasured (x1), not the calibration.
+                std::string load_error;
+                for (int pair = 0; pair < kPairs && load_error.empty(); ++pair) {
                     std::array<std::vector<double>, 2> ms;
-                    for (int with = 0; with < 2; ++with) {
-                        if (auto st = (*load)->setBusy(with == 1); !st)
-                            return makeError("co-run load: " + st.error());
+                    for (int with = 0; with < 2 && load_error.empty(); ++with) {
+                        if (auto st = (*load)->setBusy(with == 1); !st) {
+                            load_error = st.error();
+                            break;
+                        }
                         for (const PoseSample& p : poses)
                             for (LayerKind kind : {LayerKind::kMiddle, LayerKind::kOuter}) {
                                 const auto t0 = Clock::now();
@@ -886,6 +903,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                                 ms[static_cast<size_t>(with)].push_back(msSince(t0));
                             }
                     }
+                    if (!load_error.empty())
+                        break;
                     for (size_t j = 0; j < ms[0].size(); ++j) {
                         ratios.push_back(ms[1][j] / std::max(1e-6, ms[0][j]));
                         alone_all.push_back(ms[0][j]);
@@ -893,25 +912,29 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                     }
                 }
                 (*load)->stop();
-                double log_sum = 0.0;
-                for (double x : ratios)
-                    log_sum += std::log(x);
-                const double mean = std::exp(log_sum / double(ratios.size()));
-                std::sort(ratios.begin(), ratios.end());
-                std::sort(alone_all.begin(), alone_all.end());
-                std::sort(shared_all.begin(), shared_all.end());
-                cal.corun_alone_ms = alone_all[alone_all.size() / 2];
-                cal.corun_shared_ms = shared_all[shared_all.size() / 2];
-                cal.corun_samples = static_cast<int>(ratios.size());
-                cal.corun_ratio_min = ratios[ratios.size() / 10];
-                cal.corun_ratio_max = ratios[ratios.size() * 9 / 10];
-                cal.costs.corun_slowdown = std::clamp(mean, 1.0, 4.0);
-                cal.corun_note = fmt::format(
-                    "periphery layers {:.2f} ms alone, {:.2f} ms with core {} rendering "
-                    "(medians); slowdown x{:.3f} (geometric mean of {} paired renders, p10-p90 "
-                    "{:.2f}-{:.2f})",
-                    cal.corun_alone_ms, cal.corun_shared_ms, other, cal.costs.corun_slowdown,
-                    ratios.size(), cal.corun_ratio_min, cal.corun_ratio_max);
+                if (!load_error.empty() || ratios.empty()) {
+                    cal.corun_note = "not measured: the load process: " + load_error;
+                } else {
+                    double log_sum = 0.0;
+                    for (double x : ratios)
+                        log_sum += std::log(x);
+                    const double mean = std::exp(log_sum / double(ratios.size()));
+                    std::sort(ratios.begin(), ratios.end());
+                    std::sort(alone_all.begin(), alone_all.end());
+                    std::sort(shared_all.begin(), shared_all.end());
+                    cal.corun_alone_ms = alone_all[alone_all.size() / 2];
+                    cal.corun_shared_ms = shared_all[shared_all.size() / 2];
+                    cal.corun_samples = static_cast<int>(ratios.size());
+                    cal.corun_ratio_min = ratios[ratios.size() / 10];
+                    cal.corun_ratio_max = ratios[ratios.size() * 9 / 10];
+                    cal.costs.corun_slowdown = std::clamp(mean, 1.0, 4.0);
+                    cal.corun_note = fmt::format(
+                        "periphery layers {:.2f} ms alone, {:.2f} ms with core {} rendering "
+                        "(medians); slowdown x{:.3f} (geometric mean of {} paired renders, p10-p90 "
+                        "{:.2f}-{:.2f})",
+                        cal.corun_alone_ms, cal.corun_shared_ms, other, cal.costs.corun_slowdown,
+                        ratios.size(), cal.corun_ratio_min, cal.corun_ratio_max);
+                }
             }
         }
         log("  co-running: " + cal.corun_note + "\n");
