@@ -841,6 +841,19 @@ int runRun(const RunOptions& o) {
                           100.0 * o.headset_share, 10.0 * o.headset_share, share_group->path())
             : std::string());
 
+    // This thread, and every thread made while the designs run, on the headset's core: the
+    // quality pass's renderer is made here, and once the first design's GL display is gone its
+    // context makes llvmpipe's rasterizer threads, which the next designs' headsets then
+    // share. Made on an unpinned thread they ran on the server's core as well: every design
+    // after the first rendered its fovea on two cores (fixed:20's fovea 42 ms a frame after
+    // ffr, 65 ms as the only design) and slowed the server's layers (docs/RUNTIME.md).
+    std::optional<ScopedThreadPin> main_pin;
+    if (client_core >= 0 && server_core >= 0) {
+        main_pin.emplace(client_core);
+        if (!main_pin->error().empty())
+            std::fprintf(stderr, "qvr run: %s (the main thread runs unpinned)\n",
+                         main_pin->error().c_str());
+    }
     std::vector<DesignRun> runs;
     std::unique_ptr<Renderer> quality_renderer;
     std::vector<std::pair<std::string, DesignQuality>> quality;
@@ -982,6 +995,7 @@ int runRun(const RunOptions& o) {
         interrupted_note = fmt::format("interrupted between designs; {} of {} designs run",
                                        runs.size(), designs->size());
     all_csv.flush();
+    main_pin.reset();  // the report's work may use every core
     const int server_status = server->stop();
     nlohmann::json server_stats = nlohmann::json::object();
     if (std::ifstream f(server_stats_path); f) {

@@ -32,4 +32,25 @@ int currentCore() {
     return sched_getcpu();
 }
 
+ScopedThreadPin::ScopedThreadPin(int core) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) == 0)
+        for (int c = 0; c < CPU_SETSIZE; ++c)
+            if (CPU_ISSET(c, &set))
+                m_previous.push_back(c);
+    if (Status st = pinCurrentThread(core); !st)
+        m_error = st.error();
+}
+
+ScopedThreadPin::~ScopedThreadPin() {
+    if (m_previous.empty())
+        return;
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    for (int c : m_previous)
+        CPU_SET(c, &set);
+    pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+}
+
 }  // namespace qvr::runtime
