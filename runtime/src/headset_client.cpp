@@ -217,6 +217,17 @@ private:
 
     // A frame's telemetry by its index in the run.
     FrameTelemetry& tel(size_t ti) { return m_frames[ti - m_frames_base]; }
+    // Frame `frame`'s telemetry while it is held (not yet retired into the summary), else null.
+    // A frame's bytes are what arrived for it whenever they arrive (docs/RUNTIME.md step 5):
+    // those of a frame already shown count too, until it is retired.
+    FrameTelemetry* heldTelemetry(int64_t frame) {
+        if (frame < 0 || static_cast<size_t>(frame) < m_frames_base)
+            return nullptr;
+        const size_t k = static_cast<size_t>(frame) - m_frames_base;
+        if (k >= m_frames.size() || m_frames[k].frame != frame)
+            return nullptr;
+        return &m_frames[k];
+    }
 
     // A frame whose telemetry is final: into the summary and the sink.
     void retire(const FrameTelemetry& t) {
@@ -300,6 +311,9 @@ private:
             p->last_rx_ns = std::max(p->last_rx_ns, cs.last_rx_ns);
             t.bytes += static_cast<int64_t>(cs.bytes.size());
             p->bytes[cs.stream_id] += static_cast<double>(cs.bytes.size());
+        } else if (FrameTelemetry* shown = heldTelemetry(cs.frame_id)) {
+            // Already shown (late, reused): its bytes crossed the link all the same.
+            shown->bytes += static_cast<int64_t>(cs.bytes.size());
         }
         // Every frame goes through its stream's decoder, shown or not: later frames refer to it.
         VideoDecoder* dec = decoder(cs.stream_id);
@@ -375,6 +389,8 @@ private:
                 p->failed |= static_cast<uint8_t>(1u << l.stream_id);
                 tel(p->telemetry).bytes += l.bytes_received;
                 p->bytes[l.stream_id] += l.bytes_received;
+            } else if (FrameTelemetry* shown = heldTelemetry(l.frame_id)) {
+                shown->bytes += l.bytes_received;
             }
         }
     }

@@ -40,7 +40,7 @@ struct FrameState {
     double received_bytes = 0.0;
     double middle_bytes = 0.0, outer_bytes = 0.0;
     bool served = false;
-    bool closed = false;  // its pending entry is gone: later streams are not counted
+    bool closed = false;  // its pending entry is gone: LIWC does not see later streams
 };
 
 // A layer the server renders and sends: its pixels, the triangles in its view, its bytes.
@@ -433,12 +433,12 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         RuntimeFrame& rf = result.frames[static_cast<size_t>(s.frame)];
         fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
         last_stream_ms = hs;
-        // The runtime counts a frame's bytes while it holds a pending entry: until the frame
-        // after it has been shown. Streams that arrive later are decoded but not counted.
-        if (!fs.closed) {
+        // A frame's bytes are what arrived for it, whenever (the runtime counts a late
+        // frame's streams too, until the frame is retired). What LIWC observes is only what
+        // came while the frame held its pending entry: until the frame after it was shown.
+        rf.bytes += s.payload_bytes;
+        if (!fs.closed)
             fs.received_bytes += s.payload_bytes;
-            rf.bytes += s.payload_bytes;
-        }
         if (++fs.decoded == fs.expected) {
             rf.remote_done_ms = hs;
             last_complete_rx_ms = std::max(last_complete_rx_ms, fs.last_rx_ms);
