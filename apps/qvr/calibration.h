@@ -45,10 +45,11 @@ struct Calibration {
     std::string command;
     double seconds = 0.0;
     double load_avg_before = 0.0;
-    int bits_samples = 0;        // P-frames the bits-per-pixel law was fitted on
-    int padding_samples = 0;     // P-frame pairs the padding ratio was fitted on
-    nlohmann::json codec_by_e1;  // per calibration e1: median P-frame bits, key-frame ratios
-    nlohmann::json links;        // the emulator's profiles
+    int bits_samples = 0;             // P-frames the bits-per-pixel law was fitted on
+    int padding_samples = 0;          // P-frame pairs the padding ratio was fitted on
+    int bits_full_frame_samples = 0;  // whole-frame P-frames (remote's layer) measured
+    nlohmann::json codec_by_e1;       // per calibration e1: median P-frame bits, key-frame ratios
+    nlohmann::json links;             // the emulator's profiles
     // The co-running measurement behind costs.corun_slowdown (0 when not measured).
     double corun_alone_ms = 0.0;
     double corun_shared_ms = 0.0;

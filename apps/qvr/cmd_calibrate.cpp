@@ -119,7 +119,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 9;
+    constexpr int kCalibrationVersion = 10;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -173,6 +173,8 @@ nlohmann::json Calibration::toJson() const {
             {"bits_outer_per_px_at_1", costs.bits_outer_per_px_at_1},
             {"bits_outer_scale_exponent", costs.bits_outer_scale_exponent},
             {"bits_samples", bits_samples},
+            {"bits_full_frame_per_px", costs.bits_full_frame_per_px},
+            {"bits_full_frame_samples", bits_full_frame_samples},
             {"keyframe_bits_ratio", costs.keyframe_bits_ratio},
             {"keyframe_outer_bits_ratio", costs.keyframe_outer_bits_ratio},
             {"padding_bits_ratio", costs.padding_bits_ratio},
@@ -206,6 +208,8 @@ std::string Calibration::toToml() const {
         "# bits per layer pixel: middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}, over {} P-frames\n",
         costs.bits_per_px_at_1, costs.bits_scale_exponent, costs.bits_outer_per_px_at_1,
         costs.bits_outer_scale_exponent, bits_samples);
+    s += fmt::format("# bits per whole-frame pixel (remote's layer): {:.4f}, over {} P-frames\n",
+                     costs.bits_full_frame_per_px, bits_full_frame_samples);
     s += fmt::format(
         "# key frame of a new encoder: {:.2f}x a P-frame's bits (middle), {:.2f}x (outer); "
         "periodic: {:.2f}x; padding beyond the snug canvas: {:.3f} of a layer pixel's bits per "
@@ -799,6 +803,44 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     cal.costs.keyframe_outer_bits_ratio = median(key_ratio[1]);
     cal.costs.keyframe_periodic_bits_ratio = median(periodic_ratio);
     cal.codec_by_e1 = std::move(codec_by_e1);
+    // remote's whole frame (one layer per eye at scale 1) in its own codec pass: the layers'
+    // law, fitted at scales ~2.5–12 and taken to scale 1, put 0.27 bits on a whole-frame pixel
+    // where a default run's remote frames carried 0.126 (2026-11-26), and predicted remote's
+    // bytes 2.2x too high. Consecutive frames of the run's span from its warm-up on, fresh
+    // encoders (the first is their key frame), P-frames from the third frame on.
+    {
+        const int steps = o.quick ? 8 : 12;
+        const int warmup = 10;
+        std::array<std::unique_ptr<VideoEncoder>, 2> enc;
+        std::vector<double> full_bits;
+        for (int step = 0; step < steps; ++step) {
+            const double t_ms = frame_ms * (warmup + step);
+            const Pose head = poseAt(inputs->traces.motion, t_ms);
+            const LayerPlan full = planner.plan(gazeAt(inputs->traces.gaze, t_ms), 180.0);
+            for (int eye = 0; eye < 2; ++eye) {
+                if (auto st = renderLayer(r, *profile, full, head, static_cast<Eye>(eye),
+                                          LayerKind::kFovea, image);
+                    !st)
+                    return makeError("whole-frame render: " + st.error());
+                auto& e = enc[static_cast<size_t>(eye)];
+                if (!e) {
+                    auto made = makeVideoEncoder(codec);
+                    if (!made)
+                        return makeError("codec: " + made.error());
+                    e = std::move(*made);
+                }
+                auto out = e->encode(image);
+                if (!out)
+                    return makeError("whole-frame encode: " + out.error());
+                if (step >= 2 && !out->is_keyframe)
+                    full_bits.push_back(8.0 * double(out->bytes.size()) /
+                                        (double(image.width()) * double(image.height())));
+            }
+        }
+        cal.costs.bits_full_frame_per_px = median(full_bits);
+        cal.bits_full_frame_samples = static_cast<int>(full_bits.size());
+        log(fmt::format("  whole frame codec: {} P-frames\n", full_bits.size()));
+    }
     {
         // Least squares through the origin: bytes ratio − 1 = ρ · extra canvas share.
         double sxy = 0.0, sxx = 0.0;
@@ -991,6 +1033,8 @@ int runCalibrate(CalibrateCmdOptions& o) {
         cal->costs.keyframe_bits_ratio, cal->costs.keyframe_outer_bits_ratio,
         cal->costs.keyframe_periodic_bits_ratio, cal->costs.padding_bits_ratio,
         cal->padding_samples);
+    fmt::print("  codec: P-frame bits per whole-frame pixel (remote) {:.4f} ({} P-frames)\n",
+               cal->costs.bits_full_frame_per_px, cal->bits_full_frame_samples);
     fmt::print("  co-running: {}\n", cal->corun_note);
     {
         std::ofstream f(o.out);

@@ -121,6 +121,8 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
         r.number("runtime.bits_outer_per_px_at_1", rc.bits_outer_per_px_at_1, 0.0, 100.0);
     rc.bits_outer_scale_exponent =
         r.number("runtime.bits_outer_scale_exponent", rc.bits_outer_scale_exponent, -4.0, 4.0);
+    rc.bits_full_frame_per_px =
+        r.number("runtime.bits_full_frame_per_px", rc.bits_full_frame_per_px, 0.0, 100.0);
     cost("server_render_base_ms", rc.server_render.base_ms);
     cost("server_render_ms_per_mpx", rc.server_render.ms_per_mpx);
     cost("server_render_ms_per_ktri", rc.server_render.ms_per_ktri);
@@ -192,6 +194,7 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("bits_scale_exponent", c.bits_scale_exponent);
     put("bits_outer_per_px_at_1", c.bits_outer_per_px_at_1);
     put("bits_outer_scale_exponent", c.bits_outer_scale_exponent);
+    put("bits_full_frame_per_px", c.bits_full_frame_per_px);
     put("server_render_base_ms", c.server_render.base_ms);
     put("server_render_ms_per_mpx", c.server_render.ms_per_mpx);
     put("server_render_ms_per_ktri", c.server_render.ms_per_ktri);

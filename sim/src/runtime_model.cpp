@@ -355,7 +355,10 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         const double total_tris = sumTotal(wf.triangles_per_ring);
         std::vector<LayerJob> jobs;
         if (whole_frame) {
-            const double bytes = bitsPerPx(wf, 1.0, false) * eye_px / 8.0;
+            const double bpp = c.bits_per_px_at_1 > 0.0 && c.bits_full_frame_per_px > 0.0
+                                   ? c.bits_full_frame_per_px
+                                   : bitsPerPx(wf, 1.0, false);
+            const double bytes = bpp * eye_px / 8.0;
             // The whole frame at scale 1 is the all-local plan's fovea view, no hole.
             for (int eye = 0; eye < 2; ++eye)
                 jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true,

@@ -56,6 +56,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.bits_scale_exponent = 0.25;
     c.bits_outer_per_px_at_1 = 0.125;
     c.bits_outer_scale_exponent = 0.5;
+    c.bits_full_frame_per_px = 0.0625;
     c.canvas_align_px = 8;
     c.canvas_headroom = 0.25;
     c.canvas_shrink_ratio = 0.375;
@@ -82,6 +83,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.packet_overhead_bytes, 60.0);
     EXPECT_EQ(hw->runtime.bits_outer_per_px_at_1, 0.125);
     EXPECT_EQ(hw->runtime.bits_outer_scale_exponent, 0.5);
+    EXPECT_EQ(hw->runtime.bits_full_frame_per_px, 0.0625);
     EXPECT_EQ(hw->runtime.canvas_align_px, 8);
     EXPECT_EQ(hw->runtime.canvas_headroom, 0.25);
     EXPECT_EQ(hw->runtime.canvas_shrink_ratio, 0.375);
@@ -119,6 +121,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\ndecode_ms_per_mpx = \"x\"\n",
                             "[runtime]\nbits_outer_per_px_at_1 = -0.1\n",
                             "[runtime]\nbits_outer_scale_exponent = 9\n",
+                            "[runtime]\nbits_full_frame_per_px = -0.5\n",
                             "[runtime]\ncanvas_align_px = 7\n",
                             "[runtime]\ncanvas_align_px = 0\n",
                             "[runtime]\ncanvas_headroom = 2\n",

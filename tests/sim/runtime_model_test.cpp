@@ -118,6 +118,23 @@ TEST(RuntimeModel, TheMiddleAndOuterLayersTakeTheirOwnBitsLaw) {
     EXPECT_NEAR(run(Design::Ffr, c, 2, 20).summary.bytes_per_frame_mean, one_law, 1e-6 * one_law);
 }
 
+TEST(RuntimeModel, RemotesWholeFrameTakesItsOwnMeasuredBitsPerPixel) {
+    // remote sends one layer per eye at scale 1: its measured bits per pixel when the
+    // calibration has it, else the layers' law at scale 1.
+    RuntimeCosts c = flatCosts(1.0, 1.0, 1.0);
+    c.bits_per_px_at_1 = 0.4;
+    c.bits_scale_exponent = 0.3;
+    c.bits_full_frame_per_px = 0.15;
+    const WorkloadTrace trace = flatTrace(20);
+    const double eye_px =
+        double(trace.header.profile.width_px) * double(trace.header.profile.height_px);
+    const double own = 2.0 * eye_px * 0.15 / 8.0;
+    EXPECT_NEAR(run(Design::Remote, c, 2, 20).summary.bytes_per_frame_mean, own, 1e-6 * own);
+    c.bits_full_frame_per_px = 0.0;
+    const double law = 2.0 * eye_px * 0.4 / 8.0;
+    EXPECT_NEAR(run(Design::Remote, c, 2, 20).summary.bytes_per_frame_mean, law, 1e-6 * law);
+}
+
 // The canvas model (calibration version 7): a key frame at each stream's first frame and every
 // keyint_frames-th, the padding of a canvas larger than the snug one, an IDR when a layer outgrows
 // its canvas.

@@ -128,6 +128,10 @@ struct RuntimeCosts {
     // same scale the outer layer takes ~0.6× the middle's bits per pixel (measured, MODEL.md §8).
     double bits_outer_per_px_at_1 = 0.0;
     double bits_outer_scale_exponent = 0.0;
+    // remote's whole frame (one layer per eye at scale 1), measured on its own (> 0); 0: the
+    // law above at scale 1. The law, fitted to periphery layers at scales ~2.5–12, put 0.27
+    // bits on a whole-frame pixel where a default run's remote frames carried 0.126.
+    double bits_full_frame_per_px = 0.0;
     // Bits per layer pixel of a P-frame at scale s of the middle (or whole-frame) or outer layer.
     double bitsPerPx(double scale, bool outer) const {
         const bool own = outer && bits_outer_per_px_at_1 > 0.0;
@@ -208,8 +212,9 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             fovea_ms_per_ktri, fovea_power_coef_ms, fovea_px_exponent, fovea_tri_exponent
 //             (−4…4), fovea_full_frame_scale (0.01…100), decode_base_ms, decode_ms_per_mpx,
 //             uca_base_ms, uca_ms_per_mpx, frame_overhead_ms, bits_per_px_at_1 (0…100),
-//             bits_scale_exponent (−4…4), bits_outer_per_px_at_1 (0…100), bits_outer_scale_exponent
-//             (−4…4), server_render_base_ms, server_render_ms_per_mpx, server_render_ms_per_ktri,
+//             bits_scale_exponent (−4…4), bits_outer_per_px_at_1 (0…100),
+//             bits_outer_scale_exponent (−4…4), bits_full_frame_per_px (0…100),
+//             server_render_base_ms, server_render_ms_per_mpx, server_render_ms_per_ktri,
 //             server_render_power_coef_ms, server_render_px_exponent, server_render_tri_exponent
 //             (−4…4), server_render_full_frame_scale (0.01…100), encode_base_ms, encode_ms_per_mpx,
 //             server_frame_ms, link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes
