@@ -319,6 +319,29 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
     EXPECT_GT(fresh_tail, 30);
 }
 
+TEST(Runtime, ALateFramesStreamsCountAsItsBytesAfterItWasShown) {
+    // A 40 Mbit/s link carries a frame's four raw streams (~0.5 MB) in ~100 ms, and the headset
+    // waits 30 ms for them: every frame is shown re-warped (reused) and its streams land two or
+    // more frames later, after it left the pending list. They crossed the link for it, so they
+    // are its bytes. Before, bytes counted only while the frame was pending, so these frames
+    // had none.
+    RenderServerConfig sc = serverConfig("rate:40", "raw");
+    auto server = RenderServer::start(sc, world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 60);
+    h.pipeline_depth = 1;
+    h.remote_timeout_ms = 30.0;
+    const HeadsetResult r = runOn(h);
+    ASSERT_EQ(r.frames.size(), 60u);
+    int late_with_bytes = 0;
+    int64_t bytes = 0;
+    for (const FrameTelemetry& t : r.frames) {
+        late_with_bytes += t.reused && t.bytes > 0 ? 1 : 0;
+        bytes += t.bytes;
+    }
+    EXPECT_GE(late_with_bytes, 5) << bytes << " bytes counted in all";
+}
+
 TEST(Runtime, KillingTheServerLeavesTheHeadsetDisplayingAndItReconnects) {
     auto first = RenderServer::start(serverConfig("none", "raw"), world().scene);
     ASSERT_TRUE(first.ok()) << first.error();
