@@ -45,7 +45,9 @@ struct Calibration {
     std::string command;
     double seconds = 0.0;
     double load_avg_before = 0.0;
-    int bits_samples = 0;             // P-frames the bits-per-pixel law was fitted on
+    int bits_samples = 0;  // P-frames the bits-per-pixel law was fitted on
+    // Each law's b over the log fit's: how far the mean P-frame sits above the geometric mean.
+    std::array<double, 2> bits_mean_over_geometric{1.0, 1.0};
     int padding_samples = 0;          // P-frame pairs the padding ratio was fitted on
     int bits_full_frame_samples = 0;  // whole-frame P-frames (remote's layer) measured
     nlohmann::json codec_by_e1;       // per calibration e1: median P-frame bits, key-frame ratios

@@ -119,7 +119,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 10;
+    constexpr int kCalibrationVersion = 11;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -173,6 +173,7 @@ nlohmann::json Calibration::toJson() const {
             {"bits_outer_per_px_at_1", costs.bits_outer_per_px_at_1},
             {"bits_outer_scale_exponent", costs.bits_outer_scale_exponent},
             {"bits_samples", bits_samples},
+            {"bits_mean_over_geometric", bits_mean_over_geometric},
             {"bits_full_frame_per_px", costs.bits_full_frame_per_px},
             {"bits_full_frame_samples", bits_full_frame_samples},
             {"keyframe_bits_ratio", costs.keyframe_bits_ratio},
@@ -205,9 +206,11 @@ std::string Calibration::toToml() const {
             p.name, p.samples, p.what, p.median_ms, p.min_ms, p.max_ms, costLawText(p.cost),
             p.residual_rms_pct);
     s += fmt::format(
-        "# bits per layer pixel: middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}, over {} P-frames\n",
+        "# bits per layer pixel: middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}, over {} P-frames "
+        "(the mean; {:.3f}x / {:.3f}x the geometric mean)\n",
         costs.bits_per_px_at_1, costs.bits_scale_exponent, costs.bits_outer_per_px_at_1,
-        costs.bits_outer_scale_exponent, bits_samples);
+        costs.bits_outer_scale_exponent, bits_samples, bits_mean_over_geometric[0],
+        bits_mean_over_geometric[1]);
     s += fmt::format("# bits per whole-frame pixel (remote's layer): {:.4f}, over {} P-frames\n",
                      costs.bits_full_frame_per_px, bits_full_frame_samples);
     s += fmt::format(
@@ -512,10 +515,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         std::unique_ptr<VideoDecoder> dec;
         int frames = 0;
     };
-    std::array<Chain, 4> chains;  // stream ids: eye × {middle, outer}
-    struct BitsSample {
-        double log_scale, log_bits_per_px;
-    };
+    std::array<Chain, 4> chains;                  // stream ids: eye × {middle, outer}
     std::array<std::vector<BitsSample>, 2> bits;  // middle (and whole frame), outer
     // Warm-up: llvmpipe compiles its shaders on first use.
     {
@@ -675,6 +675,12 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
         return v[v.size() / 2];
     };
+    auto mean = [](const std::vector<double>& v) {  // 0 for none
+        double sum = 0.0;
+        for (double x : v)
+            sum += x;
+        return v.empty() ? 0.0 : sum / double(v.size());
+    };
     std::array<std::vector<double>, 2> key_ratio;  // a new encoder's IDR: middle, outer
     std::vector<double> periodic_ratio;            // the IDR at keyint_frames, both kinds
     nlohmann::json codec_by_e1 = nlohmann::json::array();
@@ -733,10 +739,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                             bits_px[size_t(li)].push_back(8.0 * double(enc->bytes.size()) /
                                                           double(rect.pixels()));
                             scale[size_t(li)] = rect.scale;
-                            bits[middle ? 0 : 1].push_back(
-                                {std::log(std::max(rect.scale, 1.0)),
-                                 std::log(8.0 * double(enc->bytes.size()) /
-                                          double(rect.pixels()))});
+                            bits[middle ? 0 : 1].push_back({rect.scale, double(rect.pixels()),
+                                                            8.0 * double(enc->bytes.size())});
                             p_bytes[sid].push_back(double(enc->bytes.size()));
                         }
                         Chain& pc = padded[sid];
@@ -773,13 +777,14 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 std::vector<double>& v = p_bytes[sid];
                 if (v.empty())
                     continue;
-                std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+                // Over the mean P-frame, the scale the bits law now has (fitBitsLaw).
+                const double p_mean = mean(v);
                 if (idr_bytes[sid] > 0.0) {
-                    open_r[sid] = idr_bytes[sid] / v[v.size() / 2];
+                    open_r[sid] = idr_bytes[sid] / p_mean;
                     key_ratio[sid % 2].push_back(open_r[sid]);
                 }
                 if (periodic_bytes[sid] > 0.0) {
-                    periodic_r[sid] = periodic_bytes[sid] / v[v.size() / 2];
+                    periodic_r[sid] = periodic_bytes[sid] / p_mean;
                     periodic_ratio.push_back(periodic_r[sid]);
                 }
             }
@@ -807,9 +812,13 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // law, fitted at scales ~2.5–12 and taken to scale 1, put 0.27 bits on a whole-frame pixel
     // where a default run's remote frames carried 0.126 (2026-11-26), and predicted remote's
     // bytes 2.2x too high. Consecutive frames of the run's span from its warm-up on, fresh
-    // encoders (the first is their key frame), P-frames from the third frame on.
+    // encoders (the first is their key frame). P-frames from the encoder's seventh frame on: the
+    // first P-frames after a key frame are cheap while x264's rate control settles (a default
+    // run's remote frames 1, 2, 3 after its key frame: 0.076, 0.098, 0.113 bits a pixel, then
+    // 0.12–0.127), and the layers' pass above likewise skips its first 10 frames.
     {
-        const int steps = o.quick ? 8 : 12;
+        const int steps = o.quick ? 12 : 18;
+        const int ramp = 6;
         const int warmup = 10;
         std::array<std::unique_ptr<VideoEncoder>, 2> enc;
         std::vector<double> full_bits;
@@ -832,12 +841,13 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 auto out = e->encode(image);
                 if (!out)
                     return makeError("whole-frame encode: " + out.error());
-                if (step >= 2 && !out->is_keyframe)
+                if (step >= ramp && !out->is_keyframe)
                     full_bits.push_back(8.0 * double(out->bytes.size()) /
                                         (double(image.width()) * double(image.height())));
             }
         }
-        cal.costs.bits_full_frame_per_px = median(full_bits);
+        // The mean, as for the layers' law: the model's bytes per frame are a mean.
+        cal.costs.bits_full_frame_per_px = mean(full_bits);
         cal.bits_full_frame_samples = static_cast<int>(full_bits.size());
         log(fmt::format("  whole frame codec: {} P-frames\n", full_bits.size()));
     }
@@ -851,27 +861,19 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         cal.costs.padding_bits_ratio = sxx > 0.0 ? std::clamp(sxy / sxx, 0.0, 10.0) : 0.0;
         cal.padding_samples = static_cast<int>(pad.size());
     }
-    // Bits per pixel: log-linear least squares, b·s^γ, for the middle and the outer layer apart.
-    auto fitBits = [](const std::vector<BitsSample>& samples, double& b, double& gamma) {
-        double sx = 0, sy = 0, sxx = 0, sxy = 0;
-        for (const BitsSample& s : samples) {
-            sx += s.log_scale;
-            sy += s.log_bits_per_px;
-            sxx += s.log_scale * s.log_scale;
-            sxy += s.log_scale * s.log_bits_per_px;
-        }
-        const double n = double(samples.size());
-        const double den = n * sxx - sx * sx;
-        gamma = std::clamp(std::fabs(den) > 1e-12 ? (n * sxy - sx * sy) / den : 0.0, -4.0, 4.0);
-        b = std::clamp(std::exp((sy - gamma * sx) / n), 1e-6, 100.0);
-    };
-    if (bits[0].size() >= 2) {
-        fitBits(bits[0], cal.costs.bits_per_px_at_1, cal.costs.bits_scale_exponent);
-        cal.bits_samples = static_cast<int>(bits[0].size());
-    }
-    if (bits[1].size() >= 2) {
-        fitBits(bits[1], cal.costs.bits_outer_per_px_at_1, cal.costs.bits_outer_scale_exponent);
-        cal.bits_samples += static_cast<int>(bits[1].size());
+    // Bits per pixel: b·s^γ for the middle and the outer layer apart, γ from the logs, b from
+    // the mean (sim/cost_fit.h fitBitsLaw).
+    for (int li = 0; li < 2; ++li) {
+        const BitsLaw law = fitBitsLaw(bits[static_cast<size_t>(li)]);
+        if (law.bits_per_px_at_1 <= 0.0)
+            continue;
+        (li == 0 ? cal.costs.bits_per_px_at_1 : cal.costs.bits_outer_per_px_at_1) =
+            law.bits_per_px_at_1;
+        (li == 0 ? cal.costs.bits_scale_exponent : cal.costs.bits_outer_scale_exponent) =
+            law.scale_exponent;
+        cal.bits_mean_over_geometric[static_cast<size_t>(li)] =
+            law.bits_per_px_at_1 / law.geometric_b;
+        cal.bits_samples += static_cast<int>(bits[static_cast<size_t>(li)].size());
     }
     // The render passes may follow the power law (llvmpipe's fovea pass is not linear over
     // 3 kpx … 4 Mpx); the whole frame gets its own scale (MODEL.md §8).
@@ -960,7 +962,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                     double log_sum = 0.0;
                     for (double x : ratios)
                         log_sum += std::log(x);
-                    const double mean = std::exp(log_sum / double(ratios.size()));
+                    const double geo_mean = std::exp(log_sum / double(ratios.size()));
                     std::sort(ratios.begin(), ratios.end());
                     std::sort(alone_all.begin(), alone_all.end());
                     std::sort(shared_all.begin(), shared_all.end());
@@ -969,7 +971,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                     cal.corun_samples = static_cast<int>(ratios.size());
                     cal.corun_ratio_min = ratios[ratios.size() / 10];
                     cal.corun_ratio_max = ratios[ratios.size() * 9 / 10];
-                    cal.costs.corun_slowdown = std::clamp(mean, 1.0, 4.0);
+                    cal.costs.corun_slowdown = std::clamp(geo_mean, 1.0, 4.0);
                     cal.corun_note = fmt::format(
                         "periphery layers {:.2f} ms alone, {:.2f} ms with core {} rendering "
                         "(medians); slowdown x{:.3f} (geometric mean of {} paired renders, p10-p90 "
@@ -1025,11 +1027,12 @@ int runCalibrate(CalibrateCmdOptions& o) {
         cal->costs.frame_overhead_ms, cal->costs.packet_payload_bytes,
         cal->costs.packet_overhead_bytes, cal->seconds, cal->load_avg_before);
     fmt::print(
-        "  codec: P-frame bits per layer pixel middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f}; key "
-        "frame {:.2f}x / {:.2f}x a P-frame (new encoder), {:.2f}x (periodic); padding {:.3f} of a "
-        "layer pixel's bits ({} pairs)\n",
+        "  codec: P-frame bits per layer pixel middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f} (the "
+        "mean: {:.3f}x / {:.3f}x the geometric mean); key frame {:.2f}x / {:.2f}x a P-frame (new "
+        "encoder), {:.2f}x (periodic); padding {:.3f} of a layer pixel's bits ({} pairs)\n",
         cal->costs.bits_per_px_at_1, cal->costs.bits_scale_exponent,
         cal->costs.bits_outer_per_px_at_1, cal->costs.bits_outer_scale_exponent,
+        cal->bits_mean_over_geometric[0], cal->bits_mean_over_geometric[1],
         cal->costs.keyframe_bits_ratio, cal->costs.keyframe_outer_bits_ratio,
         cal->costs.keyframe_periodic_bits_ratio, cal->costs.padding_bits_ratio,
         cal->padding_samples);

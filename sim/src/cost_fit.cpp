@@ -170,4 +170,35 @@ PartCost fitPartCost(const std::vector<CostSample>& samples, const CostFitOption
     return cost;
 }
 
+BitsLaw fitBitsLaw(const std::vector<BitsSample>& samples) {
+    double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, n = 0.0;
+    for (const BitsSample& s : samples) {
+        if (!(s.pixels > 0.0) || !(s.bits > 0.0))
+            continue;
+        const double x = std::log(std::max(s.scale, 1.0));
+        const double y = std::log(s.bits / s.pixels);
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+        n += 1.0;
+    }
+    BitsLaw law;
+    if (n < 2.0)
+        return law;
+    const double den = n * sxx - sx * sx;
+    law.scale_exponent =
+        std::clamp(std::fabs(den) > 1e-12 ? (n * sxy - sx * sy) / den : 0.0, -4.0, 4.0);
+    law.geometric_b = std::clamp(std::exp((sy - law.scale_exponent * sx) / n), 1e-6, 100.0);
+    double bits = 0.0, shape = 0.0;
+    for (const BitsSample& s : samples) {
+        if (!(s.pixels > 0.0) || !(s.bits > 0.0))
+            continue;
+        bits += s.bits;
+        shape += s.pixels * std::pow(std::max(s.scale, 1.0), law.scale_exponent);
+    }
+    law.bits_per_px_at_1 = std::clamp(shape > 0.0 ? bits / shape : law.geometric_b, 1e-6, 100.0);
+    return law;
+}
+
 }  // namespace qvr

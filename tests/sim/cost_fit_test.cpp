@@ -106,5 +106,47 @@ TEST(CostFit, OnlyWholeFramesOrNoSamples) {
     EXPECT_EQ(none.at(1e5, 1e4), 0.0);
 }
 
+// The bits law b·s^γ: exact samples give it back, and noisy ones give the b whose total is the
+// samples' total (the mean), not the geometric mean a log fit alone gives.
+TEST(BitsLaw, RecoversAnExactLawAndItsTotal) {
+    std::vector<BitsSample> s;
+    for (double scale : {1.0, 2.5, 4.0, 7.0, 12.0})
+        for (double px : {2e4, 9e4})
+            s.push_back({scale, px, px * 0.3 * std::pow(scale, 0.4)});
+    const BitsLaw law = fitBitsLaw(s);
+    EXPECT_NEAR(law.bits_per_px_at_1, 0.3, 1e-9);
+    EXPECT_NEAR(law.scale_exponent, 0.4, 1e-9);
+    EXPECT_NEAR(law.geometric_b, 0.3, 1e-9);
+}
+
+TEST(BitsLaw, NoisyFramesKeepTheirMeanNotTheirGeometricMean) {
+    // Every scale sees P-frames at 0.7x and 1.5x the law alike: the mean is 1.1x, the geometric
+    // mean sqrt(1.05) = 1.0247x.
+    std::vector<BitsSample> s;
+    double total = 0.0;
+    for (double scale : {1.5, 3.0, 6.0, 10.0})
+        for (double noise : {0.7, 1.5}) {
+            const double px = 5e4;
+            s.push_back({scale, px, px * 0.25 * std::pow(scale, 0.3) * noise});
+            total += s.back().bits;
+        }
+    const BitsLaw law = fitBitsLaw(s);
+    EXPECT_NEAR(law.scale_exponent, 0.3, 1e-9);
+    EXPECT_NEAR(law.geometric_b, 0.25 * std::sqrt(0.7 * 1.5), 1e-9);
+    EXPECT_NEAR(law.bits_per_px_at_1, 0.25 * 1.1, 1e-9);
+    double predicted = 0.0;
+    for (const BitsSample& b : s)
+        predicted += b.pixels * law.bits_per_px_at_1 * std::pow(b.scale, law.scale_exponent);
+    EXPECT_NEAR(predicted, total, 1e-6 * total);
+}
+
+TEST(BitsLaw, TooFewUsableSamplesGiveNoLaw) {
+    EXPECT_EQ(fitBitsLaw({}).bits_per_px_at_1, 0.0);
+    // Empty frames and empty layers do not count.
+    const BitsLaw law = fitBitsLaw({{2.0, 1e4, 3e3}, {3.0, 0.0, 100.0}, {4.0, 1e4, 0.0}});
+    EXPECT_EQ(law.bits_per_px_at_1, 0.0);
+    EXPECT_EQ(law.scale_exponent, 0.0);
+}
+
 }  // namespace
 }  // namespace qvr

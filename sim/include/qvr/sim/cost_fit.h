@@ -38,4 +38,28 @@ PartCost fitPartCost(const std::vector<CostSample>& samples, const CostFitOption
 // predicted with the cost's full_frame_scale.
 double costResidualRmsPct(const std::vector<CostSample>& samples, const PartCost& cost);
 
+// One encoded P-frame of one layer: its scale (display pixels per layer pixel along an axis,
+// ≥ 1), its pixels and the bits the encoder spent on it.
+struct BitsSample {
+    double scale = 1.0;
+    double pixels = 0.0;
+    double bits = 0.0;
+};
+
+// The bits law b·s^γ bits per layer pixel. geometric_b is what least squares on logs alone gives
+// b; b / geometric_b is how far the per-frame bits sit above their geometric mean.
+struct BitsLaw {
+    double bits_per_px_at_1 = 0.0;
+    double scale_exponent = 0.0;
+    double geometric_b = 0.0;
+};
+
+// γ from least squares on logs (the law's shape over scale, clamped to ±4); b such that the
+// law, applied to every sample's scale and pixels, spends the samples' bits in total — their
+// mean, which is what the model's bytes per frame is compared with. The log fit's own b is the
+// geometric mean, below the mean by about half the variance of the log bits (a layer's P-frames
+// vary by 20–40% frame to frame: 2–8% low). Samples with no pixels or bits are skipped; fewer
+// than two left: a zero law.
+BitsLaw fitBitsLaw(const std::vector<BitsSample>& samples);
+
 }  // namespace qvr
