@@ -154,6 +154,10 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     rc.padding_bits_ratio =
         r.number("runtime.padding_bits_ratio", rc.padding_bits_ratio, 0.0, 10.0);
     rc.corun_slowdown = r.number("runtime.corun_slowdown", rc.corun_slowdown, 1.0, 4.0);
+    rc.corun_headset_slowdown =
+        r.number("runtime.corun_headset_slowdown", rc.corun_headset_slowdown, 1.0, 4.0);
+    rc.corun_server_slowdown =
+        r.number("runtime.corun_server_slowdown", rc.corun_server_slowdown, 1.0, 4.0);
     if (auto st = r.finish(); !st)
         return makeError(st.error());
     return hw;
@@ -215,6 +219,10 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("keyframe_periodic_bits_ratio", c.keyframe_periodic_bits_ratio);
     put("padding_bits_ratio", c.padding_bits_ratio);
     put("corun_slowdown", c.corun_slowdown);
+    if (c.corun_headset_slowdown > 0.0)  // 0: not measured, corun_slowdown stands
+        put("corun_headset_slowdown", c.corun_headset_slowdown);
+    if (c.corun_server_slowdown > 0.0)
+        put("corun_server_slowdown", c.corun_server_slowdown);
     return s;
 }
 

@@ -301,19 +301,20 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
     size_t next_undecoded = 0;
 
     // Work on one side runs slower where the previous pass had the other side busy.
-    const double slowdown = previous ? c.corun_slowdown : 1.0;
+    const double headset_slowdown = previous ? c.headsetCoRun() : 1.0;
+    const double server_slowdown = previous ? c.serverCoRun() : 1.0;
     static const std::vector<BusySpan> kNone;
     const std::vector<BusySpan>& server_spans = previous ? previous->server : kNone;
     const std::vector<BusySpan>& headset_spans = previous ? previous->headset : kNone;
     auto work = [&](double ms) {
-        const double end = coRunEnd(hs, ms, server_spans, slowdown);
+        const double end = coRunEnd(hs, ms, server_spans, headset_slowdown);
         if (log)
             logSpan(log->headset, hs, end);
         busy += end - hs;
         hs = end;
     };
     auto serverWork = [&](double start, double ms) {
-        const double end = coRunEnd(start, ms, headset_spans, slowdown);
+        const double end = coRunEnd(start, ms, headset_spans, server_slowdown);
         if (log)
             logSpan(log->server, start, end);
         return end;
@@ -666,7 +667,7 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
 
 RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
                                  Link& link) {
-    if (!(config.costs.corun_slowdown > 1.0))
+    if (!(config.costs.headsetCoRun() > 1.0) && !(config.costs.serverCoRun() > 1.0))
         return simulatePass(trace, config, link, nullptr, nullptr);
     CoRunLog previous;
     RuntimeRunResult result = simulatePass(trace, config, link, nullptr, &previous);

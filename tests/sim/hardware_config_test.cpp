@@ -67,6 +67,8 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.keyframe_periodic_bits_ratio = 3.5;
     c.padding_bits_ratio = 0.5;
     c.corun_slowdown = 1.125;
+    c.corun_headset_slowdown = 1.25;
+    c.corun_server_slowdown = 1.0625;
     c.server_render.power_coef_ms = 3.5;
     c.server_render.px_exponent = 0.5;
     c.server_render.tri_exponent = 0.75;
@@ -94,6 +96,8 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.keyframe_periodic_bits_ratio, 3.5);
     EXPECT_EQ(hw->runtime.padding_bits_ratio, 0.5);
     EXPECT_EQ(hw->runtime.corun_slowdown, 1.125);
+    EXPECT_EQ(hw->runtime.corun_headset_slowdown, 1.25);
+    EXPECT_EQ(hw->runtime.corun_server_slowdown, 1.0625);
     // A render part's power law and whole-frame scale.
     EXPECT_EQ(hw->runtime.server_render.power_coef_ms, 3.5);
     EXPECT_EQ(hw->runtime.server_render.px_exponent, 0.5);
@@ -134,6 +138,8 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\nserver_render_px_exponent = 5\n",
                             "[runtime]\ncorun_slowdown = 0.9\n",
                             "[runtime]\ncorun_slowdown = 5\n",
+                            "[runtime]\ncorun_headset_slowdown = 0.5\n",
+                            "[runtime]\ncorun_server_slowdown = 4.5\n",
                             "[runtime]\nserver_render_power_coef_ms = -2\n",
                             "[runtime]\nfovea_tri_exponent = \"x\"\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);

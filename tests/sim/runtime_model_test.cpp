@@ -274,6 +274,34 @@ TEST(RuntimeModel, CoRunningSlowsWhatOverlapsAndNothingElse) {
     EXPECT_DOUBLE_EQ(run(Design::Local, l, 2).summary.fps_mean, alone);
 }
 
+TEST(RuntimeModel, EachSideSlowsByItsOwnCoRunningFactor) {
+    // The same frame as above with a factor per side. The server slowed 1.25x beside the
+    // headset, the headset not at all: the fovea ends at 40 ms; by then the server has done
+    // 32 ms of its 60 at 0.8 of its pace, its last 28 run alone (to 68 ms); UCA: 73 ms.
+    RuntimeCosts server_only = flatCosts(20.0, 5.0, 15.0);
+    server_only.corun_headset_slowdown = 1.0;
+    server_only.corun_server_slowdown = 1.25;
+    const RuntimeRunResult s = run(Design::Ffr, server_only, 1);
+    // The headset slowed 1.25x, the server not: the fovea's 40 ms take 50 beside the server's
+    // 60 ms alone; UCA after the server: 65 ms.
+    RuntimeCosts headset_only = flatCosts(20.0, 5.0, 15.0);
+    headset_only.corun_headset_slowdown = 1.25;
+    headset_only.corun_server_slowdown = 1.0;
+    const RuntimeRunResult h = run(Design::Ffr, headset_only, 1);
+    for (size_t k = 10; k < s.frames.size(); ++k) {
+        EXPECT_NEAR(s.frames[k].t_local_ms, 40.0, 0.1) << k;
+        EXPECT_NEAR(s.frames[k].uca_end_ms - s.frames[k].pose_ms, 73.0, 0.1) << k;
+        EXPECT_NEAR(h.frames[k].t_local_ms, 50.0, 0.1) << k;
+        EXPECT_NEAR(h.frames[k].uca_end_ms - h.frames[k].pose_ms, 65.0, 0.1) << k;
+    }
+    // A side's own factor stands in for the shared one; without one the shared one holds.
+    RuntimeCosts shared = flatCosts(20.0, 5.0, 15.0);
+    shared.corun_slowdown = 1.25;
+    shared.corun_server_slowdown = 1.0;
+    EXPECT_DOUBLE_EQ(shared.headsetCoRun(), 1.25);
+    EXPECT_DOUBLE_EQ(shared.serverCoRun(), 1.0);
+}
+
 TEST(RuntimeModel, AFrameLaterThanTheWaitLimitIsReused) {
     // One frame in flight, server 2 × 120 ms = 240 ms: in time for a 250 ms limit...
     const RuntimeRunResult in_time = run(Design::Remote, flatCosts(0.0, 1.0, 120.0), 1, 30);

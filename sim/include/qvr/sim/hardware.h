@@ -171,6 +171,18 @@ struct RuntimeCosts {
     // render's median with a second core rendering without pause over its median alone). 1: the
     // sides do not disturb each other. docs/MODEL.md §8 "Co-running".
     double corun_slowdown = 1.0;
+    // Per side (0: corun_slowdown for that side): the headset's work (fovea, decodes, UCA) while
+    // the server works, and the server's (layer renders, read-back, encodes) while the headset
+    // works. Their mixes differ in what they ask of the memory both cores share, so each is
+    // measured beside the other's mix (calibration version 12; docs/MODEL.md §8 "Co-running").
+    double corun_headset_slowdown = 0.0;
+    double corun_server_slowdown = 0.0;
+    double headsetCoRun() const {
+        return corun_headset_slowdown > 0.0 ? corun_headset_slowdown : corun_slowdown;
+    }
+    double serverCoRun() const {
+        return corun_server_slowdown > 0.0 ? corun_server_slowdown : corun_slowdown;
+    }
     double payloadShare() const {
         return packet_payload_bytes / (packet_payload_bytes + packet_overhead_bytes);
     }
@@ -221,7 +233,8 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             (0…65536); canvas_align_px (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio
 //             (0…1), canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
 //             keyframe_bits_ratio, keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio
-//             (0…1000), padding_bits_ratio (0…10), corun_slowdown (1…4)
+//             (0…1000), padding_bits_ratio (0…10), corun_slowdown, corun_headset_slowdown,
+//             corun_server_slowdown (1…4)
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);

@@ -141,11 +141,12 @@ double coRunEnd(double start, double work, const std::vector<BusySpan>& other, d
 
 // Replays `trace` through the runtime's pipeline on `link` (a constant rate or a trace; the
 // caller gives it the link emulator's rate and no noise, efficiency 1: the payload share of a
-// packet is applied here). Deterministic. With costs.corun_slowdown > 1 the replay runs more than
-// once: each pass slows the headset's work where the previous pass had the server busy and the
-// server's where it had the headset busy (a fixed point of the two cores' mutual slowdown,
-// docs/MODEL.md §8 "Co-running"); `link` must then time every transfer from its start alone, as
-// makeRuntimeLink's do.
+// packet is applied here). Deterministic. With a co-running slowdown over 1 on either side
+// (costs.headsetCoRun(), costs.serverCoRun()) the replay runs more than once: each pass slows the
+// headset's work where the previous pass had the server busy, by the headset's factor, and the
+// server's where it had the headset busy, by the server's (a fixed point of the two cores' mutual
+// slowdown, docs/MODEL.md §8 "Co-running"); `link` must then time every transfer from its start
+// alone, as makeRuntimeLink's do.
 RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
                                  Link& link);
 
