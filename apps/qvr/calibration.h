@@ -52,12 +52,16 @@ struct Calibration {
     int bits_full_frame_samples = 0;  // whole-frame P-frames (remote's layer) measured
     nlohmann::json codec_by_e1;       // per calibration e1: median P-frame bits, key-frame ratios
     nlohmann::json links;             // the emulator's profiles
-    // The co-running measurement behind costs.corun_slowdown (0 when not measured).
-    double corun_alone_ms = 0.0;
-    double corun_shared_ms = 0.0;
-    int corun_samples = 0;                                // paired renders
-    double corun_ratio_min = 0.0, corun_ratio_max = 0.0;  // their ratios' p10 and p90
-    std::string corun_note = "not measured";
+    // The co-running measurements behind costs.corun_headset_slowdown and corun_server_slowdown
+    // (calibration version 12): one side's frames timed alone and beside the other side's mix.
+    struct CoRun {
+        double alone_ms = 0.0, shared_ms = 0.0;  // a frame's median, alone and beside the load
+        int samples = 0;                         // paired frames
+        double ratio_p10 = 0.0, ratio_p90 = 0.0;
+        double slowdown = 0.0;  // their geometric mean (0: not measured)
+        std::string note = "not measured";
+    };
+    CoRun corun_headset, corun_server;
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included
 };

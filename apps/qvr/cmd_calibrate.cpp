@@ -27,6 +27,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "qvr/codec/video_codec.h"
 #include "qvr/compose/uca.h"
@@ -119,7 +120,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 11;
+    constexpr int kCalibrationVersion = 12;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -139,6 +140,18 @@ std::string calibrationCachePath(const CalibrateOptions& o) {
                                              : std::string("/tmp");
     return base + "/qvr/calibration-" + calibrationCacheKey(o) + ".toml";
 }
+
+namespace {
+nlohmann::json corunJson(const Calibration::CoRun& c) {
+    return {{"slowdown", c.slowdown},
+            {"frame_alone_ms", c.alone_ms},
+            {"frame_shared_ms", c.shared_ms},
+            {"paired_frames", c.samples},
+            {"ratio_p10", c.ratio_p10},
+            {"ratio_p90", c.ratio_p90},
+            {"note", c.note}};
+}
+}  // namespace
 
 nlohmann::json Calibration::toJson() const {
     nlohmann::json parts_json = nlohmann::json::array();
@@ -184,13 +197,8 @@ nlohmann::json Calibration::toJson() const {
             {"codec_by_e1", codec_by_e1},
             {"packet_payload_bytes", costs.packet_payload_bytes},
             {"packet_overhead_bytes", costs.packet_overhead_bytes},
-            {"corun_slowdown", costs.corun_slowdown},
-            {"corun_alone_ms", corun_alone_ms},
-            {"corun_shared_ms", corun_shared_ms},
-            {"corun_paired_renders", corun_samples},
-            {"corun_ratio_p10", corun_ratio_min},
-            {"corun_ratio_p90", corun_ratio_max},
-            {"corun_note", corun_note}};
+            {"corun_headset", corunJson(corun_headset)},
+            {"corun_server", corunJson(corun_server)}};
 }
 
 std::string Calibration::toToml() const {
@@ -219,7 +227,8 @@ std::string Calibration::toToml() const {
         "pixel, over {} P-frame pairs\n",
         costs.keyframe_bits_ratio, costs.keyframe_outer_bits_ratio,
         costs.keyframe_periodic_bits_ratio, costs.padding_bits_ratio, padding_samples);
-    s += "# co-running: " + corun_note + "\n";
+    s += "# co-running, headset: " + corun_headset.note + "\n";
+    s += "# co-running, server: " + corun_server.note + "\n";
     return s + runtimeCostsToml(costs);
 }
 
@@ -234,12 +243,142 @@ double poseTimeMs(int k) {
 }
 }  // namespace
 
+// One frame of one side's work in a run, for the co-running measurement (step 5 of
+// runCalibration) and the decode's cost where the headset decodes (step 3b). The server's: the
+// middle and outer layers of both eyes rendered with their holes, read back and each encoded in its
+// own stream. The headset's: the fovea of both eyes rendered, the four streams' next frames
+// decoded, UCA over the frame. At e1 = 10 degrees (where qvr and sw settle on the reference scenes)
+// unless told; step k is the default motion's k-th refresh, with the first step's gaze throughout
+// (so every layer keeps its size and any stream frame fits any step's plan).
+class SideMix {
+public:
+    static constexpr double kE1Deg = 10.0;
+    static constexpr int kStreamFrames = 24;  // the headset's streams, decoded round and round
+
+    SideMix(Renderer& r, const HmdProfile& profile, const runtime::HeadsetInputs& inputs,
+            const CodecConfig& codec, double e1_deg = kE1Deg)
+        : m_r(r),
+          m_profile(profile),
+          m_inputs(inputs),
+          m_codec(codec),
+          m_e1_deg(e1_deg),
+          m_planner(profile),
+          m_compositor(profile, [] {
+              ComposeOptions c;
+              c.threads = 1;
+              return c;
+          }()) {}
+
+    // The server's frame `step` (its encoders carry on from the frame before).
+    Status server(int step) {
+        const auto [head, plan] = view(step);
+        for (int eye = 0; eye < 2; ++eye)
+            for (int li = 0; li < 2; ++li) {
+                const LayerKind kind = li == 0 ? LayerKind::kMiddle : LayerKind::kOuter;
+                if (auto st = renderLayer(m_r, m_profile, plan, head, static_cast<Eye>(eye), kind,
+                                          m_image, CameraOptions{}, LayerHoles{.enabled = true});
+                    !st)
+                    return makeError("layer render: " + st.error());
+                auto& enc = m_encoders[static_cast<size_t>(eye * 2 + li)];
+                if (!enc) {
+                    auto made = makeVideoEncoder(m_codec);
+                    if (!made)
+                        return makeError("codec: " + made.error());
+                    enc = std::move(*made);
+                }
+                auto out = enc->encode(m_image);
+                if (!out)
+                    return makeError("encode: " + out.error());
+                m_canvas_px[static_cast<size_t>(eye * 2 + li)] =
+                    double(enc->canvasWidth()) * double(enc->canvasHeight());
+                if (m_recording)
+                    m_streams[static_cast<size_t>(eye * 2 + li)].push_back(std::move(out->bytes));
+            }
+        return {};
+    }
+    // The headset's frame `step`: its streams are the server's first kStreamFrames frames,
+    // coded once (the first call), then decoded in order, key frame first, round and round.
+    Status headset(int step) {
+        if (m_streams[0].empty()) {
+            m_recording = true;
+            for (int k = 0; k < kStreamFrames; ++k)
+                if (auto st = server(k); !st)
+                    return st;
+            m_recording = false;
+            m_encoders = {};
+        }
+        const auto [head, plan] = view(step);
+        auto frame = std::make_shared<LayerFrame>();
+        frame->plan = plan;
+        frame->render_pose = head;
+        for (int eye = 0; eye < 2; ++eye) {
+            EyeLayerImages& imgs = frame->eyes[static_cast<size_t>(eye)];
+            if (auto st = renderLayer(m_r, m_profile, plan, head, static_cast<Eye>(eye),
+                                      LayerKind::kFovea, imgs.fovea);
+                !st)
+                return makeError("fovea render: " + st.error());
+            for (int li = 0; li < 2; ++li) {
+                const size_t sid = static_cast<size_t>(eye * 2 + li);
+                auto& dec = m_decoders[sid];
+                if (!dec) {
+                    auto made = makeVideoDecoder(m_codec);
+                    if (!made)
+                        return makeError("codec: " + made.error());
+                    dec = std::move(*made);
+                }
+                const auto& packets = m_streams[sid];
+                const auto t0 = Clock::now();
+                auto img =
+                    dec->decode(packets[static_cast<size_t>(m_next_packet) % packets.size()]);
+                const double ms = msSince(t0);
+                if (!img)
+                    return makeError("decode: " + img.error());
+                if (m_decodes)
+                    m_decodes->push_back({ms, m_canvas_px[sid], 0.0});
+                (li == 0 ? imgs.middle : imgs.outer) = std::move(*img);
+            }
+        }
+        ++m_next_packet;
+        auto rep = m_compositor.present(frame, head, m_display);
+        if (!rep)
+            return makeError("UCA: " + rep.error());
+        return {};
+    }
+
+    // Every decode's time from now on, against its canvas's pixels (nullptr: none).
+    void recordDecodes(std::vector<CostSample>* sink) { m_decodes = sink; }
+
+private:
+    std::pair<Pose, LayerPlan> view(int step) const {
+        const double t_ms = poseTimeMs(0) + 1000.0 / m_profile.refresh_hz * step;
+        return {poseAt(m_inputs.traces.motion, t_ms),
+                m_planner.plan(gazeAt(m_inputs.traces.gaze, poseTimeMs(0)), m_e1_deg)};
+    }
+    Renderer& m_r;
+    const HmdProfile& m_profile;
+    const runtime::HeadsetInputs& m_inputs;
+    CodecConfig m_codec;
+    double m_e1_deg;
+    LayerPlanner m_planner;
+    Compositor m_compositor;
+    ImageRgba8 m_image;
+    std::array<ImageRgba8, 2> m_display;
+    std::array<std::unique_ptr<VideoEncoder>, 4> m_encoders;  // eye × {middle, outer}
+    std::array<std::unique_ptr<VideoDecoder>, 4> m_decoders;
+    std::array<std::vector<std::vector<uint8_t>>, 4> m_streams;
+    std::array<double, 4> m_canvas_px{};  // each stream's canvas (its frames all share it)
+    std::vector<CostSample>* m_decodes = nullptr;
+    bool m_recording = false;
+    int m_next_packet = 0;
+};
+
 // The other core's work for the co-running measurement: `qvr corun-load` in a child process,
-// pinned to its core, rendering the whole view while told to be busy ("1" on its stdin, "0" to
-// pause); it exits when its stdin closes.
+// pinned to its core, doing one side's frames (SideMix, `mix` "server" or "headset") while told
+// to be busy ("1" on its stdin, "0" to pause); it exits when its stdin closes.
 class CoRunLoad {
 public:
-    static Expected<std::unique_ptr<CoRunLoad>> start(const CalibrateOptions& o, int core) {
+    static Expected<std::unique_ptr<CoRunLoad>> start(const CalibrateOptions& o, int core,
+                                                      const std::string& mix) {
         std::error_code ec;
         const std::string exe = std::filesystem::read_symlink("/proc/self/exe", ec).string();
         if (ec)
@@ -256,10 +395,13 @@ public:
         posix_spawn_file_actions_init(&actions);
         posix_spawn_file_actions_adddup2(&actions, to_child[0], STDIN_FILENO);
         posix_spawn_file_actions_adddup2(&actions, from_child[1], STDOUT_FILENO);
-        std::vector<std::string> args{
-            exe,         "corun-load",        "--scene",  o.scene,
-            "--profile", o.profile,           "--lod-px", fmt::format("{}", o.lod_px),
-            "--core",    std::to_string(core)};
+        std::vector<std::string> args{exe,         "corun-load",
+                                      "--scene",   o.scene,
+                                      "--profile", o.profile,
+                                      "--lod-px",  fmt::format("{}", o.lod_px),
+                                      "--core",    std::to_string(core),
+                                      "--codec",   o.codec,
+                                      "--mix",     mix};
         std::vector<char*> argv;
         for (std::string& a : args)
             argv.push_back(a.data());
@@ -291,8 +433,8 @@ public:
             return makeError("the load process: " + line);
         return load;
     }
-    // Busy renders until told otherwise; the answer line comes once the first render under way
-    // after "1" has finished, or at once after "0" (the current render finishes first).
+    // Busy frames until told otherwise; the answer comes once the first frame under way after
+    // "1" has finished, or at once after "0" (the current frame finishes first).
     Status setBusy(bool busy) {
         const char cmd[2] = {busy ? '1' : '0', '\n'};
         // A load process that died has closed its end: the write must fail with EPIPE, not
@@ -345,7 +487,7 @@ private:
 };
 
 // `qvr corun-load`: the child CoRunLoad starts.
-int runCoRunLoad(const CalibrateOptions& o) {
+int runCoRunLoad(const CalibrateOptions& o, const std::string& mix) {
     using namespace qvr::runtime;
     if (auto st = pinCurrentThread(o.core); !st) {
         std::printf("%s\n", st.error().c_str());
@@ -366,10 +508,17 @@ int runCoRunLoad(const CalibrateOptions& o) {
         std::printf("%s\n", renderer ? "cannot upload the scene" : renderer.error().c_str());
         return 2;
     }
-    const LayerPlanner planner(*profile);
-    const Pose head = poseAt(inputs->traces.motion, poseTimeMs(0));
-    const LayerPlan whole = planner.plan(gazeAt(inputs->traces.gaze, poseTimeMs(0)), 180.0);
-    ImageRgba8 img;
+    CodecConfig codec;
+    codec.backend = o.codec;
+    SideMix side(**renderer, *profile, *inputs, codec);
+    const bool server = mix == "server";
+    int step = 0;
+    auto frame = [&] { return server ? side.server(step++) : side.headset(step++); };
+    // The first frame before "ready": shaders compiled, the headset's streams coded.
+    if (auto st = frame(); !st) {
+        std::printf("%s\n", st.error().c_str());
+        return 1;
+    }
     std::printf("ready\n");
     std::fflush(stdout);
     bool busy = false;
@@ -387,10 +536,10 @@ int runCoRunLoad(const CalibrateOptions& o) {
             }
         }
         if (busy) {
-            if (!renderLayer(**renderer, *profile, whole, head, Eye::kLeft, LayerKind::kFovea, img))
+            if (auto st = frame(); !st)
                 return 1;
         }
-        if (answer) {  // after the first render when busy: the load is under way
+        if (answer) {  // after the first frame when busy: the load is under way
             std::printf("k");
             std::fflush(stdout);
             answer = false;
@@ -601,12 +750,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                         const double dec_ms = msSince(t1);
                         if (!dec)
                             return makeError("decode: " + dec.error());
-                        // Key frames are the exception in a run (one every 120 frames): P-frames
-                        // only.
-                        if (sampled && !enc->is_keyframe) {
-                            encode.push_back({enc->encode_ms, double(rect.pixels()), 0});
-                            decode.push_back({dec_ms, double(rect.pixels()), 0});
-                        }
+                        (void)dec_ms;  // timed in the steady codec pass below
                     }
                 }
                 // UCA over the frame just rendered.
@@ -721,13 +865,31 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                         Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
                         if (!ch.enc) {
                             auto e = makeVideoEncoder(codec);
-                            if (!e)
-                                return makeError("codec: " + e.error());
+                            auto d = makeVideoDecoder(codec);
+                            if (!e || !d)
+                                return makeError("codec: " + (e ? d.error() : e.error()));
                             ch.enc = std::move(*e);
+                            ch.dec = std::move(*d);
                         }
                         auto enc = ch.enc->encode(image);
                         if (!enc)
                             return makeError("encode: " + enc.error());
+                        const auto t_dec = Clock::now();
+                        auto decoded = ch.dec->decode(enc->bytes);
+                        const double dec_ms = msSince(t_dec);
+                        if (!decoded)
+                            return makeError("decode: " + decoded.error());
+                        (void)dec_ms;  // the decode's cost: step 3b, where the headset decodes
+                        // The encoder's time per pixel of the canvas it codes (the model charges
+                        // the canvas), in a running stream: the six-frame sequences above saw
+                        // only the first P-frames after a key frame, which carry 25-40% fewer
+                        // bits (calibration version 12). Every third frame.
+                        if (step >= warmup && step < bits_frames && step % 3 == 0 &&
+                            !enc->is_keyframe && !enc->bytes.empty())
+                            encode.push_back(
+                                {enc->encode_ms,
+                                 double(ch.enc->canvasWidth()) * double(ch.enc->canvasHeight()),
+                                 0});
                         const size_t sid = static_cast<size_t>(eye * 2 + li);
                         if (step == 0 && enc->is_keyframe)
                             idr_bytes[sid] = double(enc->bytes.size());
@@ -851,6 +1013,27 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         cal.bits_full_frame_samples = static_cast<int>(full_bits.size());
         log(fmt::format("  whole frame codec: {} P-frames\n", full_bits.size()));
     }
+    // 3b. The decode where the headset decodes: in a headset frame (SideMix), after the
+    // previous frame's UCA and this frame's fovea, whose memory traffic has evicted the decoder's
+    // pictures from the caches. Timed right after its own encode (versions 1-11), a layer's
+    // decode took 0.3 ms where a run's headset took 0.74 ms over layers of the same size and
+    // bits, 2.4x (docs/MODEL.md §8, calibration version 12). Per canvas pixel, P-frames only.
+    {
+        const std::vector<double> decode_e1s =
+            o.quick ? std::vector<double>{4, 10, 20} : std::vector<double>{3, 5, 8, 12, 18, 28};
+        const int frames = o.quick ? 8 : 12;  // under SideMix::kStreamFrames: no key frame
+        for (double e1 : decode_e1s) {
+            SideMix mix(r, *profile, *inputs, codec, e1);
+            if (auto st = mix.headset(0); !st)  // codes the streams; decodes their key frames
+                return makeError("decode pass: " + st.error());
+            mix.recordDecodes(&decode);
+            for (int k = 1; k <= frames; ++k)
+                if (auto st = mix.headset(k); !st)
+                    return makeError("decode pass: " + st.error());
+        }
+        log(fmt::format("  decode in headset frames: {} decodes at e1 {}\n", decode.size(),
+                        fmt::join(decode_e1s, ", ")));
+    }
     {
         // Least squares through the origin: bytes ratio − 1 = ρ · extra canvas share.
         double sxy = 0.0, sxx = 0.0;
@@ -889,8 +1072,10 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     cal.parts.push_back(summarise("server render",
                                   "one periphery or whole-frame layer (ktri drawn: LOD, holes)",
                                   server, cal.costs.server_render));
-    cal.parts.push_back(summarise("encode", "one layer, P-frame", encode, cal.costs.encode));
-    cal.parts.push_back(summarise("decode", "one stream, P-frame", decode, cal.costs.decode));
+    cal.parts.push_back(summarise("encode", "one layer, P-frame, running stream (canvas px)",
+                                  encode, cal.costs.encode));
+    cal.parts.push_back(summarise("decode", "one stream, P-frame, in a headset frame (canvas px)",
+                                  decode, cal.costs.decode));
     cal.parts.push_back(
         summarise("uca", "one frame, both eyes, per layer pixel read", uca, cal.costs.uca));
 
@@ -904,84 +1089,100 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             cal.links[name] = {{"rate_bps", lc->rate_bps}, {"delay_ms", lc->delay_ms}};
     }
     // 5. The two cores at once. In a run the headset and the server work at the same time, each
-    // on its core and in its own process; on a machine whose cores share a physical core or a
-    // host's time, each is then slower than alone, which no part timed alone shows (the
-    // runtime's periphery layers render 5-20% slower than this calibration's law on a 2-core
-    // KVM guest: docs/MODEL.md §8 "Co-running"). Measured here: the same periphery layers
-    // rendered on this core alone and while a second process (`qvr corun-load`), pinned to
-    // another core, renders the whole view without pause. A process, not a thread: llvmpipe
-    // serialises the rasterisation of contexts that share its screen (a thread here made this
-    // core's 6 ms layers wait up to 170 ms for the other's whole frame).
+    // on its core and in its own process; on a machine whose cores share memory bandwidth, a
+    // physical core or a host's time, each is then slower than alone, which no part timed alone
+    // shows. How much depends on what both do: a rasteriser beside a rasteriser (versions 9-11)
+    // measured x1.00 on a 2-core KVM guest where a run's periphery layers took 1.15x their law
+    // and its fovea 1.2x, and a streaming copy beside another 2.2x (docs/MODEL.md §8
+    // "Co-running"). So each side's frames (SideMix) are timed on this core alone and beside
+    // `qvr corun-load` doing the other side's frames on another core without pause: pairs of
+    // blocks, alone then shared, over the same frames. A process, not a thread: llvmpipe
+    // serialises the rasterisation of contexts that share its screen.
     {
         const int cores = onlineCores();
         const int other = cores > 1 ? (o.core == cores - 1 ? 0 : cores - 1) : -1;
-        if (other < 0) {
-            cal.corun_note = "one core: no co-running to measure";
-        } else {
-            auto load = CoRunLoad::start(o, other);
-            if (!load) {
-                cal.corun_note = "not measured: " + load.error();
-            } else {
-                // Pairs of blocks, alone then shared, over the same layers: each layer's time
-                // beside the load over its time alone in the same pair. The slowdown comes and
-                // goes with what the host does, so many pairs, and their geometric mean.
-                constexpr int kPairs = 12;
-                std::vector<double> ratios, alone_all, shared_all;
-                const LayerPlan plan = planner.plan(poses[0].gaze, 10.0);
-                // A load that fails leaves co-running unmeasured (x1), not the calibration.
-                std::string load_error;
-                for (int pair = 0; pair < kPairs && load_error.empty(); ++pair) {
-                    std::array<std::vector<double>, 2> ms;
-                    for (int with = 0; with < 2 && load_error.empty(); ++with) {
-                        if (auto st = (*load)->setBusy(with == 1); !st) {
-                            load_error = st.error();
-                            break;
-                        }
-                        for (const PoseSample& p : poses)
-                            for (LayerKind kind : {LayerKind::kMiddle, LayerKind::kOuter}) {
-                                const auto t0 = Clock::now();
-                                if (auto st = renderLayer(r, *profile, plan, p.head, Eye::kLeft,
-                                                          kind, image, CameraOptions{}, holes);
-                                    !st)
-                                    return makeError("co-run render: " + st.error());
-                                ms[static_cast<size_t>(with)].push_back(msSince(t0));
-                            }
-                    }
-                    if (!load_error.empty())
+        SideMix side(r, *profile, *inputs, codec);
+        auto measure = [&](bool headset_side, Calibration::CoRun& out) -> Status {
+            const char* self = headset_side ? "headset" : "server";
+            const char* load_mix = headset_side ? "server" : "headset";
+            if (other < 0) {
+                out.note = "one core: no co-running to measure";
+                return {};
+            }
+            auto load = CoRunLoad::start(o, other, load_mix);
+            if (!load) {  // a load that cannot run leaves co-running unmeasured (x1)
+                out.note = "not measured: " + load.error();
+                return {};
+            }
+            auto frame = [&](int step) {
+                return headset_side ? side.headset(step) : side.server(step);
+            };
+            if (auto st = frame(0); !st)  // warm-up (and the headset's streams)
+                return makeError(std::string("co-run ") + self + " frame: " + st.error());
+            // The slowdown comes and goes with what the host does: many pairs, their
+            // geometric mean.
+            const int pairs = o.quick ? 6 : 10;
+            constexpr int kBlock = 6;
+            std::vector<double> ratios, alone_all, shared_all;
+            std::string load_error;
+            for (int pair = 0; pair < pairs && load_error.empty(); ++pair) {
+                std::array<std::vector<double>, 2> ms;
+                for (int with = 0; with < 2 && load_error.empty(); ++with) {
+                    if (auto st = (*load)->setBusy(with == 1); !st) {
+                        load_error = st.error();
                         break;
-                    for (size_t j = 0; j < ms[0].size(); ++j) {
-                        ratios.push_back(ms[1][j] / std::max(1e-6, ms[0][j]));
-                        alone_all.push_back(ms[0][j]);
-                        shared_all.push_back(ms[1][j]);
+                    }
+                    for (int k = 0; k < kBlock; ++k) {
+                        const auto t0 = Clock::now();
+                        if (auto st = frame(1 + pair * kBlock + k); !st)
+                            return makeError(std::string("co-run ") + self +
+                                             " frame: " + st.error());
+                        ms[static_cast<size_t>(with)].push_back(msSince(t0));
                     }
                 }
-                (*load)->stop();
-                if (!load_error.empty() || ratios.empty()) {
-                    cal.corun_note = "not measured: the load process: " + load_error;
-                } else {
-                    double log_sum = 0.0;
-                    for (double x : ratios)
-                        log_sum += std::log(x);
-                    const double geo_mean = std::exp(log_sum / double(ratios.size()));
-                    std::sort(ratios.begin(), ratios.end());
-                    std::sort(alone_all.begin(), alone_all.end());
-                    std::sort(shared_all.begin(), shared_all.end());
-                    cal.corun_alone_ms = alone_all[alone_all.size() / 2];
-                    cal.corun_shared_ms = shared_all[shared_all.size() / 2];
-                    cal.corun_samples = static_cast<int>(ratios.size());
-                    cal.corun_ratio_min = ratios[ratios.size() / 10];
-                    cal.corun_ratio_max = ratios[ratios.size() * 9 / 10];
-                    cal.costs.corun_slowdown = std::clamp(geo_mean, 1.0, 4.0);
-                    cal.corun_note = fmt::format(
-                        "periphery layers {:.2f} ms alone, {:.2f} ms with core {} rendering "
-                        "(medians); slowdown x{:.3f} (geometric mean of {} paired renders, p10-p90 "
-                        "{:.2f}-{:.2f})",
-                        cal.corun_alone_ms, cal.corun_shared_ms, other, cal.costs.corun_slowdown,
-                        ratios.size(), cal.corun_ratio_min, cal.corun_ratio_max);
+                if (!load_error.empty())
+                    break;
+                for (size_t j = 0; j < ms[0].size(); ++j) {
+                    ratios.push_back(ms[1][j] / std::max(1e-6, ms[0][j]));
+                    alone_all.push_back(ms[0][j]);
+                    shared_all.push_back(ms[1][j]);
                 }
             }
-        }
-        log("  co-running: " + cal.corun_note + "\n");
+            (*load)->stop();
+            if (!load_error.empty() || ratios.empty()) {
+                out.note = "not measured: the load process: " + load_error;
+                return {};
+            }
+            double log_sum = 0.0;
+            for (double x : ratios)
+                log_sum += std::log(x);
+            const double geo_mean = std::exp(log_sum / double(ratios.size()));
+            std::sort(ratios.begin(), ratios.end());
+            std::sort(alone_all.begin(), alone_all.end());
+            std::sort(shared_all.begin(), shared_all.end());
+            out.alone_ms = alone_all[alone_all.size() / 2];
+            out.shared_ms = shared_all[shared_all.size() / 2];
+            out.samples = static_cast<int>(ratios.size());
+            out.ratio_p10 = ratios[ratios.size() / 10];
+            out.ratio_p90 = ratios[ratios.size() * 9 / 10];
+            out.slowdown = std::clamp(geo_mean, 1.0, 4.0);
+            out.note = fmt::format(
+                "{} frames (e1 = {:g} deg) {:.2f} ms alone, {:.2f} ms with core {} doing the "
+                "{}'s (medians); slowdown x{:.3f} (geometric mean of {} paired frames, p10-p90 "
+                "{:.2f}-{:.2f})",
+                self, SideMix::kE1Deg, out.alone_ms, out.shared_ms, other, load_mix, out.slowdown,
+                ratios.size(), out.ratio_p10, out.ratio_p90);
+            return {};
+        };
+        if (auto st = measure(true, cal.corun_headset); !st)
+            return makeError(st.error());
+        log("  co-running, headset: " + cal.corun_headset.note + "\n");
+        if (auto st = measure(false, cal.corun_server); !st)
+            return makeError(st.error());
+        log("  co-running, server: " + cal.corun_server.note + "\n");
+        // Measured per side; the shared factor stays 1 (sim/hardware.h).
+        cal.costs.corun_headset_slowdown = cal.corun_headset.slowdown;
+        cal.costs.corun_server_slowdown = cal.corun_server.slowdown;
     }
 
     cal.seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
@@ -1038,7 +1239,8 @@ int runCalibrate(CalibrateCmdOptions& o) {
         cal->padding_samples);
     fmt::print("  codec: P-frame bits per whole-frame pixel (remote) {:.4f} ({} P-frames)\n",
                cal->costs.bits_full_frame_per_px, cal->bits_full_frame_samples);
-    fmt::print("  co-running: {}\n", cal->corun_note);
+    fmt::print("  co-running, headset: {}\n", cal->corun_headset.note);
+    fmt::print("  co-running, server: {}\n", cal->corun_server.note);
     {
         std::ofstream f(o.out);
         f << cal->toToml();
@@ -1096,13 +1298,17 @@ QVR_REGISTER_COMMAND(91, registerCalibrate);
 static Registered registerCoRunLoad(CLI::App& app) {
     auto o = std::make_shared<CalibrateOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "corun-load", "qvr calibrate's second-core load (internal: renders while told to)");
+        "corun-load",
+        "qvr calibrate's second-core load (internal: one side's frames while told to)");
     cmd->group("");  // not listed: qvr calibrate starts it
     cmd->add_option("--scene", o->scene)->required();
     cmd->add_option("--profile", o->profile)->required();
     cmd->add_option("--lod-px", o->lod_px)->check(CLI::Range(0.0, 16.0));
     cmd->add_option("--core", o->core)->required()->check(CLI::Range(0, 4095));
-    return {cmd, [o] { return runCoRunLoad(*o); }};
+    cmd->add_option("--codec", o->codec)->check(CLI::IsMember({"x264", "raw"}));
+    auto mix = std::make_shared<std::string>("server");
+    cmd->add_option("--mix", *mix)->check(CLI::IsMember({"server", "headset"}));
+    return {cmd, [o, mix] { return runCoRunLoad(*o, *mix); }};
 }
 QVR_REGISTER_COMMAND(92, registerCoRunLoad);
 
