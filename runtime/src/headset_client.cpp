@@ -13,6 +13,7 @@
 #include "qvr/compose/uca.h"
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
+#include "qvr/core/silence.h"
 #include "qvr/render/camera.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/workload_probe.h"
@@ -264,7 +265,7 @@ private:
         m_last_connect_try_ns = now_ns;
         if (auto st = m_client->connect(m_config.host, m_config.port); st) {
             ++m_stats.connects;
-            m_last_stream_ns = m_clock.nowNs();  // a new session has a whole limit to start
+            m_silence.restart(double(m_clock.nowNs()) * 1e-6);  // a whole limit to start
             // A new session: new encoders on the server, so new decoders here.
             for (auto& d : m_decoders)
                 d.reset();
@@ -301,7 +302,7 @@ private:
 
     void onStream(net::CompletedStream& cs) {
         ++m_stats.streams_received;
-        m_last_stream_ns = m_clock.nowNs();
+        m_silence.onStream(double(m_clock.nowNs()) * 1e-6);
         if (cs.stream_id >= net::kMaxStreams)
             return;
         PendingFrame* p = pendingFor(cs.frame_id);
@@ -589,9 +590,12 @@ private:
             // A server that has delivered no stream for a whole wait limit is stalled or its
             // link is dead: waiting the limit for every frame would drop the display to
             // 1 / limit (4 Hz at 250 ms, measured under a 2 s SIGSTOP of the server). Then
-            // wait one refresh and re-warp the newest layers, until streams come again.
+            // wait one refresh and re-warp the newest layers, until streams come again. A
+            // server whose streams are spaced wider than half the limit is given twice its
+            // spacing before it is called silent (qvr/core/silence.h).
             const int64_t limit_ns = static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
-            const bool silent = local_end_ns - m_last_stream_ns > limit_ns;
+            const bool silent =
+                m_silence.silent(double(local_end_ns) * 1e-6, m_config.remote_timeout_ms);
             const int64_t deadline_ns =
                 silent ? std::max(local_end_ns, pose_ns) +
                              static_cast<int64_t>(1e9 / m_config.profile.refresh_hz)
@@ -757,8 +761,8 @@ private:
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
     int64_t m_last_complete_rx_ns = 0;
-    int64_t m_last_stream_ns = 0;  // the newest stream from the server, or the session's start
-    int64_t m_idle_ns = 0;         // waiting for the network or vsync since the last frame finished
+    SilenceDetector m_silence;  // the newest streams from the server, or the session's start
+    int64_t m_idle_ns = 0;      // waiting for the network or vsync since the last frame finished
     int64_t m_last_finish_ns = 0;
     size_t m_depth = 1;
     uint64_t m_proof_failures_seen = 0;

@@ -17,6 +17,7 @@
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
 #include "qvr/core/canvas_policy.h"
+#include "qvr/core/silence.h"
 #include "qvr/foveation/layer_plan.h"
 
 namespace qvr {
@@ -285,9 +286,10 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
     double busy = 0.0;  // busy time since the previous frame finished
     double last_e1_deg = 5.0;
     double last_complete_rx_ms = 0.0;
-    // The newest stream the headset took from the transport (the session's start before any):
-    // a server silent for a whole wait limit makes the runtime wait one refresh instead.
-    double last_stream_ms = 0.0;
+    // The streams the headset took from the transport (the session's start, 0 ms, before any):
+    // a server silent for a whole wait limit (or twice its spacing, if longer) makes the runtime
+    // wait one refresh instead.
+    SilenceDetector silence;
     int64_t last_slot = -1;  // the newest scan-out's vsync slot index
     double ack_goodput_bps = 0.0;
     // Server and link.
@@ -436,7 +438,7 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         FrameState& fs = state[static_cast<size_t>(s.frame)];
         RuntimeFrame& rf = result.frames[static_cast<size_t>(s.frame)];
         fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
-        last_stream_ms = hs;
+        silence.onStream(hs);
         // A frame's bytes are what arrived for it, whenever (the runtime counts a late
         // frame's streams too, until the frame is retired). What LIWC observes is only what
         // came while the frame held its pending entry: until the frame after it was shown.
@@ -535,7 +537,7 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
             const double service_start = std::max(rf.request_ms, last_complete_rx_ms);
             // A server that has delivered no stream for a whole wait limit: wait one refresh
             // (the runtime's silent_server_frames, docs/RUNTIME.md step 5).
-            const bool silent = rf.local_end_ms - last_stream_ms > config.wait_limit_ms;
+            const bool silent = silence.silent(rf.local_end_ms, config.wait_limit_ms);
             const double deadline =
                 silent
                     ? std::max(rf.local_end_ms, rf.pose_ms) + period_ms

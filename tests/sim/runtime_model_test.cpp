@@ -529,5 +529,23 @@ TEST(RuntimeModel, DesignNames) {
     EXPECT_FALSE(runtimeDesignByName("").ok());
 }
 
+TEST(RuntimeModel, ASlowServerIsNotASilentOne) {
+    // remote, one frame in flight, 300 ms per whole-frame layer: streams 300 ms apart, each
+    // frame needing 600 ms, later than the 250 ms limit. Until the second stream the server has
+    // no spacing and is silent after a limit (frames shown a refresh apart); once two streams
+    // are 300 ms apart it is given twice that, 600 ms, and every frame waits the whole limit
+    // from when the server could start on it and is reused — never one refresh.
+    const RuntimeRunResult r = run(Design::Remote, flatCosts(0.0, 1.0, 300.0), 1, 40);
+    int waited = 0;
+    for (const RuntimeFrame& f : r.frames) {
+        if (f.local_end_ms < 700.0)
+            continue;
+        EXPECT_TRUE(f.reused);
+        EXPECT_GE(f.uca_start_ms - f.local_end_ms, 250.0 - 1e-6) << f.local_end_ms;
+        ++waited;
+    }
+    EXPECT_GT(waited, 8);
+}
+
 }  // namespace
 }  // namespace qvr
