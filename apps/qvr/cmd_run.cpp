@@ -620,9 +620,10 @@ nlohmann::json predictionJson(double fps, double mtp, double mtp_p99, double byt
 // Signed error of the prediction, percent of the measurement (null where it is 0).
 nlohmann::json errorPctJson(const nlohmann::json& predicted, const nlohmann::json& measured) {
     nlohmann::json e = nlohmann::json::object();
-    for (const char* k :
-         {"fps_mean", "mtp_ms_mean", "mtp_ms_p99", "bytes_per_frame_mean", "e1_deg_mean"}) {
-        const double m = measured.value(k, 0.0);
+    for (const char* k : {"fps_mean", "mtp_ms_mean", "mtp_ms_p99", "bytes_per_frame_mean",
+                          "e1_deg_mean", "headset_busy_ms_mean", "server_busy_ms_mean"}) {
+        const nlohmann::json& mv = measured.contains(k) ? measured[k] : nlohmann::json();
+        const double m = mv.is_number() ? mv.get<double>() : 0.0;
         const double p = predicted.value(k, 0.0);
         e[k] = m != 0.0 ? nlohmann::json(100.0 * (p - m) / std::fabs(m)) : nlohmann::json();
     }
@@ -656,7 +657,9 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
                               {"mtp_ms_mean", "MTP mean ms", "{:.1f}"},
                               {"mtp_ms_p99", "MTP p99 ms", "{:.1f}"},
                               {"bytes_per_frame_mean", "bytes/frame", "{:.0f}"},
-                              {"e1_deg_mean", "e1 mean °", "{:.1f}"}};
+                              {"e1_deg_mean", "e1 mean °", "{:.1f}"},
+                              {"headset_busy_ms_mean", "headset busy ms/frame", "{:.1f}"},
+                              {"server_busy_ms_mean", "server busy ms/served frame", "{:.1f}"}};
     for (auto it = designs.begin(); it != designs.end(); ++it) {
         const nlohmann::json& d = it.value();
         if (!d.contains("predicted"))
@@ -674,7 +677,9 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
             h += fmt::format(
                 "<tr>{}<td style='text-align:left'>{}</td><td>{}</td><td>{}</td><td>{}</td>"
                 "<td>{}</td></tr>\n",
-                first ? fmt::format("<td rowspan='5'>{}</td>", report::htmlEscape(it.key())) : "",
+                first ? fmt::format("<td rowspan='{}'>{}</td>", std::size(metrics),
+                                    report::htmlEscape(it.key()))
+                      : "",
                 m.label, fmtCell(d.value(m.key, nlohmann::json()), m.f),
                 fmtCell(d["predicted"].value(m.key, nlohmann::json()), m.f), err_cell,
                 fmtCell(paper, m.f));
@@ -1008,6 +1013,7 @@ int runRun(const RunOptions& o) {
     // trace.json: every design's headset stages and the server's, on the headset's clock.
     nlohmann::json trace_json = nlohmann::json::object();
     std::string trace_note;
+    std::vector<ServerBusy> server_busy;  // per design, in the order of runs
     {
         std::vector<ServerFrameStamps> stamps;
         if (auto read = readServerStamps(server_stamps_path.string()))
@@ -1017,6 +1023,7 @@ int runRun(const RunOptions& o) {
         std::vector<TraceDesign> tds;
         for (const DesignRun& r : runs)
             tds.push_back({r.label(), r.result.origin_ns, profile->refresh_hz, &r.result.frames});
+        server_busy = serverBusyPerDesign(tds, stamps);
         if (auto info = writeChromeTrace((out / "trace.json").string(), tds, stamps)) {
             trace_json = {{"path", "trace.json"},
                           {"events", info->events},
@@ -1231,9 +1238,26 @@ int runRun(const RunOptions& o) {
     const DesignSummary* local = nullptr;
     const DesignSummary* remote = nullptr;
     const DesignSummary* qvr = nullptr;
-    for (const DesignRun& r : runs) {
+    for (size_t ri = 0; ri < runs.size(); ++ri) {
+        const DesignRun& r = runs[ri];
         const std::string name = r.label();
         dj[name] = summaryJson(r.result.summary, r.result.stats);
+        // The two sides' own costs, as the model counts them, to tell which side an error is
+        // on: the headset's busy time per frame after the warm-up, the server's render and
+        // encode per served frame (docs/MODEL.md §8, "Stage errors").
+        {
+            double sum = 0.0;
+            int n = 0;
+            for (const FrameTelemetry& t : r.result.frames)
+                if (t.frame >= o.warmup_frames && t.headset_busy_ms > 0.0) {
+                    sum += t.headset_busy_ms;
+                    ++n;
+                }
+            dj[name]["headset_busy_ms_mean"] = n > 0 ? nlohmann::json(sum / n) : nlohmann::json();
+            const bool served = ri < server_busy.size() && server_busy[ri].frames > 0;
+            dj[name]["server_busy_ms_mean"] =
+                served ? nlohmann::json(server_busy[ri].busy_ms_mean) : nlohmann::json();
+        }
         if (predicted.contains(name)) {
             dj[name]["predicted"] = predicted[name];
             dj[name]["prediction_error_pct"] = errorPctJson(predicted[name], dj[name]);
@@ -1555,16 +1579,22 @@ int runRun(const RunOptions& o) {
 
     fmt::print("  ratios: {}\n", ratios.dump());
     if (!predicted.empty()) {
-        fmt::print("  calibrated prediction ({}): error of FPS, MTP mean, bytes/frame; e1\n",
-                   calibration->source);
+        fmt::print(
+            "  calibrated prediction ({}): error of FPS, MTP mean, bytes/frame; e1; and of each "
+            "side's own cost (headset busy per frame, server render+encode per served frame)\n",
+            calibration->source);
         for (auto it = dj.begin(); it != dj.end(); ++it) {
             if (!it.value().contains("prediction_error_pct"))
                 continue;
             const nlohmann::json& e = it.value()["prediction_error_pct"];
-            fmt::print("    {:8} fps {:>8}  mtp {:>8}  bytes {:>8}  e1 {:>7}\n", it.key(),
-                       fmtCell(e["fps_mean"], "{:+.1f}%"), fmtCell(e["mtp_ms_mean"], "{:+.1f}%"),
-                       fmtCell(e["bytes_per_frame_mean"], "{:+.1f}%"),
-                       fmtCell(it.value()["prediction_error_abs"]["e1_deg_mean"], "{:+.1f}°"));
+            fmt::print(
+                "    {:8} fps {:>8}  mtp {:>8}  bytes {:>8}  e1 {:>7}  | headset {:>7}  server "
+                "{:>7}\n",
+                it.key(), fmtCell(e["fps_mean"], "{:+.1f}%"), fmtCell(e["mtp_ms_mean"], "{:+.1f}%"),
+                fmtCell(e["bytes_per_frame_mean"], "{:+.1f}%"),
+                fmtCell(it.value()["prediction_error_abs"]["e1_deg_mean"], "{:+.1f}°"),
+                fmtCell(e.value("headset_busy_ms_mean", nlohmann::json()), "{:+.1f}%"),
+                fmtCell(e.value("server_busy_ms_mean", nlohmann::json()), "{:+.1f}%"));
         }
     }
     if (!sim_note.empty())

@@ -175,6 +175,24 @@ ClockOffset estimateClockOffset(const std::vector<TraceDesign>& designs,
     return c;
 }
 
+std::vector<ServerBusy> serverBusyPerDesign(const std::vector<TraceDesign>& designs,
+                                            const std::vector<ServerFrameStamps>& server) {
+    std::vector<ServerBusy> out(designs.size());
+    const auto index = requestIndex(designs);
+    for (const ServerFrameStamps& s : server) {
+        int d = 0;
+        if (!match(index, designs, s, &d))
+            continue;
+        double ms = 0.0;
+        for (const ServerFrameStamps::Layer& l : s.layers)
+            ms += double(std::max<int64_t>(0, l.encode_end_ns - l.render_start_ns)) * 1e-6;
+        ServerBusy& b = out[size_t(d)];
+        ++b.frames;
+        b.busy_ms_mean += (ms - b.busy_ms_mean) / double(b.frames);
+    }
+    return out;
+}
+
 Expected<ChromeTraceInfo> writeChromeTrace(const std::string& path,
                                            const std::vector<TraceDesign>& designs,
                                            const std::vector<ServerFrameStamps>& server,

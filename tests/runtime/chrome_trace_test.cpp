@@ -76,6 +76,29 @@ TEST(ChromeTrace, EstimatesTheServerClockOffsetWithinItsBound) {
     EXPECT_LE(std::abs(c.offset_ns - double(kServerAhead)), c.bound_ns);
 }
 
+TEST(ChromeTrace, SumsTheServersRenderAndEncodePerDesign) {
+    // Two layers a frame, each 3 ms from render start to encode end: 6 ms a frame for the
+    // design whose requests they served; none for a design that requested nothing matched; a
+    // stamp for no known request (another headset) counts nowhere.
+    std::vector<FrameTelemetry> telemetry;
+    std::vector<ServerFrameStamps> server;
+    makeRun(30, telemetry, server);
+    std::vector<FrameTelemetry> other = telemetry;
+    for (FrameTelemetry& t : other)
+        t.remote_requested = false;
+    ServerFrameStamps stray = server.front();
+    stray.client_send_ns += 1;
+    server.push_back(stray);
+    const std::vector<TraceDesign> designs = {{"qvr", kOrigin, 90.0, &telemetry},
+                                              {"local", kOrigin + 5000 * kMs, 90.0, &other}};
+    const std::vector<ServerBusy> busy = serverBusyPerDesign(designs, server);
+    ASSERT_EQ(busy.size(), 2u);
+    EXPECT_EQ(busy[0].frames, 30);
+    EXPECT_NEAR(busy[0].busy_ms_mean, 6.0, 1e-9);
+    EXPECT_EQ(busy[1].frames, 0);
+    EXPECT_EQ(busy[1].busy_ms_mean, 0.0);
+}
+
 TEST(ChromeTrace, WritesEveryFramesStagesInOrderOnTheHeadsetClock) {
     std::vector<FrameTelemetry> telemetry;
     std::vector<ServerFrameStamps> server;

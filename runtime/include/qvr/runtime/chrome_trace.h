@@ -45,6 +45,16 @@ struct ClockOffset {
 ClockOffset estimateClockOffset(const std::vector<TraceDesign>& designs,
                                 const std::vector<ServerFrameStamps>& server);
 
+// The server's work for each design, as the simulator's server_busy_ms counts it: per matched
+// server frame, the sum over its layers of render, readback and encode (render start to encode
+// end; not the queue, not the send). One entry per design, in the order given.
+struct ServerBusy {
+    int64_t frames = 0;
+    double busy_ms_mean = 0.0;
+};
+std::vector<ServerBusy> serverBusyPerDesign(const std::vector<TraceDesign>& designs,
+                                            const std::vector<ServerFrameStamps>& server);
+
 struct ChromeTraceInfo {
     int64_t events = 0;
     int64_t frames_written = 0;
