@@ -44,7 +44,11 @@ RunSummarizer::RunSummarizer(std::string design, int warmup_frames)
 
 void RunSummarizer::add(const FrameTelemetry& t) {
     if (!m_startup_done) {
-        if (m_startup.size() < m_warmup) {
+        // The first m_warmup frames, and then every frame that still shows none of the
+        // server's layers (DesignSummary::warmup_frames).
+        const bool no_remote_yet = m_warmup > 0 && t.remote_requested && t.shown_frame < 0;
+        if (m_startup.size() < m_warmup ||
+            (no_remote_yet && m_startup.size() < kMaxStartupFrames)) {
             m_startup.push_back(t);
             return;
         }

@@ -624,9 +624,23 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
     // Summary, as summarizeRun (runtime/telemetry.cpp) computes it.
     RuntimeSummary& s = result.summary;
     s.design = std::string(traits.name);
-    // Statistics over the frames after the warm-up, as summarizeRun skips them.
-    const int skip =
-        config.warmup_frames > 0 && n_frames > config.warmup_frames ? config.warmup_frames : 0;
+    // Statistics over the frames after the warm-up, as summarizeRun skips them: the first
+    // warmup_frames, and after them every frame that asked for layers while none had yet come
+    // (the runtime's shown_frame < 0); all frames when the start-up is the whole run.
+    double first_layers_ms = std::numeric_limits<double>::infinity();
+    for (const RuntimeFrame& f : result.frames)
+        if (f.remote_done_ms >= 0.0)
+            first_layers_ms = std::min(first_layers_ms, f.remote_done_ms);
+    int skip = config.warmup_frames > 0 ? config.warmup_frames : 0;
+    if (skip > 0)
+        while (skip < n_frames && skip < 4096) {  // RunSummarizer::kMaxStartupFrames
+            const RuntimeFrame& f = result.frames[static_cast<size_t>(skip)];
+            if (!f.requested || f.uca_start_ms >= first_layers_ms)
+                break;
+            ++skip;
+        }
+    if (skip >= n_frames)
+        skip = 0;
     const int counted = n_frames - skip;
     s.frames = counted;
     if (counted <= 0)

@@ -24,6 +24,7 @@ std::vector<FrameTelemetry> frames(size_t n, uint32_t seed) {
         t.e1_deg = 5.0 + double(i % 7);
         t.t_local_ms = 10.0 + double(i % 5);
         t.remote_requested = i % 3 != 0;
+        t.shown_frame = t.remote_requested ? static_cast<int64_t>(i) : -1;
         t.t_remote_ms = 30.0 + double(i % 11);
         t.uca_ms = 2.0;
     }
@@ -57,6 +58,37 @@ TEST(RunSummarizer, LeavesOutTheStartUpUnlessTheRunIsNoLonger) {
     EXPECT_EQ(t.frames, 10);
     EXPECT_EQ(t.warmup_frames, 0);
     EXPECT_DOUBLE_EQ(t.mtp_ms_p99, exactP99(ten, 0));
+}
+
+TEST(RunSummarizer, TheStartUpLastsUntilTheServersFirstLayersAreOnScreen) {
+    // Every frame asks for layers; none is on screen before frame 23 (the server's first frame
+    // took longer than the wait limit and the headset re-warped nothing): frames 0–22 are the
+    // start-up, not only the first ten.
+    auto v = frames(40, 2);
+    for (size_t i = 0; i < v.size(); ++i) {
+        v[i].remote_requested = true;
+        v[i].shown_frame = i < 23 ? -1 : static_cast<int64_t>(i) - 3;
+    }
+    const DesignSummary s = summarizeRun("remote", v, 10);
+    EXPECT_EQ(s.warmup_frames, 23);
+    EXPECT_EQ(s.frames, 17);
+    double mean = 0.0;
+    for (size_t i = 23; i < 40; ++i)
+        mean += v[i].mtp_ms / 17.0;
+    EXPECT_NEAR(s.mtp_ms_mean, mean, 1e-9);
+    // A design that asks for nothing (local) keeps the ten frames.
+    auto local = v;
+    for (FrameTelemetry& t : local)
+        t.remote_requested = false;
+    EXPECT_EQ(summarizeRun("local", local, 10).warmup_frames, 10);
+    // Without a warm-up every frame counts, shown or not.
+    EXPECT_EQ(summarizeRun("remote", v, 0).frames, 40);
+    // Layers never on screen: the start-up is the whole run, summarized whole.
+    for (FrameTelemetry& t : v)
+        t.shown_frame = -1;
+    const DesignSummary never = summarizeRun("remote", v, 10);
+    EXPECT_EQ(never.frames, 40);
+    EXPECT_EQ(never.warmup_frames, 0);
 }
 
 TEST(RunSummarizer, AHourLongSessionKeepsItsP99WithinTheHistogramsPrecision) {

@@ -547,5 +547,36 @@ TEST(RuntimeModel, ASlowServerIsNotASilentOne) {
     EXPECT_GT(waited, 8);
 }
 
+TEST(RuntimeModel, TheStartUpLastsUntilTheServersFirstLayersAreOnScreen) {
+    // remote at 300 ms per layer: its first frame's layers are all in at 600 ms, after one
+    // wait limit and a stretch of frames re-warping nothing a refresh apart. With a warm-up of
+    // 2 frames the statistics start at the first frame composed after those layers came (the
+    // runtime's first shown_frame ≥ 0), not at frame 2.
+    const WorkloadTrace trace = flatTrace(40);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Remote;
+    cfg.costs = flatCosts(0.0, 1.0, 300.0);
+    cfg.pipeline_depth = 1;
+    cfg.frames = 40;
+    cfg.warmup_frames = 2;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    double first_ms = 1e300;
+    for (const RuntimeFrame& f : r.frames)
+        if (f.remote_done_ms >= 0.0)
+            first_ms = std::min(first_ms, f.remote_done_ms);
+    ASSERT_GT(first_ms, 600.0);
+    size_t skip = 0;
+    while (r.frames[skip].uca_start_ms < first_ms)
+        ++skip;
+    ASSERT_GT(skip, 5u);  // frame 0 waits the limit, then frames a refresh apart
+    EXPECT_EQ(r.summary.frames, 40 - static_cast<int>(skip));
+    // The counted frames each wait the whole limit: the FPS is the limit's, not the refresh's.
+    EXPECT_LT(r.summary.fps_mean, 1000.0 / 250.0);
+    cfg.warmup_frames = 0;
+    NoisyLink link0 = fastLink();
+    EXPECT_EQ(simulateRuntime(trace, cfg, link0).summary.frames, 40);
+}
+
 }  // namespace
 }  // namespace qvr

@@ -73,7 +73,12 @@ struct DesignSummary {
     // The session's first frames (connection, the server's first render and key frame, first
     // use of every code path) are its start-up, not its steady state: they are left out of
     // every statistic above (with 150 frames the MTP p99 is the second-worst frame, which was
-    // always frame 0 or 1 for every design) and their worst MTP is reported on its own.
+    // always frame 0 or 1 for every design) and their worst MTP is reported on its own. For a
+    // design that asks the server for layers, the start-up lasts at least until the first of
+    // them is on screen (FrameTelemetry::shown_frame ≥ 0), at most kMaxStartupFrames: a server
+    // whose first frame takes longer than the wait limit leaves the headset re-warping nothing at
+    // the refresh rate, and those frames are not the design's steady state. warmup_frames is the
+    // number of frames the start-up took.
     int warmup_frames = 0;
     double startup_mtp_ms_max = 0.0;
 };
@@ -89,6 +94,7 @@ DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTel
 class RunSummarizer {
 public:
     static constexpr size_t kExactMtpFrames = size_t{1} << 16;
+    static constexpr size_t kMaxStartupFrames = 4096;  // what the start-up may hold
 
     RunSummarizer(std::string design, int warmup_frames);
     void add(const FrameTelemetry& t);
