@@ -100,6 +100,9 @@ struct Row {
     std::string scene, link, design;
     int depth = 0;
     std::vector<double> fps_err, mtp_err, bytes_err, e1_err_abs, fps_meas, fps_pred;
+    // Each side's own cost against the model's (docs/MODEL.md §8, "Stage errors"): a host that
+    // changed speed since the calibration shows here as well as in the FPS.
+    std::vector<double> headset_err, server_err;
 };
 
 double mean(const std::vector<double>& v) {
@@ -234,7 +237,12 @@ int runValidate(const ValidateOptions& o) {
                             fmt::format("{}|{}|{}|{}", scene, link, depth, it.key());
                         if (!rows.count(key)) {
                             order.push_back(key);
-                            rows[key] = Row{scene, link, it.key(), depth, {}, {}, {}, {}, {}, {}};
+                            Row row;
+                            row.scene = scene;
+                            row.link = link;
+                            row.design = it.key();
+                            row.depth = depth;
+                            rows[key] = std::move(row);
                         }
                         Row& r = rows[key];
                         const nlohmann::json& e = d["prediction_error_pct"];
@@ -247,6 +255,10 @@ int runValidate(const ValidateOptions& o) {
                         r.e1_err_abs.push_back(num(d["prediction_error_abs"]["e1_deg_mean"]));
                         r.fps_meas.push_back(num(d["fps_mean"]));
                         r.fps_pred.push_back(num(d["predicted"]["fps_mean"]));
+                        r.headset_err.push_back(
+                            num(e.value("headset_busy_ms_mean", nlohmann::json())));
+                        r.server_err.push_back(
+                            num(e.value("server_busy_ms_mean", nlohmann::json())));
                     }
                 }
     if (o.dry_run)
@@ -255,8 +267,8 @@ int runValidate(const ValidateOptions& o) {
     // 3. The sheet.
     std::string md = fmt::format(
         "| scene | link | depth | design | FPS measured | FPS predicted | FPS error | MTP error | "
-        "bytes error | e1 error | FPS spread over reps |\n|---|---|---|---|---|---|---|---|---|---|"
-        "---|\n");
+        "bytes error | e1 error | FPS spread over reps | headset cost error | server cost error "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     std::vector<double> abs_fps, abs_mtp, abs_bytes, abs_e1;
     nlohmann::json rows_json = nlohmann::json::array();
     for (const std::string& key : order) {
@@ -275,11 +287,12 @@ int runValidate(const ValidateOptions& o) {
             r.link.rfind("trace:", 0) == 0
                 ? "trace:" + fs::path(r.link.substr(6)).filename().string()
                 : r.link;
-        md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.scene,
-                          link_label, r.depth, r.design, cell(mean(r.fps_meas), "{:.1f}"),
+        md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+                          r.scene, link_label, r.depth, r.design, cell(mean(r.fps_meas), "{:.1f}"),
                           cell(mean(r.fps_pred), "{:.1f}"), cell(fe, "{:+.1f}%"),
                           cell(me, "{:+.1f}%"), cell(be, "{:+.1f}%"), cell(ee, "{:+.1f}°"),
-                          cell(spread(r.fps_meas), "{:.1f}"));
+                          cell(spread(r.fps_meas), "{:.1f}"), cell(mean(r.headset_err), "{:+.1f}%"),
+                          cell(mean(r.server_err), "{:+.1f}%"));
         rows_json.push_back({{"scene", r.scene},
                              {"link", r.link},
                              {"depth", r.depth},
@@ -289,7 +302,9 @@ int runValidate(const ValidateOptions& o) {
                              {"fps_error_pct", r.fps_err},
                              {"mtp_error_pct", r.mtp_err},
                              {"bytes_error_pct", r.bytes_err},
-                             {"e1_error_deg", r.e1_err_abs}});
+                             {"e1_error_deg", r.e1_err_abs},
+                             {"headset_cost_error_pct", r.headset_err},
+                             {"server_cost_error_pct", r.server_err}});
     }
     auto worst = [](const std::vector<double>& v) {
         return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
