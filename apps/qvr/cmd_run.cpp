@@ -1476,7 +1476,9 @@ int runRun(const RunOptions& o) {
         "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
         "the "
         "server's egress), {} frames per design, of which the first {} are each session's "
-        "start-up (connection, first renders, key frames, the policy's first decisions): logged, "
+        "start-up (connection, first renders, key frames, the policy's first decisions; for a "
+        "design that asks the server for layers, also every frame until the first of them is "
+        "on screen: <code>warmup_frames</code> in summary.json): logged, "
         "but outside every statistic below (their worst MTP is <code>startup_mtp_ms_max</code> "
         "in summary.json and the table's last column). The headset (this process) is "
         "pinned to core {}, "
@@ -1662,8 +1664,10 @@ static Registered registerRun(CLI::App& app) {
     addLodOption(cmd, o->lod_px);
     cmd->add_option("--warmup-frames", o->warmup_frames,
                     "Each design's first frames are its session's start-up (connection, first "
-                    "renders, key frames, the policy's first decisions): run and logged, but left "
-                    "out of FPS, MTP, bytes and e1; their worst MTP is reported apart")
+                    "renders, key frames, the policy's first decisions; for a design that asks the "
+                    "server for layers, also until the first of them is on screen): run and "
+                    "logged, but left out of FPS, MTP, bytes and e1; their worst MTP is reported "
+                    "apart")
         ->capture_default_str();
     cmd->add_option("--pipeline", o->pipeline_depth,
                     "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
