@@ -1243,13 +1243,14 @@ int runRun(const RunOptions& o) {
         const std::string name = r.label();
         dj[name] = summaryJson(r.result.summary, r.result.stats);
         // The two sides' own costs, as the model counts them, to tell which side an error is
-        // on: the headset's busy time per frame after the warm-up, the server's render and
+        // on: the headset's busy time per frame after the start-up (the frames the summary
+        // left out, as the model leaves them out), the server's render and
         // encode per served frame (docs/MODEL.md §8, "Stage errors").
         {
             double sum = 0.0;
             int n = 0;
             for (const FrameTelemetry& t : r.result.frames)
-                if (t.frame >= o.warmup_frames && t.headset_busy_ms > 0.0) {
+                if (t.frame >= r.result.summary.warmup_frames && t.headset_busy_ms > 0.0) {
                     sum += t.headset_busy_ms;
                     ++n;
                 }
