@@ -88,6 +88,10 @@ void codecArgs(benchmark::internal::Benchmark* b) {
         b->Args({w, h, 0, 1});
     b->Args({270, 300, 1, 0});
     b->Args({1920, 2160, 1, 0});
+    // The layer plan's sizes are any width and height: an odd height and a width off 16 beside
+    // 270x300 (swscale's unscaled YUV<->RGB kernels want an even height, docs/CODEC.md).
+    b->Args({270, 301, 0, 0});
+    b->Args({271, 301, 0, 0});
     b->Unit(benchmark::kMillisecond);
 }
 

@@ -322,7 +322,10 @@ private:
             ++m_stats.decode_failures;
             return;
         }
+        const int64_t decode_start_ns = m_clock.nowNs();
         auto image = dec->decode(cs.bytes);
+        if (p)
+            tel(p->telemetry).decode_ms += double(m_clock.nowNs() - decode_start_ns) * 1e-6;
         if (!image) {
             ++m_stats.decode_failures;
             if (p)

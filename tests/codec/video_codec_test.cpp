@@ -3,8 +3,11 @@
 // behaving like the real codec.
 #include "qvr/codec/video_codec.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -131,6 +134,37 @@ TEST(X264Codec, OutgrowingTheCanvasReopensWithAKeyframeAndDecodes) {
         EXPECT_GT(psnrRgb(src, *dec), kMinPsnrDb);
     }
     EXPECT_EQ(p.encoder->stats().reopens, 1);
+}
+
+// The decoder converts a size swscale's fast kernel takes (even height, width a multiple of 16)
+// out of the padded canvas and crops to the layer: the crop must be the layer, to its last row
+// and column, as close to the source as an even-sized layer's.
+TEST(X264Codec, AnOddSizedLayerDecodesToItsLastRowAndColumn) {
+    for (auto [w, h] : {std::pair{270, 300}, std::pair{270, 301}, std::pair{271, 301}}) {
+        Pair p = makePair();
+        double worst_edge = 0.0;
+        for (int i = 0; i < 4; ++i) {
+            const ImageRgba8 src = detailedImage(w, h, i * 2);
+            auto enc = p.encoder->encode(src, false);
+            ASSERT_TRUE(enc.ok()) << enc.error();
+            auto dec = p.decoder->decode(enc->bytes);
+            ASSERT_TRUE(dec.ok()) << dec.error();
+            ASSERT_EQ(dec->width(), w);
+            ASSERT_EQ(dec->height(), h);
+            EXPECT_GT(psnrRgb(src, *dec), kMinPsnrDb) << w << "x" << h << " frame " << i;
+            // Mean absolute error over the last row and the last column.
+            double sum = 0.0;
+            int n = 0;
+            for (int x = 0; x < w; ++x, ++n)
+                for (int c = 0; c < 3; ++c)
+                    sum += std::abs(int(src.at(x, h - 1, c)) - int(dec->at(x, h - 1, c))) / 3.0;
+            for (int y = 0; y < h; ++y, ++n)
+                for (int c = 0; c < 3; ++c)
+                    sum += std::abs(int(src.at(w - 1, y, c)) - int(dec->at(w - 1, y, c))) / 3.0;
+            worst_edge = std::max(worst_edge, sum / n);
+        }
+        EXPECT_LT(worst_edge, 12.0) << w << "x" << h;
+    }
 }
 
 TEST_P(CodecBackends, GarbageBytesGiveAnErrorNeverACrash) {

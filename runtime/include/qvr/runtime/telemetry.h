@@ -44,6 +44,9 @@ struct FrameTelemetry {
     double t_local_pred_ms = 0.0;      // the policy's prediction (0 when it made none)
     double t_remote_pred_ms = 0.0;
     double probe_ms = 0.0;  // the pre-render triangle-ring count (LIWC's input)
+    // The headset's decodes of this frame's streams, the calls alone (the picture out of the
+    // decoder, in RGBA): what the model charges as decode (docs/MODEL.md §8).
+    double decode_ms = 0.0;
     double uca_ms = 0.0;
     // The headset's busy time for this frame (its decision, fovea, decodes, UCA, bookkeeping:
     // everything but waiting for the network and for vsync). With frames in flight this, not the
