@@ -3,6 +3,7 @@
 // decision's ring counts, the server's layer render and encode, a stream's decode, UCA per
 // frame, the plan; fitted by least squares to RuntimeCosts.
 #include "calibration.h"
+#include "scanout_recorder.h"
 
 #include "cli_parse.h"
 #include "commands.h"
@@ -120,7 +121,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 12;
+    constexpr int kCalibrationVersion = 13;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -181,6 +182,7 @@ nlohmann::json Calibration::toJson() const {
             {"parts", parts_json},
             {"links", links},
             {"frame_overhead_ms", costs.frame_overhead_ms},
+            {"scanout_record_ms", costs.scanout_record_ms},
             {"bits_per_px_at_1", costs.bits_per_px_at_1},
             {"bits_scale_exponent", costs.bits_scale_exponent},
             {"bits_outer_per_px_at_1", costs.bits_outer_per_px_at_1},
@@ -771,6 +773,9 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // median is the whole frame's scale: from the 4 samples of 2 poses (2 in --quick) one slow
     // moment of the host moved it from 1.02 to 1.14 between two calibrations of the room three
     // hours apart, and local's predicted FPS 13-18% low in every run after (docs/MODEL.md §8).
+    ScanoutRecorder video_stand_in(*profile, 1, false, /*keep=*/false);
+    video_stand_in.reserve(1);
+    std::vector<double> video_copy;
     for (size_t pi = 0; pi < poses.size(); ++pi) {
         const PoseSample& p = poses[pi];
         const LayerPlan full = planner.plan(p.gaze, 180.0);
@@ -796,9 +801,21 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             if (!rep)
                 return makeError("UCA: " + rep.error());
             uca.push_back({msSince(t0), 2.0 * eye_px, 0});
+            // The display video's copy (`qvr run --video`): every design's headset copies its
+            // scan-out at a quarter resolution right after UCA wrote it (ScanoutRecorder; its
+            // stand-in for the designs not kept). Timed back to back over one display it read
+            // 0.29 ms, where a run's headset paid 1.05: the display must be the one UCA just
+            // wrote, as in a run.
+            const auto t1 = Clock::now();
+            video_stand_in.onScanout(runtime::FrameTelemetry{}, full, display);
+            video_copy.push_back(msSince(t1));
         }
         log(fmt::format("  full frame {}/{}\n", pi + 1, poses.size()));
     }
+    std::sort(video_copy.begin(), video_copy.end());
+    cal.costs.scanout_record_ms = video_copy[video_copy.size() / 2];
+    log(fmt::format("  display video copy after UCA: {:.2f} ms a frame (median of {})\n",
+                    cal.costs.scanout_record_ms, video_copy.size()));
     // The codec's bits, as a run at a steady e1 spends them: one encoder per stream carried over
     // the consecutive frames of a default run's span (its motion's first 120 frames, 1/refresh
     // apart), P-frames from the run's warm-up (10 frames) on. The six-frame sequences above, each
@@ -1215,9 +1232,9 @@ int runCalibrate(CalibrateCmdOptions& o) {
         fmt::print("  {:14} {:>7} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.0f}%  {}\n", p.name, p.samples,
                    p.median_ms, p.min_ms, p.max_ms, p.residual_rms_pct, costLawText(p.cost));
     fmt::print(
-        "  frame overhead (plan) {:.3f} ms; packets {} + {} bytes; took {:.0f} s, load "
-        "average {:.2f} before\n",
-        cal->costs.frame_overhead_ms, cal->costs.packet_payload_bytes,
+        "  frame overhead (plan) {:.3f} ms; display video copy {:.3f} ms; packets {} + {} bytes; "
+        "took {:.0f} s, load average {:.2f} before\n",
+        cal->costs.frame_overhead_ms, cal->costs.scanout_record_ms, cal->costs.packet_payload_bytes,
         cal->costs.packet_overhead_bytes, cal->seconds, cal->load_avg_before);
     fmt::print(
         "  codec: P-frame bits per layer pixel middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f} (the "

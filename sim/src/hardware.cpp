@@ -114,6 +114,7 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     cost("uca_base_ms", rc.uca.base_ms);
     cost("uca_ms_per_mpx", rc.uca.ms_per_mpx);
     cost("frame_overhead_ms", rc.frame_overhead_ms);
+    cost("scanout_record_ms", rc.scanout_record_ms);
     rc.bits_per_px_at_1 = r.number("runtime.bits_per_px_at_1", rc.bits_per_px_at_1, 0.0, 100.0);
     rc.bits_scale_exponent =
         r.number("runtime.bits_scale_exponent", rc.bits_scale_exponent, -4.0, 4.0);
@@ -194,6 +195,7 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     put("uca_base_ms", c.uca.base_ms);
     put("uca_ms_per_mpx", c.uca.ms_per_mpx);
     put("frame_overhead_ms", c.frame_overhead_ms);
+    put("scanout_record_ms", c.scanout_record_ms);
     put("bits_per_px_at_1", c.bits_per_px_at_1);
     put("bits_scale_exponent", c.bits_scale_exponent);
     put("bits_outer_per_px_at_1", c.bits_outer_per_px_at_1);

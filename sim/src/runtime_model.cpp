@@ -584,6 +584,8 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         hs = config.wait_for_vsync ? slot : std::max(hs, slot - period_ms);
         rf.headset_busy_ms = i > 0 ? busy : 0.0;
         busy = 0.0;
+        if (config.record_scanout)
+            work(c.scanout_record_ms);
         rf.served = fs.served;
         // 8. The policy learns what the frame measured.
         if (policy && !local_only && !whole_frame) {

@@ -74,6 +74,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.server_render.tri_exponent = 0.75;
     c.server_render.full_frame_scale = 1.75;
     c.fovea.full_frame_scale = 0.875;
+    c.scanout_record_ms = 1.25;
     auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
     ASSERT_TRUE(hw.ok()) << hw.error();
     EXPECT_TRUE(hw->runtime_pipeline);
@@ -98,6 +99,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.corun_slowdown, 1.125);
     EXPECT_EQ(hw->runtime.corun_headset_slowdown, 1.25);
     EXPECT_EQ(hw->runtime.corun_server_slowdown, 1.0625);
+    EXPECT_EQ(hw->runtime.scanout_record_ms, 1.25);
     // A render part's power law and whole-frame scale.
     EXPECT_EQ(hw->runtime.server_render.power_coef_ms, 3.5);
     EXPECT_EQ(hw->runtime.server_render.px_exponent, 0.5);
@@ -126,6 +128,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\nbits_outer_per_px_at_1 = -0.1\n",
                             "[runtime]\nbits_outer_scale_exponent = 9\n",
                             "[runtime]\nbits_full_frame_per_px = -0.5\n",
+                            "[runtime]\nscanout_record_ms = -1\n",
                             "[runtime]\ncanvas_align_px = 7\n",
                             "[runtime]\ncanvas_align_px = 0\n",
                             "[runtime]\ncanvas_headroom = 2\n",

@@ -437,6 +437,35 @@ TEST(RuntimeModel, QueuedScanOutLetsTheHeadsetRunAtItsOwnRate) {
         EXPECT_NEAR(fast.frames[k].pose_ms, fast.frames[k - 1].display_ms - kSlotMs, 1e-6);
 }
 
+TEST(RuntimeModel, RecordingTheDisplayVideoCostsEveryFrameItsCopyAfterTheFrameIsQueued) {
+    // Local at 65 ms a frame with the video's 3 ms copy after each frame is queued: a frame every
+    // 68 ms, its MTP still 65 ms (the copy comes after UCA), and the next frame's busy time 68.
+    const int n = 60;
+    RuntimeCosts c = flatCosts(30.0, 5.0, 0.0);
+    c.scanout_record_ms = 3.0;
+    const WorkloadTrace trace = flatTrace(n);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Local;
+    cfg.costs = c;
+    cfg.frames = n;
+    cfg.record_scanout = true;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    EXPECT_NEAR(1000.0 / r.summary.fps_mean, 68.0, kSlotMs / double(n - 1));
+    EXPECT_NEAR(r.summary.mtp_ms_mean, 65.0, 1e-6);
+    for (size_t k = 1; k < r.frames.size(); ++k) {
+        EXPECT_NEAR(r.frames[k].pose_ms - r.frames[k - 1].pose_ms, 68.0, 1e-6);
+        if (k >= 2) {
+            EXPECT_NEAR(r.frames[k].headset_busy_ms, 68.0, 1e-6);
+        }
+    }
+    // Not recording: the cost is not paid.
+    cfg.record_scanout = false;
+    NoisyLink link2 = fastLink();
+    const RuntimeRunResult off = simulateRuntime(trace, cfg, link2);
+    EXPECT_NEAR(1000.0 / off.summary.fps_mean, 65.0, kSlotMs / double(n - 1));
+}
+
 TEST(RuntimeModel, TRemoteRunsToTheLastPacketNotTheDecode) {
     // Remote, one frame in flight, two 100 ms layers, 3 ms per decode, an instant link: the last
     // packet arrives 200 ms after the request; its decode ends 3 ms later (the first stream was

@@ -120,6 +120,9 @@ struct RuntimeCosts {
     PartCost decode{0.3, 4.0, 0.0};     // one stream, per decoded layer pixel
     PartCost uca{5.0, 1.3, 0.0};        // one frame: base + per layer pixel read (both eyes)
     double frame_overhead_ms = 0.5;     // per frame: pumps, telemetry, bookkeeping
+    // Per frame, when the run records its display video (qvr run --video, RuntimeSimConfig::
+    // record_scanout): the quarter-resolution copy of the scan-out, after the frame is queued.
+    double scanout_record_ms = 0.0;
     // The codec's P-frame size on the calibration's scene: bits per layer pixel b·s^γ at scale
     // s. 0: take bits per pixel from the workload trace instead.
     double bits_per_px_at_1 = 0.0;
@@ -223,7 +226,8 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             decision_base_ms, decision_ms_per_ktri, fovea_base_ms, fovea_ms_per_mpx,
 //             fovea_ms_per_ktri, fovea_power_coef_ms, fovea_px_exponent, fovea_tri_exponent
 //             (−4…4), fovea_full_frame_scale (0.01…100), decode_base_ms, decode_ms_per_mpx,
-//             uca_base_ms, uca_ms_per_mpx, frame_overhead_ms, bits_per_px_at_1 (0…100),
+//             uca_base_ms, uca_ms_per_mpx, frame_overhead_ms, scanout_record_ms,
+//             bits_per_px_at_1 (0…100),
 //             bits_scale_exponent (−4…4), bits_outer_per_px_at_1 (0…100),
 //             bits_outer_scale_exponent (−4…4), bits_full_frame_per_px (0…100),
 //             server_render_base_ms, server_render_ms_per_mpx, server_render_ms_per_ktri,

@@ -49,6 +49,10 @@ struct RuntimeSimConfig {
     // T_remote as the policies see it: to the last packet's arrival (the runtime's t_remote_ms),
     // or, when set, to the last stream decoded (t_remote_decoded_ms).
     bool t_remote_to_decode = false;
+    // The run records its display video (qvr run --video): every frame's headset also pays
+    // costs.scanout_record_ms, after the frame is queued for its slot (in the next frame's busy
+    // time, as the runtime's DisplaySink is called).
+    bool record_scanout = false;
     // The triangles one layer draws — kind 0 fovea (the whole frame for local and remote), 1
     // middle, 2 outer; eye 0 left, 1 right — for frame `frame` of the trace under `plan`: what
     // the renderer submits at its level of detail with the periphery's holes (render/renderer.h
