@@ -262,6 +262,7 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
             {"wall_s", s.wall_s},
             {"warmup_frames", s.warmup_frames},
             {"startup_mtp_ms_max", s.startup_mtp_ms_max},
+            {"startup_unfinished", s.startup_unfinished},
             {"streams_decoded", st.streams_decoded},
             {"streams_lost", st.streams_lost},
             {"decode_failures", st.decode_failures},
@@ -825,6 +826,12 @@ int runRun(const RunOptions& o) {
             "displayed {} reused {}\n",
             s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
             s.e1_deg_mean, s.frames_displayed, s.frames_reused);
+        if (s.startup_unfinished && o.warmup_frames > 0)
+            fmt::print(
+                "  warning: {}: the start-up never ended (none of the server's layers reached the "
+                "screen in {} frames); its statistics are over every frame, not a steady state "
+                "(summary.json startup_unfinished)\n",
+                s.design, s.frames);
         std::fflush(stdout);
         for (const FrameTelemetry& t : result->frames)
             all_csv << telemetryCsvRow(label, t);

@@ -123,7 +123,9 @@ DesignSummary RunSummarizer::finish() const {
         RunSummarizer all(m_s.design, 0);
         for (const FrameTelemetry& t : m_startup)
             all.add(t);
-        return all.finish();
+        DesignSummary s = all.finish();
+        s.startup_unfinished = true;
+        return s;
     }
     DesignSummary s = m_s;
     if (s.frames > 0) {

@@ -72,6 +72,7 @@ TEST(RunSummarizer, TheStartUpLastsUntilTheServersFirstLayersAreOnScreen) {
     const DesignSummary s = summarizeRun("remote", v, 10);
     EXPECT_EQ(s.warmup_frames, 23);
     EXPECT_EQ(s.frames, 17);
+    EXPECT_FALSE(s.startup_unfinished);
     double mean = 0.0;
     for (size_t i = 23; i < 40; ++i)
         mean += v[i].mtp_ms / 17.0;
@@ -89,6 +90,8 @@ TEST(RunSummarizer, TheStartUpLastsUntilTheServersFirstLayersAreOnScreen) {
     const DesignSummary never = summarizeRun("remote", v, 10);
     EXPECT_EQ(never.frames, 40);
     EXPECT_EQ(never.warmup_frames, 0);
+    EXPECT_TRUE(never.startup_unfinished);  // and says so (qvr run warns)
+    EXPECT_FALSE(summarizeRun("local", local, 10).startup_unfinished);
 }
 
 TEST(RunSummarizer, AHourLongSessionKeepsItsP99WithinTheHistogramsPrecision) {

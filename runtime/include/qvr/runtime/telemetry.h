@@ -84,6 +84,10 @@ struct DesignSummary {
     // number of frames the start-up took.
     int warmup_frames = 0;
     double startup_mtp_ms_max = 0.0;
+    // No frame came past the start-up: the design asked for the server's layers and none of them
+    // reached the screen (or the run was not longer than the warm-up). The statistics are then
+    // over every frame, and a reader must not take them for the design's steady state.
+    bool startup_unfinished = false;
 };
 
 // Statistics over frames[warmup_frames…] (all frames when there are no more than that).
