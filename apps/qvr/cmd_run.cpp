@@ -1127,14 +1127,10 @@ int runRun(const RunOptions& o) {
         // left out, as the model leaves them out), the server's render and
         // encode per served frame (docs/MODEL.md §8, "Stage errors").
         {
-            double sum = 0.0;
-            int n = 0;
-            for (const FrameTelemetry& t : r.result.frames)
-                if (t.frame >= r.result.summary.warmup_frames && t.headset_busy_ms > 0.0) {
-                    sum += t.headset_busy_ms;
-                    ++n;
-                }
-            dj[name]["headset_busy_ms_mean"] = n > 0 ? nlohmann::json(sum / n) : nlohmann::json();
+            const DesignSummary& s = r.result.summary;
+            dj[name]["headset_busy_ms_mean"] = s.headset_busy_frames > 0
+                                                   ? nlohmann::json(s.headset_busy_ms_mean)
+                                                   : nlohmann::json();
             const bool served = ri < server_busy.size() && server_busy[ri].frames > 0;
             dj[name]["server_busy_ms_mean"] =
                 served ? nlohmann::json(server_busy[ri].busy_ms_mean) : nlohmann::json();

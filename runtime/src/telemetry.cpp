@@ -94,6 +94,10 @@ void RunSummarizer::count(const FrameTelemetry& t) {
     m_bytes += static_cast<double>(t.bytes);
     m_e1 += t.e1_deg;
     m_t_local += t.t_local_ms;
+    if (t.headset_busy_ms > 0.0) {
+        m_busy += t.headset_busy_ms;
+        ++m_s.headset_busy_frames;
+    }
     m_uca += t.uca_ms;
     if (t.remote_requested) {
         m_t_remote += t.t_remote_ms;
@@ -135,6 +139,8 @@ DesignSummary RunSummarizer::finish() const {
         s.bytes_per_frame_mean = m_bytes / n;
         s.e1_deg_mean = m_e1 / n;
         s.t_local_ms_mean = m_t_local / n;
+        if (s.headset_busy_frames > 0)
+            s.headset_busy_ms_mean = m_busy / double(s.headset_busy_frames);
         s.uca_ms_mean = m_uca / n;
         s.wall_s = static_cast<double>(m_last_display_ns - m_first_pose_ns) * 1e-9;
     }

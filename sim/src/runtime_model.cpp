@@ -635,7 +635,7 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
             first_layers_ms = std::min(first_layers_ms, f.remote_done_ms);
     int skip = config.warmup_frames > 0 ? config.warmup_frames : 0;
     if (skip > 0)
-        while (skip < n_frames && skip < 4096) {  // RunSummarizer::kMaxStartupFrames
+        while (skip < n_frames && skip < static_cast<int64_t>(kMaxStartupFrames)) {
             const RuntimeFrame& f = result.frames[static_cast<size_t>(skip)];
             if (!f.requested || f.uca_start_ms >= first_layers_ms)
                 break;

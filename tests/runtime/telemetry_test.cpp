@@ -68,11 +68,18 @@ TEST(RunSummarizer, TheStartUpLastsUntilTheServersFirstLayersAreOnScreen) {
     for (size_t i = 0; i < v.size(); ++i) {
         v[i].remote_requested = true;
         v[i].shown_frame = i < 23 ? -1 : static_cast<int64_t>(i) - 3;
+        v[i].headset_busy_ms = 20.0 + double(i % 3);
     }
     const DesignSummary s = summarizeRun("remote", v, 10);
     EXPECT_EQ(s.warmup_frames, 23);
     EXPECT_EQ(s.frames, 17);
     EXPECT_FALSE(s.startup_unfinished);
+    // The headset's busy time over the same frames as every other statistic.
+    double busy = 0.0;
+    for (size_t i = 23; i < 40; ++i)
+        busy += v[i].headset_busy_ms / 17.0;
+    EXPECT_EQ(s.headset_busy_frames, 17);
+    EXPECT_NEAR(s.headset_busy_ms_mean, busy, 1e-9);
     double mean = 0.0;
     for (size_t i = 23; i < 40; ++i)
         mean += v[i].mtp_ms / 17.0;

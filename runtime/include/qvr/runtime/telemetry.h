@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "qvr/core/expected.h"
+#include "qvr/core/silence.h"
 
 namespace qvr::runtime {
 
@@ -69,6 +70,10 @@ struct DesignSummary {
     double bytes_per_frame_mean = 0.0;
     double e1_deg_mean = 0.0;
     double t_local_ms_mean = 0.0;
+    // The headset's busy time per frame (FrameTelemetry::headset_busy_ms) over the counted frames
+    // that have one (the first frame of a session has none); headset_busy_frames 0: no mean.
+    double headset_busy_ms_mean = 0.0;
+    int headset_busy_frames = 0;
     double t_remote_ms_mean = 0.0;  // over frames that requested remote layers
     double uca_ms_mean = 0.0;
     double frames_fallback_local = 0;
@@ -101,7 +106,7 @@ DesignSummary summarizeRun(const std::string& design, const std::vector<FrameTel
 class RunSummarizer {
 public:
     static constexpr size_t kExactMtpFrames = size_t{1} << 16;
-    static constexpr size_t kMaxStartupFrames = 4096;  // what the start-up may hold
+    static constexpr size_t kMaxStartupFrames = qvr::kMaxStartupFrames;  // the start-up's cap
 
     RunSummarizer(std::string design, int warmup_frames);
     void add(const FrameTelemetry& t);
@@ -118,6 +123,7 @@ private:
     std::vector<FrameTelemetry> m_startup;
     bool m_startup_done = false;
     double m_mtp_sum = 0.0, m_bytes = 0.0, m_e1 = 0.0, m_t_local = 0.0, m_t_remote = 0.0;
+    double m_busy = 0.0;
     double m_uca = 0.0;
     int m_remote_frames = 0;
     int64_t m_first_display = -1, m_last_display = -1;
