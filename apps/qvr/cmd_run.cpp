@@ -749,6 +749,9 @@ int runRun(const RunOptions& o) {
     std::signal(SIGINT, onRunSignal);
     std::signal(SIGTERM, onRunSignal);
     std::string interrupted_note;
+    // Designs that asked for the server's layers and never showed one: their display was stale
+    // throughout, so the run is reported as failed (exit 1) after everything is written.
+    std::vector<std::string> never_shown;
     for (const DesignSpec& spec : *designs) {
         if (g_run_stop.load())
             break;
@@ -826,12 +829,14 @@ int runRun(const RunOptions& o) {
             "displayed {} reused {}\n",
             s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
             s.e1_deg_mean, s.frames_displayed, s.frames_reused);
-        if (s.startup_unfinished && o.warmup_frames > 0)
+        if (s.startup_unfinished && o.warmup_frames > 0) {
+            never_shown.push_back(label);
             fmt::print(
                 "  warning: {}: the start-up never ended (none of the server's layers reached the "
                 "screen in {} frames); its statistics are over every frame, not a steady state "
                 "(summary.json startup_unfinished)\n",
                 s.design, s.frames);
+        }
         std::fflush(stdout);
         for (const FrameTelemetry& t : result->frames)
             all_csv << telemetryCsvRow(label, t);
@@ -1486,6 +1491,13 @@ int runRun(const RunOptions& o) {
         std::fprintf(stderr, "qvr run: %s; wrote what was measured to %s\n",
                      interrupted_note.c_str(), o.out.c_str());
         return 130;
+    }
+    if (!never_shown.empty()) {
+        std::fprintf(stderr,
+                     "qvr run: %s never showed a layer from the server (summary.json "
+                     "startup_unfinished); wrote what was measured to %s\n",
+                     fmt::format("{}", fmt::join(never_shown, ", ")).c_str(), o.out.c_str());
+        return 1;
     }
     return 0;
 }

@@ -98,3 +98,22 @@ print("PASS: quality by band for every design (fixed:10 fovea %.1f dB, outer %.1
 print("PASS: qvr run writes qvr_display.mp4 (%s, %d frames) and a report without JSON dumps"
       % (v["codec"], v["frames"]))
 PY
+status=$?
+[ "$status" -eq 0 ] || exit "$status"
+# A design that asks for the server's layers and never shows one (a link so slow the first key
+# frame cannot cross it in the run) is a failed run: everything written, the design flagged, a
+# message, exit 1 — never stale frames reported as numbers with exit 0.
+timeout 120 "$QVR" run --profile small --frames 14 --designs remote --net rate:0.01 \
+    --hardware "$tmp/rt.toml" --no-video --out "$tmp/never" >"$tmp/never.txt" 2>"$tmp/never_err.txt"
+rc=$?
+if [ "$rc" -ne 1 ]; then
+    echo "FAIL: a run that never showed the server's layers exited $rc, not 1"
+    exit 1
+fi
+grep -q "remote never showed a layer from the server" "$tmp/never_err.txt" || {
+    echo "FAIL: no message: $(head -c 400 "$tmp/never_err.txt")"
+    exit 1
+}
+python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['designs']['remote']['startup_unfinished'] is True" \
+    "$tmp/never/summary.json" || { echo "FAIL: startup_unfinished not set"; exit 1; }
+echo "PASS: a run whose server never reached the screen exits 1 and says so"
