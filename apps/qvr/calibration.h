@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,12 @@ struct CalibratedPart {
     std::vector<int> samples_full_frame;                   // 1 where that sample is a whole frame
 };
 
+// One speed probe (SpeedProbe below).
+struct SpeedSample {
+    double headset_ms = 0.0;  // median of kFrames headset frames
+    double server_ms = 0.0;   // median of kFrames server frames
+};
+
 struct Calibration {
     RuntimeCosts costs;
     std::vector<CalibratedPart> parts;
@@ -62,11 +69,34 @@ struct Calibration {
         std::string note = "not measured";
     };
     CoRun corun_headset, corun_server;
+    std::vector<SpeedSample> speed_probes;  // over the calibration: start, middle, end
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included
 };
 
 Expected<Calibration> runCalibration(const CalibrateOptions& options);
+
+// The machine's speed at one moment: a fixed headset frame and a fixed server frame (the
+// co-running measurement's frames at e1 = 10°: both eyes' fovea, four decodes and UCA; four
+// periphery layers rendered and encoded), each timed over the same frames every time on this
+// thread's core, their medians. `qvr calibrate` takes it three times over its measurement and
+// keeps the mean as the hardware file's speed reference; `qvr run` takes it before and after
+// each design, and its prediction charges that design's costs at the ratio (docs/MODEL.md §8
+// "The machine's speed at the run"). Nothing in it is a run's measurement.
+class SpeedProbe {
+public:
+    static constexpr int kFrames = 12;
+    // Its own renderer and the calibration's poses for these options; the caller's thread and
+    // core are the ones it measures.
+    static Expected<std::unique_ptr<SpeedProbe>> make(const CalibrateOptions& options);
+    ~SpeedProbe();
+    Expected<SpeedSample> measure();
+    struct Impl;
+
+private:
+    explicit SpeedProbe(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> m_impl;
+};
 
 // A key for this machine and these options (CPU model, cores, profile, scene, codec, LOD); the
 // cached calibration of `qvr run` is stored under it.
@@ -77,5 +107,7 @@ std::string calibrationCachePath(const CalibrateOptions& options);
 std::string costLawText(const PartCost& cost);
 
 std::string machineDescriptionLine();
+// "h/s, h/s … ms headset/server" of speed probes.
+std::string speedProbesText(const std::vector<SpeedSample>& probes);
 
 }  // namespace qvr::cli

@@ -25,6 +25,8 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -121,7 +123,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 13;
+    constexpr int kCalibrationVersion = 14;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -200,7 +202,18 @@ nlohmann::json Calibration::toJson() const {
             {"packet_payload_bytes", costs.packet_payload_bytes},
             {"packet_overhead_bytes", costs.packet_overhead_bytes},
             {"corun_headset", corunJson(corun_headset)},
-            {"corun_server", corunJson(corun_server)}};
+            {"corun_server", corunJson(corun_server)},
+            {"speed_reference",
+             {{"headset_frame_ms", costs.speed_reference_headset_ms},
+              {"server_frame_ms", costs.speed_reference_server_ms},
+              {"key", costs.speed_reference_key},
+              {"probes", [this] {
+                   nlohmann::json a = nlohmann::json::array();
+                   for (const SpeedSample& p : speed_probes)
+                       a.push_back(
+                           {{"headset_frame_ms", p.headset_ms}, {"server_frame_ms", p.server_ms}});
+                   return a;
+               }()}}}};
 }
 
 std::string Calibration::toToml() const {
@@ -231,6 +244,10 @@ std::string Calibration::toToml() const {
         costs.keyframe_periodic_bits_ratio, costs.padding_bits_ratio, padding_samples);
     s += "# co-running, headset: " + corun_headset.note + "\n";
     s += "# co-running, server: " + corun_server.note + "\n";
+    if (!speed_probes.empty())
+        s += fmt::format(
+            "# speed reference (the probe's headset/server frame, the mean of {}): {}\n",
+            speed_probes.size(), speedProbesText(speed_probes));
     return s + runtimeCostsToml(costs);
 }
 
@@ -349,6 +366,13 @@ public:
 
     // Every decode's time from now on, against its canvas's pixels (nullptr: none).
     void recordDecodes(std::vector<CostSample>* sink) { m_decodes = sink; }
+    // Fresh encoders and decoders, the streams from their first (key) frame: the frames after
+    // are the same work as the last time after a restart (the speed probe's).
+    void restart() {
+        m_encoders = {};
+        m_decoders = {};
+        m_next_packet = 0;
+    }
 
 private:
     std::pair<Pose, LayerPlan> view(int step) const {
@@ -373,6 +397,33 @@ private:
     bool m_recording = false;
     int m_next_packet = 0;
 };
+
+// The speed probe (calibration.h SpeedProbe): the same headset and server frames every time,
+// each after its key frame, their medians.
+static Expected<SpeedSample> probeSpeed(SideMix& mix) {
+    constexpr int n = SpeedProbe::kFrames;
+    mix.restart();
+    std::vector<double> headset, server;
+    for (int k = 0; k <= n; ++k) {  // frame 0 decodes the streams' key frames, untimed
+        const auto t0 = Clock::now();
+        if (auto st = mix.headset(k); !st)
+            return makeError("speed probe, headset frame: " + st.error());
+        if (k > 0)
+            headset.push_back(msSince(t0));
+    }
+    for (int k = 0; k < n + 2; ++k) {  // the key frame and the first P-frame untimed
+        const auto t0 = Clock::now();
+        if (auto st = mix.server(k); !st)
+            return makeError("speed probe, server frame: " + st.error());
+        if (k >= 2)
+            server.push_back(msSince(t0));
+    }
+    auto median = [](std::vector<double>& v) {
+        std::sort(v.begin(), v.end());
+        return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    };
+    return SpeedSample{median(headset), median(server)};
+}
 
 // The other core's work for the co-running measurement: `qvr corun-load` in a child process,
 // pinned to its core, doing one side's frames (SideMix, `mix` "server" or "headset") while told
@@ -460,6 +511,37 @@ public:
             return makeError("the load process did not answer");
         return {};
     }
+    // One speed probe in the child (mix "probe"): its line "headset_ms server_ms".
+    Expected<SpeedSample> probe() {
+        sigset_t pipe_set, old_set;
+        sigemptyset(&pipe_set);
+        sigaddset(&pipe_set, SIGPIPE);
+        pthread_sigmask(SIG_BLOCK, &pipe_set, &old_set);
+        const ssize_t written = ::write(m_in, "p\n", 2);
+        if (written != 2 && errno == EPIPE) {
+            const timespec zero{0, 0};
+            sigtimedwait(&pipe_set, nullptr, &zero);
+        }
+        pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
+        if (written != 2)
+            return makeError("cannot write to the speed probe process");
+        std::string line;
+        for (char c = 0;;) {
+            pollfd pfd{m_out, POLLIN, 0};
+            if (::poll(&pfd, 1, 60'000) <= 0 || ::read(m_out, &c, 1) != 1)
+                return makeError("the speed probe process did not answer");
+            if (c == '\n')
+                break;
+            if (line.size() > 200)
+                return makeError("the speed probe process answered garbage");
+            line += c;
+        }
+        SpeedSample sample;
+        if (std::sscanf(line.c_str(), "%lf %lf", &sample.headset_ms, &sample.server_ms) != 2 ||
+            !(sample.headset_ms > 0.0) || !(sample.server_ms > 0.0))
+            return makeError("the speed probe process: " + line);
+        return sample;
+    }
     void stop() {
         if (m_in >= 0)
             ::close(m_in);
@@ -513,6 +595,27 @@ int runCoRunLoad(const CalibrateOptions& o, const std::string& mix) {
     CodecConfig codec;
     codec.backend = o.codec;
     SideMix side(**renderer, *profile, *inputs, codec);
+    if (mix == "probe") {
+        // The speed probe (SpeedProbe): one probe per "p" line, its medians on one line.
+        if (auto st = side.headset(0); !st) {  // shaders compiled, the headset's streams coded
+            std::printf("%s\n", st.error().c_str());
+            return 1;
+        }
+        std::printf("ready\n");
+        std::fflush(stdout);
+        for (char c = 0; ::read(STDIN_FILENO, &c, 1) == 1;) {
+            if (c != 'p')
+                continue;
+            auto sample = probeSpeed(side);
+            if (!sample) {
+                std::printf("%s\n", sample.error().c_str());
+                return 1;
+            }
+            std::printf("%.6f %.6f\n", sample->headset_ms, sample->server_ms);
+            std::fflush(stdout);
+        }
+        return 0;  // the parent is done
+    }
     const bool server = mix == "server";
     int step = 0;
     auto frame = [&] { return server ? side.server(step++) : side.headset(step++); };
@@ -676,6 +779,22 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 !st)
                 return makeError("render: " + st.error());
     }
+    // The machine's speed while it is measured: a probe now, one after the layers, one at the
+    // end (SpeedProbe; their mean is the hardware file's speed reference).
+    auto speed_probe = SpeedProbe::make(o);
+    if (!speed_probe)
+        return makeError(speed_probe.error());
+    auto speed = [&]() -> Status {
+        auto sample = (*speed_probe)->measure();
+        if (!sample)
+            return makeError(sample.error());
+        cal.speed_probes.push_back(*sample);
+        log(fmt::format("  speed probe {}: headset frame {:.2f} ms, server frame {:.2f} ms\n",
+                        cal.speed_probes.size(), sample->headset_ms, sample->server_ms));
+        return {};
+    };
+    if (auto st = speed(); !st)
+        return makeError(st.error());
     // Consecutive frames (1/refresh apart, as a run's content advances) so the codec sees the
     // motion of a run. Each sequence starts fresh encoders (below): frame 0 is their key frame,
     // frame 1 the first P-frame, which refers to that key frame and costs ~25% fewer bits than
@@ -773,6 +892,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // median is the whole frame's scale: from the 4 samples of 2 poses (2 in --quick) one slow
     // moment of the host moved it from 1.02 to 1.14 between two calibrations of the room three
     // hours apart, and local's predicted FPS 13-18% low in every run after (docs/MODEL.md §8).
+    if (auto st = speed(); !st)
+        return makeError(st.error());
     ScanoutRecorder video_stand_in(*profile, 1, false, /*keep=*/false);
     video_stand_in.reserve(1);
     std::vector<double> video_copy;
@@ -1194,8 +1315,70 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         cal.costs.corun_server_slowdown = cal.corun_server.slowdown;
     }
 
+    // The third speed probe, and the reference: the mean of the three.
+    if (auto st = speed(); !st)
+        return makeError(st.error());
+    {
+        SpeedSample ref;
+        for (const SpeedSample& p : cal.speed_probes) {
+            ref.headset_ms += p.headset_ms / double(cal.speed_probes.size());
+            ref.server_ms += p.server_ms / double(cal.speed_probes.size());
+        }
+        cal.costs.speed_reference_headset_ms = ref.headset_ms;
+        cal.costs.speed_reference_server_ms = ref.server_ms;
+        cal.costs.speed_reference_key = calibrationCacheKey(o);
+        log(
+            fmt::format("  speed reference: headset frame {:.2f} ms, server frame {:.2f} ms "
+                        "(mean of {} probes: {})\n",
+                        ref.headset_ms, ref.server_ms, cal.speed_probes.size(),
+                        speedProbesText(cal.speed_probes)));
+    }
+
     cal.seconds = std::chrono::duration<double>(Clock::now() - t_start).count();
     return cal;
+}
+
+struct SpeedProbe::Impl {
+    std::unique_ptr<CoRunLoad> child;
+};
+
+SpeedProbe::SpeedProbe(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
+SpeedProbe::~SpeedProbe() = default;
+
+Expected<std::unique_ptr<SpeedProbe>> SpeedProbe::make(const CalibrateOptions& o) {
+    // A process of its own, pinned to o.core, the same at the calibration and at the run: taken
+    // in the calibrating process's renderer, the probe read the headset frame 2-6% slower than
+    // in the run's process minutes later, where the run's stages were not faster (docs/MODEL.md
+    // §8 "The machine's speed at the run").
+    auto child = CoRunLoad::start(o, std::max(o.core, 0), "probe");
+    if (!child)
+        return makeError("speed probe: " + child.error());
+    auto impl = std::make_unique<Impl>();
+    impl->child = std::move(*child);
+    return std::unique_ptr<SpeedProbe>(new SpeedProbe(std::move(impl)));
+}
+
+Expected<SpeedSample> SpeedProbe::measure() {
+    return m_impl->child->probe();
+}
+
+std::string speedProbesText(const std::vector<SpeedSample>& probes) {
+    std::string s;
+    double lo_h = 1e300, hi_h = 0.0, lo_s = 1e300, hi_s = 0.0;
+    for (const SpeedSample& p : probes) {
+        s += fmt::format("{}{:.2f}/{:.2f}", s.empty() ? "" : ", ", p.headset_ms, p.server_ms);
+        lo_h = std::min(lo_h, p.headset_ms);
+        hi_h = std::max(hi_h, p.headset_ms);
+        lo_s = std::min(lo_s, p.server_ms);
+        hi_s = std::max(hi_s, p.server_ms);
+    }
+    if (probes.size() < 2)
+        return s + " ms headset/server";
+    const double spread = 100.0 * std::max(hi_h / lo_h, hi_s / lo_s) - 100.0;
+    return s + fmt::format(" ms headset/server; spread {:.0f}%{}", spread,
+                           spread > 10.0 ? " (the machine was unsteady while it was measured: "
+                                           "calibrate again on a steady one)"
+                                         : "");
 }
 
 }  // namespace qvr::cli
@@ -1316,7 +1499,7 @@ static Registered registerCoRunLoad(CLI::App& app) {
     cmd->add_option("--core", o->core)->required()->check(CLI::Range(0, 4095));
     cmd->add_option("--codec", o->codec)->check(CLI::IsMember({"x264", "raw"}));
     auto mix = std::make_shared<std::string>("server");
-    cmd->add_option("--mix", *mix)->check(CLI::IsMember({"server", "headset"}));
+    cmd->add_option("--mix", *mix)->check(CLI::IsMember({"server", "headset", "probe"}));
     return {cmd, [o, mix] { return runCoRunLoad(*o, *mix); }};
 }
 QVR_REGISTER_COMMAND(92, registerCoRunLoad);

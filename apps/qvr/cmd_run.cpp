@@ -281,6 +281,8 @@ nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
 struct DesignRun {
     DesignSpec spec;
     HeadsetResult result;
+    // The machine's speed just before and just after the design ran (calibration.h SpeedProbe).
+    std::optional<SpeedSample> speed_before, speed_after;
     RuntimeDesign design() const { return spec.design; }
     std::string label() const { return spec.label(); }
 };
@@ -400,6 +402,19 @@ struct CalibrationChoice {
     std::string note;  // one sentence for the console and the report
 };
 
+// What `qvr run` calibrates (and probes the machine's speed) with: the run's scene, profile,
+// codec and level of detail, on the headset's core.
+CalibrateOptions runCalibrateOptions(const RunOptions& o) {
+    CalibrateOptions co;
+    co.scene = o.scene;  // the bits law and the render costs are the scene's
+    co.profile = o.profile;
+    co.codec = o.codec;
+    co.lod_px = o.lod_px;
+    co.core = 0;
+    co.verbose = false;
+    return co;
+}
+
 Expected<CalibrationChoice> chooseCalibration(const RunOptions& o) {
     CalibrationChoice c;
     if (!o.hardware.empty()) {
@@ -416,13 +431,7 @@ Expected<CalibrationChoice> chooseCalibration(const RunOptions& o) {
         c.note = "calibration from " + o.hardware;
         return c;
     }
-    CalibrateOptions co;
-    co.scene = o.scene;  // the bits law and the render costs are the scene's
-    co.profile = o.profile;
-    co.codec = o.codec;
-    co.lod_px = o.lod_px;
-    co.core = 0;
-    co.verbose = false;
+    CalibrateOptions co = runCalibrateOptions(o);
     const std::string cache = calibrationCachePath(co);
     if (!o.recalibrate && fs::exists(cache)) {
         auto hw = loadHardwareConfig(cache, 500.0);
@@ -494,8 +503,10 @@ nlohmann::json errorPctJson(const nlohmann::json& predicted, const nlohmann::jso
                           "e1_deg_mean", "headset_busy_ms_mean", "server_busy_ms_mean"}) {
         const nlohmann::json& mv = measured.contains(k) ? measured[k] : nlohmann::json();
         const double m = mv.is_number() ? mv.get<double>() : 0.0;
-        const double p = predicted.value(k, 0.0);
-        e[k] = m != 0.0 ? nlohmann::json(100.0 * (p - m) / std::fabs(m)) : nlohmann::json();
+        const bool predicts = predicted.contains(k) && predicted[k].is_number();
+        const double p = predicts ? predicted[k].get<double>() : 0.0;
+        e[k] = m != 0.0 && predicts ? nlohmann::json(100.0 * (p - m) / std::fabs(m))
+                                    : nlohmann::json();
     }
     return e;
 }
@@ -515,9 +526,11 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
         "(docs/MODEL.md §8) with this machine's costs, " +
         report::htmlEscape(calibration_note) +
         ". <b>paper hardware</b>: the paper's pipeline on its modelled mobile GPU and server "
-        "(the default of <code>qvr eval</code>), for reference, not this machine. Error = "
-        "(predicted − measured) / measured.</p>\n<table><tr><th>design</th><th>metric</th>"
-        "<th>measured</th><th>calibrated</th><th>error</th><th>paper hardware</th></tr>\n";
+        "(the default of <code>qvr eval</code>), for reference, not this machine. <b>at the "
+        "calibration's speed</b>: the calibrated model without the speed probes' correction. "
+        "Error = (predicted − measured) / measured.</p>\n<table><tr><th>design</th>"
+        "<th>metric</th><th>measured</th><th>calibrated</th><th>error</th><th>at the "
+        "calibration's speed</th><th>error</th><th>paper hardware</th></tr>\n";
     struct Metric {
         const char* key;
         const char* label;
@@ -544,15 +557,29 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
                 d.contains("predicted_paper_hardware")
                     ? d["predicted_paper_hardware"].value(m.key, nlohmann::json())
                     : nlohmann::json();
+            const bool at_cal = d.contains("predicted_at_calibration_speed");
+            const nlohmann::json cal_speed =
+                at_cal ? d["predicted_at_calibration_speed"].value(m.key, nlohmann::json())
+                       : nlohmann::json();
+            const nlohmann::json cal_speed_err =
+                at_cal && std::string(m.key) != "e1_deg_mean"
+                    ? d["prediction_error_pct_at_calibration_speed"].value(m.key, nlohmann::json())
+                    : nlohmann::json();
+            std::string speed_line;
+            if (const auto& sp = d.value("speed", nlohmann::json::object());
+                sp.contains("headset_factor"))
+                speed_line = fmt::format("<br><small>speed ×{:.3f} headset, ×{:.3f} server</small>",
+                                         sp["headset_factor"].get<double>(),
+                                         sp["server_factor"].get<double>());
             h += fmt::format(
                 "<tr>{}<td style='text-align:left'>{}</td><td>{}</td><td>{}</td><td>{}</td>"
-                "<td>{}</td></tr>\n",
-                first ? fmt::format("<td rowspan='{}'>{}</td>", std::size(metrics),
-                                    report::htmlEscape(it.key()))
+                "<td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                first ? fmt::format("<td rowspan='{}'>{}{}</td>", std::size(metrics),
+                                    report::htmlEscape(it.key()), speed_line)
                       : "",
                 m.label, fmtCell(d.value(m.key, nlohmann::json()), m.f),
                 fmtCell(d["predicted"].value(m.key, nlohmann::json()), m.f), err_cell,
-                fmtCell(paper, m.f));
+                fmtCell(cal_speed, m.f), fmtCell(cal_speed_err, "{:+.1f}%"), fmtCell(paper, m.f));
             first = false;
         }
     }
@@ -729,6 +756,44 @@ int runRun(const RunOptions& o) {
             std::fprintf(stderr, "qvr run: %s (the main thread runs unpinned)\n",
                          main_pin->error().c_str());
     }
+    // The machine's speed before each design and after the last (calibration.h SpeedProbe), on
+    // the headset's core while the server waits between sessions: the prediction charges each
+    // design's costs at the ratio of the probes around it to the calibration's reference. The
+    // host's speed moves ±10% from minute to minute; a calibration taken at a slow moment
+    // predicted every design of the run after it 9-14% slow (docs/MODEL.md §8).
+    const RuntimeCosts& calibrated = calibration->hardware.runtime;
+    std::unique_ptr<SpeedProbe> speed_probe;
+    std::string speed_note;
+    if (calibrated.speed_reference_headset_ms <= 0.0 || calibrated.speed_reference_server_ms <= 0.0)
+        speed_note =
+            "the calibration has no speed reference (calibration version < 14): the costs are "
+            "charged at the calibration's speed";
+    else if (calibrated.speed_reference_key != calibrationCacheKey(runCalibrateOptions(o)))
+        speed_note =
+            "the calibration's speed reference was taken on another machine, scene, profile, "
+            "codec or level of detail than this run's: the costs are charged at the "
+            "calibration's speed";
+    else if (o.headset_share < 1.0)
+        speed_note =
+            "--headset-share: a probe would run under the headset's quota; the costs are charged "
+            "at the calibration's speed";
+    else if (auto made = SpeedProbe::make(runCalibrateOptions(o)); !made)
+        speed_note = "no speed probe (" + made.error() +
+                     "): the costs are charged at the "
+                     "calibration's speed";
+    else
+        speed_probe = std::move(*made);
+    auto probeSpeedNow = [&]() -> std::optional<SpeedSample> {
+        if (!speed_probe)
+            return std::nullopt;
+        auto sample = speed_probe->measure();
+        if (sample)
+            return *sample;
+        speed_note = "the speed probe failed (" + sample.error() +
+                     "): the costs are charged at the calibration's speed";
+        speed_probe.reset();
+        return std::nullopt;
+    };
     std::vector<DesignRun> runs;
     std::unique_ptr<Renderer> quality_renderer;
     std::vector<std::pair<std::string, DesignQuality>> quality;
@@ -806,6 +871,9 @@ int runRun(const RunOptions& o) {
             progress = std::make_unique<ProgressDisplay>(label, o.frames, hc.display);
             hc.display = progress.get();
         }
+        const std::optional<SpeedSample> speed_before = probeSpeedNow();
+        if (!runs.empty())
+            runs.back().speed_after = speed_before;  // the last design's "after"
         Expected<HeadsetResult> result = makeError("not run");
         std::thread headset([&] { result = runHeadset(hc, scene, bvh, traces); });
         headset.join();
@@ -844,7 +912,7 @@ int runRun(const RunOptions& o) {
                                         result->frames);
             !st)
             std::fprintf(stderr, "qvr run: %s\n", st.error().c_str());
-        runs.push_back({spec, std::move(*result)});
+        runs.push_back({spec, std::move(*result), speed_before, std::nullopt});
         if (stopped) {
             // No quality pass: the user asked to stop.
             if (quality.empty() && quality_note.empty())
@@ -876,6 +944,32 @@ int runRun(const RunOptions& o) {
         // Let the server finish the last session before the next one starts.
         std::this_thread::sleep_for(std::chrono::milliseconds(200));
     }
+    if (!g_run_stop.load() && !runs.empty())
+        runs.back().speed_after = probeSpeedNow();
+    // How far the machine's speed moved over the run: every probe's spread, per side. A host
+    // that moves within a design (seconds) moves its FPS by as much, which no probe between
+    // designs can follow; the run says so rather than let the error look like the model's.
+    std::array<double, 2> speed_spread_pct{0.0, 0.0};  // headset, server: max / min − 1
+    {
+        std::vector<SpeedSample> all;
+        for (const DesignRun& r : runs)
+            if (r.speed_before)
+                all.push_back(*r.speed_before);
+        if (!runs.empty() && runs.back().speed_after)
+            all.push_back(*runs.back().speed_after);
+        if (all.size() >= 2)
+            for (int side = 0; side < 2; ++side) {
+                double lo = 1e300, hi = 0.0;
+                for (const SpeedSample& p : all) {
+                    const double v = side == 0 ? p.headset_ms : p.server_ms;
+                    lo = std::min(lo, v);
+                    hi = std::max(hi, v);
+                }
+                speed_spread_pct[static_cast<size_t>(side)] = 100.0 * (hi / lo - 1.0);
+            }
+    }
+    constexpr double kUnsteadyPct = 10.0;
+    const bool unsteady = std::max(speed_spread_pct[0], speed_spread_pct[1]) > kUnsteadyPct;
     // A second Ctrl-C while the report is written ends the process at once.
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
@@ -935,6 +1029,24 @@ int runRun(const RunOptions& o) {
     // machine's calibration, and the paper's model on its modelled hardware.
     nlohmann::json predicted = nlohmann::json::object();        // design → runtime model
     nlohmann::json predicted_paper = nlohmann::json::object();  // design → paper model
+    // design → the runtime model at the calibration's speed, and the speed factors used
+    nlohmann::json predicted_at_calibration_speed = nlohmann::json::object();
+    nlohmann::json speed_json = nlohmann::json::object();
+    auto speedFactors = [&](const DesignRun& r) -> std::optional<std::pair<double, double>> {
+        double h = 0.0, sv = 0.0;
+        int n = 0;
+        for (const std::optional<SpeedSample>& p : {r.speed_before, r.speed_after})
+            if (p) {
+                h += p->headset_ms;
+                sv += p->server_ms;
+                ++n;
+            }
+        if (n == 0 || calibrated.speed_reference_headset_ms <= 0.0 ||
+            calibrated.speed_reference_server_ms <= 0.0)
+            return std::nullopt;
+        return std::make_pair(h / n / calibrated.speed_reference_headset_ms,
+                              sv / n / calibrated.speed_reference_server_ms);
+    };
     nlohmann::json sim_json = nlohmann::json::object();
     std::string sim_note;
     // The workload the predictions replay: every frame's triangles and pixels per ring as the
@@ -1031,12 +1143,20 @@ int runRun(const RunOptions& o) {
                 double fixed_e1 = 5.0;
                 if (!simDesignOf(name, sd, fixed_e1))
                     continue;
-                if (rt_link_check) {
+                // The costs at this design's speed (the probes around it over the reference).
+                const std::optional<std::pair<double, double>> speed = speedFactors(r);
+                if (speed)
+                    speed_json[name] = {{"headset_factor", speed->first},
+                                        {"server_factor", speed->second}};
+                for (int pass = 0; rt_link_check && pass < (speed ? 2 : 1); ++pass) {
+                    // Pass 1 (with probes): the same model at the calibration's speed, beside
+                    // the prediction, so that what the probes changed is seen in every run.
                     auto rt_link = makeRuntimeLink(o.net, &delay_ms);
                     RuntimeSimConfig rc;
                     rc.design = sd;
                     rc.fixed_e1_deg = fixed_e1;
-                    rc.costs = calibration->hardware.runtime;
+                    rc.costs = speed && pass == 0 ? calibrated.atSpeed(speed->first, speed->second)
+                                                  : calibrated;
                     rc.costs.link_delay_ms += delay_ms;
                     rc.pipeline_depth = o.pipeline_depth;
                     rc.wait_limit_ms = o.remote_timeout_ms;
@@ -1047,6 +1167,14 @@ int runRun(const RunOptions& o) {
                     rc.layer_triangles = layer_triangles;
                     const RuntimeRunResult pr = simulateRuntime(*trace, rc, **rt_link);
                     const RuntimeSummary& ps = pr.summary;
+                    if (pass == 1) {
+                        nlohmann::json& pc = predicted_at_calibration_speed[name];
+                        pc = predictionJson(ps.fps_mean, ps.mtp_ms_mean, ps.mtp_ms_p99,
+                                            ps.bytes_per_frame_mean, ps.e1_deg_mean);
+                        pc["headset_busy_ms_mean"] = ps.headset_busy_ms_mean;
+                        pc["server_busy_ms_mean"] = ps.server_busy_ms_mean;
+                        continue;
+                    }
                     // The model's frames beside telemetry.csv's, to chase an error to its stage.
                     for (const RuntimeFrame& f : pr.frames)
                         predicted_csv << fmt::format(
@@ -1149,6 +1277,24 @@ int runRun(const RunOptions& o) {
         }
         if (predicted_paper.contains(name))
             dj[name]["predicted_paper_hardware"] = predicted_paper[name];
+        if (predicted_at_calibration_speed.contains(name)) {
+            dj[name]["predicted_at_calibration_speed"] = predicted_at_calibration_speed[name];
+            dj[name]["prediction_error_pct_at_calibration_speed"] =
+                errorPctJson(predicted_at_calibration_speed[name], dj[name]);
+        }
+        {
+            nlohmann::json sp = {{"before", nullptr}, {"after", nullptr}};
+            for (const auto& [when, p] :
+                 {std::pair{"before", r.speed_before}, std::pair{"after", r.speed_after}})
+                if (p)
+                    sp[when] = {{"headset_frame_ms", p->headset_ms},
+                                {"server_frame_ms", p->server_ms}};
+            if (speed_json.contains(name)) {
+                sp["headset_factor"] = speed_json[name]["headset_factor"];
+                sp["server_factor"] = speed_json[name]["server_factor"];
+            }
+            dj[name]["speed"] = sp;
+        }
         if (r.design() == RuntimeDesign::kLocal)
             local = &r.result.summary;
         if (r.design() == RuntimeDesign::kRemote)
@@ -1196,6 +1342,16 @@ int runRun(const RunOptions& o) {
     j["calibration"] = {{"source", calibration->source},   {"path", calibration->path},
                         {"seconds", calibration->seconds}, {"note", calibration->note},
                         {"workload", trace_source},        {"pipeline_depth", o.pipeline_depth}};
+    // The speed reference the per-design probes (designs.<d>.speed) are read against.
+    j["calibration"]["speed_reference"] = {
+        {"headset_frame_ms", calibrated.speed_reference_headset_ms},
+        {"server_frame_ms", calibrated.speed_reference_server_ms},
+        {"note", speed_note.empty()
+                     ? std::string("each design's costs at the probes around it over this "
+                                   "reference (designs.<d>.speed)")
+                     : speed_note},
+        {"run_spread_pct", {{"headset", speed_spread_pct[0]}, {"server", speed_spread_pct[1]}}},
+        {"unsteady", unsteady}};
     if (!sim_note.empty())
         j["sim_note"] = sim_note;
     // The server's own counters (all designs together), as its process wrote them on exit.
@@ -1395,7 +1551,21 @@ int runRun(const RunOptions& o) {
     }
     limitsHtml(page, runs);
     countersHtml(page, runs, j["server"]);
-    page.html(validationHtml(dj, calibration->note + "; workload: " + trace_source, sim_note));
+    page.html(validationHtml(
+        dj,
+        calibration->note + "; workload: " + trace_source + "; " +
+            (speed_note.empty()
+                 ? fmt::format("each design's costs at the machine's speed just before and "
+                               "after it (a speed probe, headset and server frame, over the "
+                               "calibration's); the probes moved {:.0f}% (headset) and {:.0f}% "
+                               "(server) over the run{}",
+                               speed_spread_pct[0], speed_spread_pct[1],
+                               unsteady ? ": the machine was unsteady, and a design's FPS moves "
+                                          "with it within the seconds it runs, which no probe "
+                                          "between designs follows"
+                                        : "")
+                 : speed_note),
+        sim_note));
     page.heading(2, "Against the paper");
     {
         // The headline ratios: measured here, the paper's, the paper-hardware model's.
@@ -1471,15 +1641,33 @@ int runRun(const RunOptions& o) {
             if (!it.value().contains("prediction_error_pct"))
                 continue;
             const nlohmann::json& e = it.value()["prediction_error_pct"];
+            const nlohmann::json sp = it.value().value("speed", nlohmann::json::object());
             fmt::print(
                 "    {:8} fps {:>8}  mtp {:>8}  bytes {:>8}  e1 {:>7}  | headset {:>7}  server "
-                "{:>7}\n",
+                "{:>7}  | speed x{} x{}\n",
                 it.key(), fmtCell(e["fps_mean"], "{:+.1f}%"), fmtCell(e["mtp_ms_mean"], "{:+.1f}%"),
                 fmtCell(e["bytes_per_frame_mean"], "{:+.1f}%"),
                 fmtCell(it.value()["prediction_error_abs"]["e1_deg_mean"], "{:+.1f}°"),
                 fmtCell(e.value("headset_busy_ms_mean", nlohmann::json()), "{:+.1f}%"),
-                fmtCell(e.value("server_busy_ms_mean", nlohmann::json()), "{:+.1f}%"));
+                fmtCell(e.value("server_busy_ms_mean", nlohmann::json()), "{:+.1f}%"),
+                fmtCell(sp.value("headset_factor", nlohmann::json()), "{:.3f}"),
+                fmtCell(sp.value("server_factor", nlohmann::json()), "{:.3f}"));
         }
+        fmt::print("  speed: {}\n",
+                   speed_note.empty()
+                       ? fmt::format("each design's costs at the probes around it over the "
+                                     "calibration's (headset, server; summary.json "
+                                     "designs.<d>.speed); the probes moved {:.0f}% / {:.0f}% over "
+                                     "the run",
+                                     speed_spread_pct[0], speed_spread_pct[1])
+                       : speed_note);
+        if (unsteady)
+            fmt::print(
+                "  warning: the machine's speed moved by {:.0f}% during the run (the speed probes "
+                "between designs, over {:.0f}%): a design's FPS moves with it within the seconds "
+                "it runs, which no prediction made around it follows; measure on a steady "
+                "machine to judge the model (summary.json calibration.speed_reference)\n",
+                std::max(speed_spread_pct[0], speed_spread_pct[1]), kUnsteadyPct);
     }
     if (!sim_note.empty())
         fmt::print("  {}\n", sim_note);

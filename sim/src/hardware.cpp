@@ -159,6 +159,11 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
         r.number("runtime.corun_headset_slowdown", rc.corun_headset_slowdown, 1.0, 4.0);
     rc.corun_server_slowdown =
         r.number("runtime.corun_server_slowdown", rc.corun_server_slowdown, 1.0, 4.0);
+    rc.speed_reference_headset_ms =
+        r.number("runtime.speed_reference_headset_ms", rc.speed_reference_headset_ms, 0.0, 1e5);
+    rc.speed_reference_server_ms =
+        r.number("runtime.speed_reference_server_ms", rc.speed_reference_server_ms, 0.0, 1e5);
+    rc.speed_reference_key = r.string("runtime.speed_reference_key", rc.speed_reference_key);
     if (auto st = r.finish(); !st)
         return makeError(st.error());
     return hw;
@@ -225,6 +230,11 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
         put("corun_headset_slowdown", c.corun_headset_slowdown);
     if (c.corun_server_slowdown > 0.0)
         put("corun_server_slowdown", c.corun_server_slowdown);
+    if (c.speed_reference_headset_ms > 0.0 && c.speed_reference_server_ms > 0.0) {
+        put("speed_reference_headset_ms", c.speed_reference_headset_ms);
+        put("speed_reference_server_ms", c.speed_reference_server_ms);
+        s += fmt::format("speed_reference_key = \"{}\"\n", c.speed_reference_key);
+    }
     return s;
 }
 

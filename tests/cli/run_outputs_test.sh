@@ -117,3 +117,70 @@ grep -q "remote never showed a layer from the server" "$tmp/never_err.txt" || {
 python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['designs']['remote']['startup_unfinished'] is True" \
     "$tmp/never/summary.json" || { echo "FAIL: startup_unfinished not set"; exit 1; }
 echo "PASS: a run whose server never reached the screen exits 1 and says so"
+# The machine's speed at the run (docs/MODEL.md §8): a calibration holds the speed probe's
+# reference; a run on the same key probes before and after each design and charges that design's
+# costs at the ratio, beside the prediction at the calibration's speed. A file without a reference,
+# or with another machine's, is charged at its own speed and says why.
+grep -q "speed_reference_headset_ms" "$tmp/rt.toml" && { echo "FAIL: the stub has a reference"; exit 1; }
+python3 - "$tmp/run/summary.json" <<'PY' || exit 1
+import json, sys
+d = json.load(open(sys.argv[1]))
+sr = d["calibration"]["speed_reference"]
+assert "no speed reference" in sr["note"], sr
+for name, x in d["designs"].items():
+    assert "headset_factor" not in x["speed"] and "predicted_at_calibration_speed" not in x, name
+print("PASS: a calibration without a speed reference is charged at its own speed, and says so")
+PY
+if ! timeout 120 "$QVR" calibrate --quick --profile small --out "$tmp/small.toml" >"$tmp/cal.txt" 2>&1; then
+    echo "FAIL: qvr calibrate --quick --profile small: $(tail -c 600 "$tmp/cal.txt")"
+    exit 1
+fi
+grep -q '^speed_reference_key = "' "$tmp/small.toml" || { echo "FAIL: no speed reference key"; exit 1; }
+sed 's/^speed_reference_key = .*/speed_reference_key = "0000000000000000"/' "$tmp/small.toml" \
+    >"$tmp/other.toml"
+for f in small other; do
+    if ! timeout 300 "$QVR" run --profile small --frames 12 --designs local,qvr --no-video \
+        --quality-every 0 --hardware "$tmp/$f.toml" --out "$tmp/speed_$f" >"$tmp/speed_$f.txt" 2>&1; then
+        echo "FAIL: qvr run --hardware $f.toml: $(tail -c 600 "$tmp/speed_$f.txt")"
+        exit 1
+    fi
+done
+python3 - "$tmp/speed_small/summary.json" "$tmp/speed_other/summary.json" "$tmp/speed_small/report.html" <<'PY' || exit 1
+import json, sys
+d = json.load(open(sys.argv[1]))
+ref = d["calibration"]["speed_reference"]
+assert ref["headset_frame_ms"] > 0 and ref["server_frame_ms"] > 0, ref
+for name in ["local", "qvr"]:
+    x = d["designs"][name]
+    sp = x["speed"]
+    before, after = sp["before"], sp["after"]
+    assert before and after, sp
+    h = (before["headset_frame_ms"] + after["headset_frame_ms"]) / 2 / ref["headset_frame_ms"]
+    s = (before["server_frame_ms"] + after["server_frame_ms"]) / 2 / ref["server_frame_ms"]
+    assert abs(sp["headset_factor"] - h) < 1e-9 and abs(sp["server_factor"] - s) < 1e-9, (sp, h, s)
+    assert 0.2 < h < 5 and 0.2 < s < 5, (h, s)
+    assert "fps_mean" in x["predicted_at_calibration_speed"], x
+    assert "fps_mean" in x["prediction_error_pct_at_calibration_speed"], x
+# One design's "after" is the next one's "before".
+assert d["designs"]["local"]["speed"]["after"] == d["designs"]["qvr"]["speed"]["before"]
+assert set(ref["run_spread_pct"]) == {"headset", "server"}, ref
+html = open(sys.argv[3]).read()
+assert "at the calibration's speed" in html and "speed ×" in html, "no speed in the report"
+o = json.load(open(sys.argv[2]))
+assert "another machine" in o["calibration"]["speed_reference"]["note"], o["calibration"]
+assert "headset_factor" not in o["designs"]["qvr"]["speed"], o["designs"]["qvr"]
+print("PASS: each design's prediction at the probes' speed (local x%.3f/x%.3f), beside the "
+      "calibration's; another key is refused" % (d["designs"]["local"]["speed"]["headset_factor"],
+                                               d["designs"]["local"]["speed"]["server_factor"]))
+PY
+# The probe's process (`qvr corun-load --mix probe`): one answer per "p", anything else ignored,
+# the end of its input its end (exit 0).
+out=$(printf 'x\nzz\np\n' | timeout 120 "$QVR" corun-load --scene builtin:room --profile small --core 0 \
+    --mix probe)
+rc=$?
+if [ "$rc" -ne 0 ] || [ "$(echo "$out" | head -1)" != "ready" ] || [ "$(echo "$out" | wc -l)" -ne 2 ] ||
+    ! echo "$out" | tail -1 | grep -Eq '^[0-9]+\.[0-9]+ [0-9]+\.[0-9]+$'; then
+    echo "FAIL: the probe process answered (exit $rc): $out"
+    exit 1
+fi
+echo "PASS: the probe process answers one probe per request and ignores the rest"

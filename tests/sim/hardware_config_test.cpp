@@ -75,6 +75,9 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.server_render.full_frame_scale = 1.75;
     c.fovea.full_frame_scale = 0.875;
     c.scanout_record_ms = 1.25;
+    c.speed_reference_headset_ms = 9.5;
+    c.speed_reference_server_ms = 21.25;
+    c.speed_reference_key = "0123456789abcdef";
     auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
     ASSERT_TRUE(hw.ok()) << hw.error();
     EXPECT_TRUE(hw->runtime_pipeline);
@@ -100,6 +103,13 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.corun_headset_slowdown, 1.25);
     EXPECT_EQ(hw->runtime.corun_server_slowdown, 1.0625);
     EXPECT_EQ(hw->runtime.scanout_record_ms, 1.25);
+    EXPECT_EQ(hw->runtime.speed_reference_headset_ms, 9.5);
+    EXPECT_EQ(hw->runtime.speed_reference_server_ms, 21.25);
+    EXPECT_EQ(hw->runtime.speed_reference_key, "0123456789abcdef");
+    // Without a speed reference (a calibration before version 14) none is written or read.
+    RuntimeCosts no_speed = c;
+    no_speed.speed_reference_headset_ms = 0.0;
+    EXPECT_EQ(runtimeCostsToml(no_speed).find("speed_reference"), std::string::npos);
     // A render part's power law and whole-frame scale.
     EXPECT_EQ(hw->runtime.server_render.power_coef_ms, 3.5);
     EXPECT_EQ(hw->runtime.server_render.px_exponent, 0.5);
@@ -144,7 +154,10 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\ncorun_headset_slowdown = 0.5\n",
                             "[runtime]\ncorun_server_slowdown = 4.5\n",
                             "[runtime]\nserver_render_power_coef_ms = -2\n",
-                            "[runtime]\nfovea_tri_exponent = \"x\"\n"}) {
+                            "[runtime]\nfovea_tri_exponent = \"x\"\n",
+                            "[runtime]\nspeed_reference_headset_ms = -1\n",
+                            "[runtime]\nspeed_reference_server_ms = \"fast\"\n",
+                            "[runtime]\nspeed_reference_key = 12\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
         EXPECT_FALSE(r.ok()) << bad;
         if (!r.ok()) {

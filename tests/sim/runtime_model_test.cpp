@@ -209,6 +209,46 @@ TEST(RuntimeModel, ServerBoundRemoteRunsAtTheServersRate) {
     EXPECT_NEAR(one.summary.mtp_ms_mean, 201.0, 1e-6);
 }
 
+TEST(RuntimeModel, AtSpeedScalesEachSidesTimesAndNothingElse) {
+    // The machine 1.5x as slow on the server's side and 0.8x on the headset's: a server-bound
+    // remote at depth 2 runs at the scaled server's rate (2 × 100 ms × 1.5), a headset-bound
+    // local at its scaled passes ((2 × 30 ms + 5 ms UCA) × 0.8), rounded to vsync.
+    const RuntimeRunResult remote =
+        run(Design::Remote, flatCosts(0.0, 1.0, 100.0).atSpeed(0.8, 1.5), 2, 60, 1000.0);
+    EXPECT_NEAR(remote.summary.fps_mean, 1000.0 / 300.0, 1e-6);
+    EXPECT_EQ(remote.summary.frames_reused, 0);  // 300 ms a frame, under the 1 s wait limit
+    const RuntimeCosts c = flatCosts(30.0, 5.0, 100.0);
+    const RuntimeRunResult local = run(Design::Local, c.atSpeed(0.8, 1.5), 2);
+    EXPECT_NEAR(local.summary.fps_mean, 1000.0 / slots(0.8 * 65.0), 1e-6);
+    EXPECT_NEAR(local.summary.mtp_ms_mean, 0.8 * 65.0, 1e-6);
+    // Every time term on its side; the bits, the link and the co-running ratios stay.
+    RuntimeCosts full = c;
+    full.decision = {0.5, 0, 0.04};
+    full.decode = {0.3, 4.0, 0};
+    full.fovea.power_coef_ms = 2.0;
+    full.frame_overhead_ms = 0.5;
+    full.scanout_record_ms = 1.0;
+    full.encode = {0.5, 12.0, 0};
+    full.server_frame_ms = 2.0;
+    full.link_delay_ms = 7.0;
+    full.bits_per_px_at_1 = 0.3;
+    full.corun_server_slowdown = 1.1;
+    const RuntimeCosts s = full.atSpeed(2.0, 3.0);
+    EXPECT_DOUBLE_EQ(s.decision.ms_per_ktri, 0.08);
+    EXPECT_DOUBLE_EQ(s.decode.ms_per_mpx, 8.0);
+    EXPECT_DOUBLE_EQ(s.fovea.power_coef_ms, 4.0);
+    EXPECT_DOUBLE_EQ(s.uca.base_ms, 10.0);
+    EXPECT_DOUBLE_EQ(s.frame_overhead_ms, 1.0);
+    EXPECT_DOUBLE_EQ(s.scanout_record_ms, 2.0);
+    EXPECT_DOUBLE_EQ(s.server_render.base_ms, 300.0);
+    EXPECT_DOUBLE_EQ(s.encode.ms_per_mpx, 36.0);
+    EXPECT_DOUBLE_EQ(s.server_frame_ms, 6.0);
+    EXPECT_DOUBLE_EQ(s.link_delay_ms, 7.0);
+    EXPECT_DOUBLE_EQ(s.bits_per_px_at_1, 0.3);
+    EXPECT_DOUBLE_EQ(s.corun_server_slowdown, 1.1);
+    EXPECT_DOUBLE_EQ(s.fovea.px_exponent, full.fovea.px_exponent);
+}
+
 TEST(RuntimeModel, TwoFramesInFlightOverlapAsFarAsTheShorterStageAllows) {
     // Foveated: the headset renders two 20 ms fovea passes and 5 ms of UCA (45 ms), the server
     // four 15 ms layers (60 ms). One frame in flight overlaps only the fovea with the server:

@@ -189,6 +189,36 @@ struct RuntimeCosts {
     double payloadShare() const {
         return packet_payload_bytes / (packet_payload_bytes + packet_overhead_bytes);
     }
+    // The machine's speed when the costs above were measured (calibration version 14): the
+    // median of a fixed headset frame and a fixed server frame (a speed probe, `qvr calibrate`
+    // SpeedProbe) over the calibration, 0: not measured. speed_reference_key names what the
+    // probe ran (scene, profile, codec, level of detail): a probe at run time on the same key
+    // says how much faster or slower the machine is than when it was calibrated
+    // (docs/MODEL.md §8 "The machine's speed at the run").
+    double speed_reference_headset_ms = 0.0;
+    double speed_reference_server_ms = 0.0;
+    std::string speed_reference_key;
+    // These costs on a machine `headset` and `server` times as slow as the calibration's: every
+    // time the headset's core spends (decision, fovea, decodes, UCA, the frame's overhead, the
+    // video copy) times `headset`, every time the server's (layer render, encode, per request)
+    // times `server`. Bits, the link and the co-running ratios are not times and stay.
+    RuntimeCosts atSpeed(double headset, double server) const {
+        RuntimeCosts c = *this;
+        auto scale = [](PartCost& p, double f) {
+            p.base_ms *= f;
+            p.ms_per_mpx *= f;
+            p.ms_per_ktri *= f;
+            p.power_coef_ms *= f;
+        };
+        for (PartCost* p : {&c.decision, &c.fovea, &c.decode, &c.uca})
+            scale(*p, headset);
+        c.frame_overhead_ms *= headset;
+        c.scanout_record_ms *= headset;
+        scale(c.server_render, server);
+        scale(c.encode, server);
+        c.server_frame_ms *= server;
+        return c;
+    }
 };
 
 struct HardwareConfig {
