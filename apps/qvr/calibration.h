@@ -81,8 +81,9 @@ Expected<Calibration> runCalibration(const CalibrateOptions& options);
 // periphery layers rendered and encoded), each timed over the same frames every time on this
 // thread's core, their medians. `qvr calibrate` takes it three times over its measurement and
 // keeps the mean as the hardware file's speed reference; `qvr run` takes it before and after
-// each design, and its prediction charges that design's costs at the ratio (docs/MODEL.md §8
-// "The machine's speed at the run"). Nothing in it is a run's measurement.
+// each design, reports how far it moved, and predicts each design a second time with its costs
+// at the ratio (docs/MODEL.md §8 "The machine's speed at the run"). Nothing in it is a run's
+// measurement.
 class SpeedProbe {
 public:
     static constexpr int kFrames = 12;

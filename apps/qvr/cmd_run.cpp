@@ -527,10 +527,11 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
         report::htmlEscape(calibration_note) +
         ". <b>paper hardware</b>: the paper's pipeline on its modelled mobile GPU and server "
         "(the default of <code>qvr eval</code>), for reference, not this machine. <b>at the "
-        "calibration's speed</b>: the calibrated model without the speed probes' correction. "
+        "probes' speed</b>: the calibrated model with each design's costs at the machine's speed "
+        "just before and after it (a speed probe, over the calibration's), for reference. "
         "Error = (predicted − measured) / measured.</p>\n<table><tr><th>design</th>"
         "<th>metric</th><th>measured</th><th>calibrated</th><th>error</th><th>at the "
-        "calibration's speed</th><th>error</th><th>paper hardware</th></tr>\n";
+        "probes' speed</th><th>error</th><th>paper hardware</th></tr>\n";
     struct Metric {
         const char* key;
         const char* label;
@@ -557,13 +558,13 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
                 d.contains("predicted_paper_hardware")
                     ? d["predicted_paper_hardware"].value(m.key, nlohmann::json())
                     : nlohmann::json();
-            const bool at_cal = d.contains("predicted_at_calibration_speed");
+            const bool at_cal = d.contains("predicted_at_probe_speed");
             const nlohmann::json cal_speed =
-                at_cal ? d["predicted_at_calibration_speed"].value(m.key, nlohmann::json())
+                at_cal ? d["predicted_at_probe_speed"].value(m.key, nlohmann::json())
                        : nlohmann::json();
             const nlohmann::json cal_speed_err =
                 at_cal && std::string(m.key) != "e1_deg_mean"
-                    ? d["prediction_error_pct_at_calibration_speed"].value(m.key, nlohmann::json())
+                    ? d["prediction_error_pct_at_probe_speed"].value(m.key, nlohmann::json())
                     : nlohmann::json();
             std::string speed_line;
             if (const auto& sp = d.value("speed", nlohmann::json::object());
@@ -757,30 +758,28 @@ int runRun(const RunOptions& o) {
                          main_pin->error().c_str());
     }
     // The machine's speed before each design and after the last (calibration.h SpeedProbe), on
-    // the headset's core while the server waits between sessions: the prediction charges each
-    // design's costs at the ratio of the probes around it to the calibration's reference. The
-    // host's speed moves ±10% from minute to minute; a calibration taken at a slow moment
-    // predicted every design of the run after it 9-14% slow (docs/MODEL.md §8).
+    // the headset's core while the server waits between sessions. The host's speed moves ±10%
+    // from minute to minute (a calibration taken at a slow moment predicted every design of the
+    // run after it 9-14% slow), and within seconds when it is unsteady: the run reports how far
+    // the probes moved, warns above 10%, and puts beside the prediction a second one with each
+    // design's costs at the ratio of the probes around it to the calibration's reference
+    // (docs/MODEL.md §8 "The machine's speed at the run" says why it is not the prediction).
     const RuntimeCosts& calibrated = calibration->hardware.runtime;
     std::unique_ptr<SpeedProbe> speed_probe;
     std::string speed_note;
     if (calibrated.speed_reference_headset_ms <= 0.0 || calibrated.speed_reference_server_ms <= 0.0)
         speed_note =
-            "the calibration has no speed reference (calibration version < 14): the costs are "
-            "charged at the calibration's speed";
+            "the calibration has no speed reference (calibration version < 14): no speed "
+            "probes";
     else if (calibrated.speed_reference_key != calibrationCacheKey(runCalibrateOptions(o)))
         speed_note =
             "the calibration's speed reference was taken on another machine, scene, profile, "
-            "codec or level of detail than this run's: the costs are charged at the "
-            "calibration's speed";
+            "codec or level of detail than this run's: no speed probes";
     else if (o.headset_share < 1.0)
         speed_note =
-            "--headset-share: a probe would run under the headset's quota; the costs are charged "
-            "at the calibration's speed";
+            "--headset-share: a probe would run under the headset's quota: no speed probes";
     else if (auto made = SpeedProbe::make(runCalibrateOptions(o)); !made)
-        speed_note = "no speed probe (" + made.error() +
-                     "): the costs are charged at the "
-                     "calibration's speed";
+        speed_note = "no speed probes: " + made.error();
     else
         speed_probe = std::move(*made);
     auto probeSpeedNow = [&]() -> std::optional<SpeedSample> {
@@ -789,8 +788,7 @@ int runRun(const RunOptions& o) {
         auto sample = speed_probe->measure();
         if (sample)
             return *sample;
-        speed_note = "the speed probe failed (" + sample.error() +
-                     "): the costs are charged at the calibration's speed";
+        speed_note = "the speed probe failed: " + sample.error();
         speed_probe.reset();
         return std::nullopt;
     };
@@ -1029,8 +1027,8 @@ int runRun(const RunOptions& o) {
     // machine's calibration, and the paper's model on its modelled hardware.
     nlohmann::json predicted = nlohmann::json::object();        // design → runtime model
     nlohmann::json predicted_paper = nlohmann::json::object();  // design → paper model
-    // design → the runtime model at the calibration's speed, and the speed factors used
-    nlohmann::json predicted_at_calibration_speed = nlohmann::json::object();
+    // design → the runtime model at the probes' speed, and the speed factors used
+    nlohmann::json predicted_at_probe_speed = nlohmann::json::object();
     nlohmann::json speed_json = nlohmann::json::object();
     auto speedFactors = [&](const DesignRun& r) -> std::optional<std::pair<double, double>> {
         double h = 0.0, sv = 0.0;
@@ -1149,14 +1147,14 @@ int runRun(const RunOptions& o) {
                     speed_json[name] = {{"headset_factor", speed->first},
                                         {"server_factor", speed->second}};
                 for (int pass = 0; rt_link_check && pass < (speed ? 2 : 1); ++pass) {
-                    // Pass 1 (with probes): the same model at the calibration's speed, beside
-                    // the prediction, so that what the probes changed is seen in every run.
+                    // Pass 1 (with probes): the same model with the costs at the probes' speed,
+                    // beside the prediction.
                     auto rt_link = makeRuntimeLink(o.net, &delay_ms);
                     RuntimeSimConfig rc;
                     rc.design = sd;
                     rc.fixed_e1_deg = fixed_e1;
-                    rc.costs = speed && pass == 0 ? calibrated.atSpeed(speed->first, speed->second)
-                                                  : calibrated;
+                    rc.costs =
+                        pass == 1 ? calibrated.atSpeed(speed->first, speed->second) : calibrated;
                     rc.costs.link_delay_ms += delay_ms;
                     rc.pipeline_depth = o.pipeline_depth;
                     rc.wait_limit_ms = o.remote_timeout_ms;
@@ -1168,7 +1166,7 @@ int runRun(const RunOptions& o) {
                     const RuntimeRunResult pr = simulateRuntime(*trace, rc, **rt_link);
                     const RuntimeSummary& ps = pr.summary;
                     if (pass == 1) {
-                        nlohmann::json& pc = predicted_at_calibration_speed[name];
+                        nlohmann::json& pc = predicted_at_probe_speed[name];
                         pc = predictionJson(ps.fps_mean, ps.mtp_ms_mean, ps.mtp_ms_p99,
                                             ps.bytes_per_frame_mean, ps.e1_deg_mean);
                         pc["headset_busy_ms_mean"] = ps.headset_busy_ms_mean;
@@ -1277,10 +1275,10 @@ int runRun(const RunOptions& o) {
         }
         if (predicted_paper.contains(name))
             dj[name]["predicted_paper_hardware"] = predicted_paper[name];
-        if (predicted_at_calibration_speed.contains(name)) {
-            dj[name]["predicted_at_calibration_speed"] = predicted_at_calibration_speed[name];
-            dj[name]["prediction_error_pct_at_calibration_speed"] =
-                errorPctJson(predicted_at_calibration_speed[name], dj[name]);
+        if (predicted_at_probe_speed.contains(name)) {
+            dj[name]["predicted_at_probe_speed"] = predicted_at_probe_speed[name];
+            dj[name]["prediction_error_pct_at_probe_speed"] =
+                errorPctJson(predicted_at_probe_speed[name], dj[name]);
         }
         {
             nlohmann::json sp = {{"before", nullptr}, {"after", nullptr}};
@@ -1347,8 +1345,9 @@ int runRun(const RunOptions& o) {
         {"headset_frame_ms", calibrated.speed_reference_headset_ms},
         {"server_frame_ms", calibrated.speed_reference_server_ms},
         {"note", speed_note.empty()
-                     ? std::string("each design's costs at the probes around it over this "
-                                   "reference (designs.<d>.speed)")
+                     ? std::string("designs.<d>.speed: the probes around each design, their "
+                                   "ratio to this reference, and predicted_at_probe_speed: the "
+                                   "model with the design's costs at that ratio")
                      : speed_note},
         {"run_spread_pct", {{"headset", speed_spread_pct[0]}, {"server", speed_spread_pct[1]}}},
         {"unsteady", unsteady}};
@@ -1555,10 +1554,9 @@ int runRun(const RunOptions& o) {
         dj,
         calibration->note + "; workload: " + trace_source + "; " +
             (speed_note.empty()
-                 ? fmt::format("each design's costs at the machine's speed just before and "
-                               "after it (a speed probe, headset and server frame, over the "
-                               "calibration's); the probes moved {:.0f}% (headset) and {:.0f}% "
-                               "(server) over the run{}",
+                 ? fmt::format("speed probes (a fixed headset and server frame) before and "
+                               "after each design moved {:.0f}% (headset) and {:.0f}% (server) "
+                               "over the run{}",
                                speed_spread_pct[0], speed_spread_pct[1],
                                unsteady ? ": the machine was unsteady, and a design's FPS moves "
                                           "with it within the seconds it runs, which no probe "
@@ -1644,21 +1642,26 @@ int runRun(const RunOptions& o) {
             const nlohmann::json sp = it.value().value("speed", nlohmann::json::object());
             fmt::print(
                 "    {:8} fps {:>8}  mtp {:>8}  bytes {:>8}  e1 {:>7}  | headset {:>7}  server "
-                "{:>7}  | speed x{} x{}\n",
+                "{:>7}  | speed x{} x{}: fps {:>7}\n",
                 it.key(), fmtCell(e["fps_mean"], "{:+.1f}%"), fmtCell(e["mtp_ms_mean"], "{:+.1f}%"),
                 fmtCell(e["bytes_per_frame_mean"], "{:+.1f}%"),
                 fmtCell(it.value()["prediction_error_abs"]["e1_deg_mean"], "{:+.1f}°"),
                 fmtCell(e.value("headset_busy_ms_mean", nlohmann::json()), "{:+.1f}%"),
                 fmtCell(e.value("server_busy_ms_mean", nlohmann::json()), "{:+.1f}%"),
                 fmtCell(sp.value("headset_factor", nlohmann::json()), "{:.3f}"),
-                fmtCell(sp.value("server_factor", nlohmann::json()), "{:.3f}"));
+                fmtCell(sp.value("server_factor", nlohmann::json()), "{:.3f}"),
+                fmtCell(it.value()
+                            .value("prediction_error_pct_at_probe_speed", nlohmann::json::object())
+                            .value("fps_mean", nlohmann::json()),
+                        "{:+.1f}%"));
         }
         fmt::print("  speed: {}\n",
                    speed_note.empty()
-                       ? fmt::format("each design's costs at the probes around it over the "
-                                     "calibration's (headset, server; summary.json "
-                                     "designs.<d>.speed); the probes moved {:.0f}% / {:.0f}% over "
-                                     "the run",
+                       ? fmt::format("the probes around each design over the calibration's "
+                                     "(headset, server), and the FPS error of the prediction with "
+                                     "the design's costs at that speed (summary.json "
+                                     "designs.<d>.speed, predicted_at_probe_speed); the probes "
+                                     "moved {:.0f}% / {:.0f}% over the run",
                                      speed_spread_pct[0], speed_spread_pct[1])
                        : speed_note);
         if (unsteady)

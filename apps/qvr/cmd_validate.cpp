@@ -103,6 +103,9 @@ struct Row {
     // Each side's own cost against the model's (docs/MODEL.md §8, "Stage errors"): a host that
     // changed speed since the calibration shows here as well as in the FPS.
     std::vector<double> headset_err, server_err;
+    // The FPS error with each design's costs at its speed probes' speed (qvr run's
+    // predicted_at_probe_speed).
+    std::vector<double> fps_err_probe_speed;
 };
 
 double mean(const std::vector<double>& v) {
@@ -198,6 +201,7 @@ int runValidate(const ValidateOptions& o) {
     std::map<std::string, Row> rows;  // key: scene|link|depth|design
     std::vector<std::string> order;
     int failures = 0;
+    std::vector<double> run_speed_spread;  // per run: the probes' largest spread, percent
     for (int rep = 0; rep < o.reps; ++rep)
         for (const std::string& scene : scenes)
             for (const std::string& link : links)
@@ -227,6 +231,16 @@ int runValidate(const ValidateOptions& o) {
                         ++failures;
                         fmt::print(" failed (exit {}), see {}.log\n", rc, dir.string());
                         continue;
+                    }
+                    {
+                        const nlohmann::json sp =
+                            j["calibration"].value("speed_reference", nlohmann::json::object());
+                        const nlohmann::json spread_pct =
+                            sp.value("run_spread_pct", nlohmann::json::object());
+                        const double h = spread_pct.value("headset", NAN),
+                                     sv = spread_pct.value("server", NAN);
+                        if (std::isfinite(h) && std::isfinite(sv))
+                            run_speed_spread.push_back(std::max(h, sv));
                     }
                     fmt::print(" done\n");
                     for (auto it = j["designs"].begin(); it != j["designs"].end(); ++it) {
@@ -259,6 +273,9 @@ int runValidate(const ValidateOptions& o) {
                             num(e.value("headset_busy_ms_mean", nlohmann::json())));
                         r.server_err.push_back(
                             num(e.value("server_busy_ms_mean", nlohmann::json())));
+                        if (d.contains("prediction_error_pct_at_probe_speed"))
+                            r.fps_err_probe_speed.push_back(
+                                num(d["prediction_error_pct_at_probe_speed"]["fps_mean"]));
                     }
                 }
     if (o.dry_run)
@@ -269,7 +286,7 @@ int runValidate(const ValidateOptions& o) {
         "| scene | link | depth | design | FPS measured | FPS predicted | FPS error | MTP error | "
         "bytes error | e1 error | FPS spread over reps | headset cost error | server cost error "
         "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    std::vector<double> abs_fps, abs_mtp, abs_bytes, abs_e1;
+    std::vector<double> abs_fps, abs_mtp, abs_bytes, abs_e1, abs_fps_probe_speed;
     nlohmann::json rows_json = nlohmann::json::array();
     for (const std::string& key : order) {
         const Row& r = rows[key];
@@ -283,6 +300,8 @@ int runValidate(const ValidateOptions& o) {
             abs_bytes.push_back(std::fabs(be));
         if (std::isfinite(ee))
             abs_e1.push_back(std::fabs(ee));
+        if (const double fc = mean(r.fps_err_probe_speed); std::isfinite(fc))
+            abs_fps_probe_speed.push_back(std::fabs(fc));
         const std::string link_label =
             r.link.rfind("trace:", 0) == 0
                 ? "trace:" + fs::path(r.link.substr(6)).filename().string()
@@ -304,7 +323,8 @@ int runValidate(const ValidateOptions& o) {
                              {"bytes_error_pct", r.bytes_err},
                              {"e1_error_deg", r.e1_err_abs},
                              {"headset_cost_error_pct", r.headset_err},
-                             {"server_cost_error_pct", r.server_err}});
+                             {"server_cost_error_pct", r.server_err},
+                             {"fps_error_pct_at_probe_speed", r.fps_err_probe_speed}});
     }
     auto worst = [](const std::vector<double>& v) {
         return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
@@ -319,22 +339,41 @@ int runValidate(const ValidateOptions& o) {
         cell(mean(abs_bytes), "{:.1f}%"), cell(worst(abs_bytes), "{:.1f}%"),
         cell(mean(abs_e1), "{:.1f}°"), cell(worst(abs_e1), "{:.1f}°"), order.size(), failures,
         seconds);
+    const size_t unsteady = static_cast<size_t>(std::count_if(
+        run_speed_spread.begin(), run_speed_spread.end(), [](double x) { return x > 10.0; }));
+    md += fmt::format(
+        "With each design's costs at its speed probes' speed (predicted_at_probe_speed): FPS {} "
+        "({}). The speed probes moved by a median {} over a run, over 10% in {} of {} runs.\n",
+        cell(mean(abs_fps_probe_speed), "{:.1f}%"), cell(worst(abs_fps_probe_speed), "{:.1f}%"),
+        [&] {
+            if (run_speed_spread.empty())
+                return std::string("—");
+            std::vector<double> v = run_speed_spread;
+            std::sort(v.begin(), v.end());
+            return fmt::format("{:.1f}%", v[v.size() / 2]);
+        }(),
+        unsteady, run_speed_spread.size());
     fmt::print("\n{}", md);
     std::ofstream(out / "validation.md") << md;
-    const nlohmann::json summary = {{"machine", machineDescriptionLine()},
-                                    {"seconds", seconds},
-                                    {"reps", o.reps},
-                                    {"frames", o.frames},
-                                    {"failed_runs", failures},
-                                    {"fps_abs_error_pct_mean", mean(abs_fps)},
-                                    {"fps_abs_error_pct_worst", worst(abs_fps)},
-                                    {"mtp_abs_error_pct_mean", mean(abs_mtp)},
-                                    {"mtp_abs_error_pct_worst", worst(abs_mtp)},
-                                    {"bytes_abs_error_pct_mean", mean(abs_bytes)},
-                                    {"bytes_abs_error_pct_worst", worst(abs_bytes)},
-                                    {"e1_abs_error_deg_mean", mean(abs_e1)},
-                                    {"e1_abs_error_deg_worst", worst(abs_e1)},
-                                    {"rows", rows_json}};
+    const nlohmann::json summary = {
+        {"machine", machineDescriptionLine()},
+        {"seconds", seconds},
+        {"reps", o.reps},
+        {"frames", o.frames},
+        {"failed_runs", failures},
+        {"fps_abs_error_pct_mean", mean(abs_fps)},
+        {"fps_abs_error_pct_worst", worst(abs_fps)},
+        {"mtp_abs_error_pct_mean", mean(abs_mtp)},
+        {"mtp_abs_error_pct_worst", worst(abs_mtp)},
+        {"bytes_abs_error_pct_mean", mean(abs_bytes)},
+        {"bytes_abs_error_pct_worst", worst(abs_bytes)},
+        {"e1_abs_error_deg_mean", mean(abs_e1)},
+        {"e1_abs_error_deg_worst", worst(abs_e1)},
+        {"fps_abs_error_pct_mean_at_probe_speed", mean(abs_fps_probe_speed)},
+        {"fps_abs_error_pct_worst_at_probe_speed", worst(abs_fps_probe_speed)},
+        {"run_speed_spread_pct", run_speed_spread},
+        {"runs_unsteady", unsteady},
+        {"rows", rows_json}};
     std::ofstream(out / "validation.json") << summary.dump(2) << "\n";
     fmt::print("  wrote {}/validation.md and validation.json\n", o.out);
     return failures > 0 ? 1 : 0;
