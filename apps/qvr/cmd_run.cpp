@@ -948,6 +948,8 @@ int runRun(const RunOptions& o) {
     // that moves within a design (seconds) moves its FPS by as much, which no probe between
     // designs can follow; the run says so rather than let the error look like the model's.
     std::array<double, 2> speed_spread_pct{0.0, 0.0};  // headset, server: max / min − 1
+    // The run's probes' mean over the calibration's reference, per side (0: no probes).
+    std::array<double, 2> speed_over_reference{0.0, 0.0};
     {
         std::vector<SpeedSample> all;
         for (const DesignRun& r : runs)
@@ -955,6 +957,15 @@ int runRun(const RunOptions& o) {
                 all.push_back(*r.speed_before);
         if (!runs.empty() && runs.back().speed_after)
             all.push_back(*runs.back().speed_after);
+        if (!all.empty() && calibrated.speed_reference_headset_ms > 0.0 &&
+            calibrated.speed_reference_server_ms > 0.0) {
+            for (const SpeedSample& p : all) {
+                speed_over_reference[0] += p.headset_ms / double(all.size());
+                speed_over_reference[1] += p.server_ms / double(all.size());
+            }
+            speed_over_reference[0] /= calibrated.speed_reference_headset_ms;
+            speed_over_reference[1] /= calibrated.speed_reference_server_ms;
+        }
         if (all.size() >= 2)
             for (int side = 0; side < 2; ++side) {
                 double lo = 1e300, hi = 0.0;
@@ -1350,6 +1361,10 @@ int runRun(const RunOptions& o) {
                                    "model with the design's costs at that ratio")
                      : speed_note},
         {"run_spread_pct", {{"headset", speed_spread_pct[0]}, {"server", speed_spread_pct[1]}}},
+        {"run_over_reference", speed_over_reference[0] > 0.0
+                                   ? nlohmann::json{{"headset", speed_over_reference[0]},
+                                                    {"server", speed_over_reference[1]}}
+                                   : nlohmann::json()},
         {"unsteady", unsteady}};
     if (!sim_note.empty())
         j["sim_note"] = sim_note;
@@ -1672,6 +1687,14 @@ int runRun(const RunOptions& o) {
                 "machine to judge the model (summary.json calibration.speed_reference)\n",
                 std::max(speed_spread_pct[0], speed_spread_pct[1]), kUnsteadyPct);
     }
+    if (const double off = std::max(std::fabs(speed_over_reference[0] - 1.0),
+                                    std::fabs(speed_over_reference[1] - 1.0));
+        speed_over_reference[0] > 0.0 && off > 0.10)
+        fmt::print(
+            "  warning: this run's speed probes took x{:.2f} (headset) and x{:.2f} (server) the "
+            "time the calibration's did: the machine is not as fast as when it was calibrated "
+            "({}); `qvr run --recalibrate` measures it again\n",
+            speed_over_reference[0], speed_over_reference[1], calibration->path);
     if (!sim_note.empty())
         fmt::print("  {}\n", sim_note);
     fmt::print(

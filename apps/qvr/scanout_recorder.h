@@ -22,7 +22,9 @@ namespace qvr::cli {
 
 // Keeps what the headset scanned out, both eyes side by side at a quarter of the resolution
 // on each axis, in memory; encoded after the run. The recording runs inside the headset's loop
-// (on its one core) and only the qvr design records, so it must cost that loop next to nothing:
+// (on its one core); the qvr design's is kept, and every other design pays the same copy for a
+// stand-in that keeps nothing (so the designs pay alike), so it must cost that loop next to
+// nothing:
 // - every frame's buffer is allocated and touched by reserve(), before the run — on these KVM
 //   guests the first touch of fresh memory costs ~25 us a page, and an 8 MB image allocated
 //   per frame cost the qvr headset ~45 ms a frame;

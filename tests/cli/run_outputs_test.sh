@@ -169,6 +169,10 @@ for name in ["local", "qvr"]:
 # One design's "after" is the next one's "before".
 assert d["designs"]["local"]["speed"]["after"] == d["designs"]["qvr"]["speed"]["before"]
 assert set(ref["run_spread_pct"]) == {"headset", "server"}, ref
+probes = [d["designs"][n]["speed"][w] for n in ["local", "qvr"] for w in ["before", "after"]]
+probes = [probes[0], probes[1], probes[3]]  # local's "after" is qvr's "before"
+over = sum(p["headset_frame_ms"] for p in probes) / 3 / ref["headset_frame_ms"]
+assert abs(ref["run_over_reference"]["headset"] - over) < 1e-9, (ref, over)
 html = open(sys.argv[3]).read()
 assert "at the probes' speed" in html and "speed ×" in html, "no speed in the report"
 o = json.load(open(sys.argv[2]))
