@@ -70,6 +70,7 @@ struct Calibration {
     };
     CoRun corun_headset, corun_server;
     std::vector<SpeedSample> speed_probes;  // over the calibration: start, middle, end
+    std::string speed_note;                 // why there is no speed reference (empty: there is)
     nlohmann::json toJson() const;
     std::string toToml() const;  // the hardware file (sim/hardware.h grammar), comments included
 };

@@ -207,6 +207,7 @@ nlohmann::json Calibration::toJson() const {
              {{"headset_frame_ms", costs.speed_reference_headset_ms},
               {"server_frame_ms", costs.speed_reference_server_ms},
               {"key", costs.speed_reference_key},
+              {"note", speed_note},
               {"probes", [this] {
                    nlohmann::json a = nlohmann::json::array();
                    for (const SpeedSample& p : speed_probes)
@@ -248,6 +249,8 @@ std::string Calibration::toToml() const {
         s += fmt::format(
             "# speed reference (the probe's headset/server frame, the mean of {}): {}\n",
             speed_probes.size(), speedProbesText(speed_probes));
+    if (!speed_note.empty())
+        s += "# " + speed_note + "\n";
     return s + runtimeCostsToml(costs);
 }
 
@@ -780,21 +783,24 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 return makeError("render: " + st.error());
     }
     // The machine's speed while it is measured: a probe now, one after the layers, one at the
-    // end (SpeedProbe; their mean is the hardware file's speed reference).
+    // end (SpeedProbe; their mean is the hardware file's speed reference). A probe that cannot
+    // run leaves the file without a reference (no run probes against it), not the costs unmeasured.
     auto speed_probe = SpeedProbe::make(o);
-    if (!speed_probe)
-        return makeError(speed_probe.error());
-    auto speed = [&]() -> Status {
+    cal.speed_note = speed_probe ? "" : speed_probe.error();
+    auto speed = [&] {
+        if (!cal.speed_note.empty())
+            return;
         auto sample = (*speed_probe)->measure();
-        if (!sample)
-            return makeError(sample.error());
+        if (!sample) {
+            cal.speed_note = sample.error();
+            cal.speed_probes.clear();
+            return;
+        }
         cal.speed_probes.push_back(*sample);
         log(fmt::format("  speed probe {}: headset frame {:.2f} ms, server frame {:.2f} ms\n",
                         cal.speed_probes.size(), sample->headset_ms, sample->server_ms));
-        return {};
     };
-    if (auto st = speed(); !st)
-        return makeError(st.error());
+    speed();
     // Consecutive frames (1/refresh apart, as a run's content advances) so the codec sees the
     // motion of a run. Each sequence starts fresh encoders (below): frame 0 is their key frame,
     // frame 1 the first P-frame, which refers to that key frame and costs ~25% fewer bits than
@@ -892,8 +898,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // median is the whole frame's scale: from the 4 samples of 2 poses (2 in --quick) one slow
     // moment of the host moved it from 1.02 to 1.14 between two calibrations of the room three
     // hours apart, and local's predicted FPS 13-18% low in every run after (docs/MODEL.md §8).
-    if (auto st = speed(); !st)
-        return makeError(st.error());
+    speed();
     ScanoutRecorder video_stand_in(*profile, 1, false, /*keep=*/false);
     video_stand_in.reserve(1);
     std::vector<double> video_copy;
@@ -1316,9 +1321,11 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     }
 
     // The third speed probe, and the reference: the mean of the three.
-    if (auto st = speed(); !st)
-        return makeError(st.error());
-    {
+    speed();
+    if (!cal.speed_note.empty()) {
+        cal.speed_note = "no speed reference: " + cal.speed_note;
+        log("  " + cal.speed_note + "\n");
+    } else {
         SpeedSample ref;
         for (const SpeedSample& p : cal.speed_probes) {
             ref.headset_ms += p.headset_ms / double(cal.speed_probes.size());
@@ -1433,6 +1440,14 @@ int runCalibrate(CalibrateCmdOptions& o) {
                cal->costs.bits_full_frame_per_px, cal->bits_full_frame_samples);
     fmt::print("  co-running, headset: {}\n", cal->corun_headset.note);
     fmt::print("  co-running, server: {}\n", cal->corun_server.note);
+    fmt::print(
+        "  speed reference: {}\n",
+        cal->speed_note.empty()
+            ? fmt::format("headset frame {:.2f} ms, server frame {:.2f} ms, the mean of "
+                          "{}",
+                          cal->costs.speed_reference_headset_ms,
+                          cal->costs.speed_reference_server_ms, speedProbesText(cal->speed_probes))
+            : cal->speed_note);
     {
         std::ofstream f(o.out);
         f << cal->toToml();

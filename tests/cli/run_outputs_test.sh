@@ -8,8 +8,10 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # A calibration file, so the run does not measure this machine first.
 printf '[runtime]\npipeline = "runtime"\nfovea_base_ms = 1\n' >"$tmp/rt.toml"
-if ! timeout 300 "$QVR" run --profile small --frames 12 --designs local,fixed:10,qvr --hardware "$tmp/rt.toml" \
-    --quality-every 6 --out "$tmp/run" >"$tmp/out.txt" 2>"$tmp/err.txt"; then
+# 24 frames, 10 of them start-up: with 12 the first server layers of fixed:10 came too late
+# on a slow moment of the host (2026-11-27, 2 of 3 runs) and the run failed as a stale design.
+if ! timeout 300 "$QVR" run --profile small --frames 24 --designs local,fixed:10,qvr --hardware "$tmp/rt.toml" \
+    --quality-every 12 --out "$tmp/run" >"$tmp/out.txt" 2>"$tmp/err.txt"; then
     echo "FAIL: qvr run exited non-zero: $(head -c 600 "$tmp/err.txt")"
     exit 1
 fi
@@ -27,7 +29,7 @@ assert "mp4" in v["container"].split(","), v
 assert v["codec"] == "h264", v
 # The video has every frame; the statistics leave out each design's start-up frames.
 q = d["designs"]["qvr"]
-assert v["frames"] == 12 and q["frames_displayed"] == 12 - q["warmup_frames"], (v, q)
+assert v["frames"] == 24 and q["frames_displayed"] == 24 - q["warmup_frames"], (v, q)
 assert q["warmup_frames"] == 10 and q["startup_mtp_ms_max"] > 0, q
 assert v["width_px"] % 2 == 0 and v["height_px"] % 2 == 0, v
 html = open(os.path.join(out, "report.html")).read()
@@ -62,7 +64,7 @@ for e in t["traceEvents"]:
     a = stages.setdefault(key, {}).setdefault(stage, [e["ts"], e["ts"] + e["dur"]])
     a[0] = min(a[0], e["ts"]); a[1] = max(a[1], e["ts"] + e["dur"])
 assert len({k[0] for k in stages}) == 3, "every design on the timeline"
-assert flows["s"] == flows["f"] == 36, flows
+assert flows["s"] == flows["f"] == 72, flows
 order = ["headset:decide", "headset:request", "server:queued", "server:render", "server:encode",
          "server:send", "headset:receive", "headset:decode"]
 checked = 0
@@ -79,7 +81,7 @@ for key, s in stages.items():
 assert checked >= 10, checked
 print("PASS: trace.json holds %d frames, stages in order; server offset %+.3f ms +- %.3f ms"
       % (len(stages), d["trace"]["server_offset_ms"], d["trace"]["server_offset_bound_ms"]))
-# Image quality: every design sampled (frames 6 and 12), the bands its plan has, in the report.
+# Image quality: every design sampled (frames 12 and 24), the bands its plan has, in the report.
 q = d["quality"]
 for name in ["local", "fixed:10", "qvr"]:
     assert q[name]["frames_sampled"] == 2, q
@@ -136,6 +138,19 @@ if ! timeout 120 "$QVR" calibrate --quick --profile small --out "$tmp/small.toml
     exit 1
 fi
 grep -q '^speed_reference_key = "' "$tmp/small.toml" || { echo "FAIL: no speed reference key"; exit 1; }
+# A probe that cannot start (its core does not exist) leaves the file without a reference, and
+# the calibration says why; the costs are still measured.
+if ! timeout 120 "$QVR" calibrate --quick --profile small --core 4095 --out "$tmp/noprobe.toml" \
+    >"$tmp/noprobe.txt" 2>&1; then
+    echo "FAIL: calibrate with a probe that cannot start: $(tail -c 600 "$tmp/noprobe.txt")"
+    exit 1
+fi
+if grep -q "speed_reference" "$tmp/noprobe.toml" || ! grep -q "no speed reference" "$tmp/noprobe.txt" ||
+    ! grep -q "^server_render_" "$tmp/noprobe.toml"; then
+    echo "FAIL: a calibration whose probe cannot start: $(grep -i speed "$tmp/noprobe.txt")"
+    exit 1
+fi
+echo "PASS: a calibration whose speed probe cannot start writes its costs without a reference"
 sed 's/^speed_reference_key = .*/speed_reference_key = "0000000000000000"/' "$tmp/small.toml" \
     >"$tmp/other.toml"
 for f in small other; do
