@@ -154,7 +154,7 @@ echo "PASS: a calibration whose speed probe cannot start writes its costs withou
 sed 's/^speed_reference_key = .*/speed_reference_key = "0000000000000000"/' "$tmp/small.toml" \
     >"$tmp/other.toml"
 for f in small other; do
-    if ! timeout 300 "$QVR" run --profile small --frames 12 --designs local,qvr --no-video \
+    if ! timeout 300 "$QVR" run --profile small --frames 24 --designs local,qvr --no-video \
         --quality-every 0 --hardware "$tmp/$f.toml" --out "$tmp/speed_$f" >"$tmp/speed_$f.txt" 2>&1; then
         echo "FAIL: qvr run --hardware $f.toml: $(tail -c 600 "$tmp/speed_$f.txt")"
         exit 1
