@@ -493,20 +493,7 @@ public:
     // "1" has finished, or at once after "0" (the current frame finishes first).
     Status setBusy(bool busy) {
         const char cmd[2] = {busy ? '1' : '0', '\n'};
-        // A load process that died has closed its end: the write must fail with EPIPE, not
-        // raise SIGPIPE and end the calibration. SIGPIPE is blocked for this thread while it
-        // writes, and one it raised is taken back.
-        sigset_t pipe_set, old_set;
-        sigemptyset(&pipe_set);
-        sigaddset(&pipe_set, SIGPIPE);
-        pthread_sigmask(SIG_BLOCK, &pipe_set, &old_set);
-        const ssize_t written = ::write(m_in, cmd, 2);
-        if (written != 2 && errno == EPIPE) {
-            const timespec zero{0, 0};
-            sigtimedwait(&pipe_set, nullptr, &zero);
-        }
-        pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
-        if (written != 2)
+        if (!writeTwo(cmd))
             return makeError("cannot write to the load process");
         char c = 0;
         pollfd pfd{m_out, POLLIN, 0};
@@ -516,17 +503,7 @@ public:
     }
     // One speed probe in the child (mix "probe"): its line "headset_ms server_ms".
     Expected<SpeedSample> probe() {
-        sigset_t pipe_set, old_set;
-        sigemptyset(&pipe_set);
-        sigaddset(&pipe_set, SIGPIPE);
-        pthread_sigmask(SIG_BLOCK, &pipe_set, &old_set);
-        const ssize_t written = ::write(m_in, "p\n", 2);
-        if (written != 2 && errno == EPIPE) {
-            const timespec zero{0, 0};
-            sigtimedwait(&pipe_set, nullptr, &zero);
-        }
-        pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
-        if (written != 2)
+        if (!writeTwo("p\n"))
             return makeError("cannot write to the speed probe process");
         std::string line;
         for (char c = 0;;) {
@@ -568,6 +545,22 @@ public:
 
 private:
     CoRunLoad(pid_t pid, int in, int out) : m_pid(pid), m_in(in), m_out(out) {}
+    // Two bytes to the child. One that died has closed its end: the write must fail with EPIPE,
+    // not raise SIGPIPE and end the calibration, so SIGPIPE is blocked for this thread while it
+    // writes, and one it raised is taken back.
+    bool writeTwo(const char* bytes) {
+        sigset_t pipe_set, old_set;
+        sigemptyset(&pipe_set);
+        sigaddset(&pipe_set, SIGPIPE);
+        pthread_sigmask(SIG_BLOCK, &pipe_set, &old_set);
+        const ssize_t written = ::write(m_in, bytes, 2);
+        if (written != 2 && errno == EPIPE) {
+            const timespec zero{0, 0};
+            sigtimedwait(&pipe_set, nullptr, &zero);
+        }
+        pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
+        return written == 2;
+    }
     pid_t m_pid;
     int m_in;
     int m_out;
