@@ -562,10 +562,12 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
             const nlohmann::json cal_speed =
                 at_cal ? d["predicted_at_probe_speed"].value(m.key, nlohmann::json())
                        : nlohmann::json();
+            const bool e1 = std::string(m.key) == "e1_deg_mean";
             const nlohmann::json cal_speed_err =
-                at_cal && std::string(m.key) != "e1_deg_mean"
-                    ? d["prediction_error_pct_at_probe_speed"].value(m.key, nlohmann::json())
-                    : nlohmann::json();
+                !at_cal ? nlohmann::json()
+                : e1    ? d.value("prediction_error_abs_at_probe_speed", nlohmann::json::object())
+                           .value(m.key, nlohmann::json())
+                     : d["prediction_error_pct_at_probe_speed"].value(m.key, nlohmann::json());
             std::string speed_line;
             if (const auto& sp = d.value("speed", nlohmann::json::object());
                 sp.contains("headset_factor"))
@@ -580,7 +582,8 @@ std::string validationHtml(const nlohmann::json& designs, const std::string& cal
                       : "",
                 m.label, fmtCell(d.value(m.key, nlohmann::json()), m.f),
                 fmtCell(d["predicted"].value(m.key, nlohmann::json()), m.f), err_cell,
-                fmtCell(cal_speed, m.f), fmtCell(cal_speed_err, "{:+.1f}%"), fmtCell(paper, m.f));
+                fmtCell(cal_speed, m.f), fmtCell(cal_speed_err, e1 ? "{:+.1f}°" : "{:+.1f}%"),
+                fmtCell(paper, m.f));
             first = false;
         }
     }
@@ -1290,6 +1293,9 @@ int runRun(const RunOptions& o) {
             dj[name]["predicted_at_probe_speed"] = predicted_at_probe_speed[name];
             dj[name]["prediction_error_pct_at_probe_speed"] =
                 errorPctJson(predicted_at_probe_speed[name], dj[name]);
+            dj[name]["prediction_error_abs_at_probe_speed"] = {
+                {"e1_deg_mean", predicted_at_probe_speed[name].value("e1_deg_mean", 0.0) -
+                                    dj[name].value("e1_deg_mean", 0.0)}};
         }
         {
             nlohmann::json sp = {{"before", nullptr}, {"after", nullptr}};

@@ -176,6 +176,8 @@ for name in ["local", "qvr"]:
     assert 0.2 < h < 5 and 0.2 < s < 5, (h, s)
     assert "fps_mean" in x["predicted_at_probe_speed"], x
     assert "fps_mean" in x["prediction_error_pct_at_probe_speed"], x
+    e1 = x["predicted_at_probe_speed"]["e1_deg_mean"] - x["e1_deg_mean"]
+    assert abs(x["prediction_error_abs_at_probe_speed"]["e1_deg_mean"] - e1) < 1e-9, x
     # The probes' prediction charges the design's costs at the ratio: slower where it is > 1.
     if h > 1.02 and s > 1.02:
         assert x["predicted_at_probe_speed"]["fps_mean"] <= x["predicted"]["fps_mean"] + 1e-9, x
