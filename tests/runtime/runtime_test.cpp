@@ -282,16 +282,30 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
     // slowdown erases. It runs in the default and asan suites.
     GTEST_SKIP() << "display cadence is not measurable under ThreadSanitizer";
 #endif
+    // The stall lasts 1.5 s and at least 16 of the headset's frames, so that it spans as many
+    // frames on a slow build (ASan beside a compile: ~120 ms a frame) as on a fast one; 30 s at
+    // most, so a display that stopped fails the test instead of hanging it.
     RenderServerConfig sc = serverConfig("none", "raw");
     std::atomic<int> served{0};
-    sc.on_frame = [&served](const ServerFrameStamps&) {
-        if (++served == 20)
-            std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    std::atomic<int64_t> headset_frame{0};
+    sc.on_frame = [&served, &headset_frame](const ServerFrameStamps&) {
+        if (++served != 20)
+            return;
+        const auto t0 = std::chrono::steady_clock::now();
+        const int64_t until = headset_frame.load() + 16;
+        for (;;) {
+            const auto spent = std::chrono::steady_clock::now() - t0;
+            if (spent > std::chrono::seconds(30) ||
+                (spent >= std::chrono::milliseconds(1500) && headset_frame.load() >= until))
+                break;
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
     };
     auto server = RenderServer::start(sc, world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    const HeadsetResult r =
-        runOn(headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 240));
+    HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 240);
+    h.before_frame = [&headset_frame](int64_t f) { headset_frame.store(f); };
+    const HeadsetResult r = runOn(h);
     ASSERT_EQ(r.frames.size(), 240u);
     // The first frame into the stall waits the limit (nothing yet says the server stopped);
     // after it the display keeps its rate (before: six gaps in a row each 250 ms longer than
@@ -309,7 +323,8 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
         long_gaps += g > median_gap + 200'000'000;
     EXPECT_LE(long_gaps, 3) << "median gap " << median_gap / 1'000'000 << " ms";
     // ~135 at 90 Hz; 27 on an ASan build, 13 (3 long gaps) on an ASan build with a calibration
-    // and a compile beside it on two cores; 6 before the fix, each frame waiting the limit.
+    // and a compile beside it on two cores when the stall was 1.5 s alone; 6 before the fix,
+    // each frame waiting the limit.
     EXPECT_GT(r.stats.silent_server_frames, 8u);
     EXPECT_GT(r.summary.frames_reused, 8);
     // Fresh frames again after the stall: the last 40 frames come from the server.
