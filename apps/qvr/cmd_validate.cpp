@@ -21,6 +21,7 @@
 #include "calibration.h"
 #include "commands.h"
 #include "qvr/runtime/server_process.h"
+#include "qvr/sim/hardware.h"
 
 namespace qvr::cli {
 
@@ -35,6 +36,9 @@ struct ValidateOptions {
     std::string depths = "1,2";
     int frames = 40;
     int reps = 1;
+    // A run taken again when its speed probes say the machine was not steady over it.
+    int retakes = 1;
+    std::string hardware;  // a calibration to use instead of calibrating (one scene only)
     std::string profile = "default";
     std::string out = "qvr-validate";
     bool dry_run = false;
@@ -124,6 +128,27 @@ double spread(const std::vector<double>& v) {  // max − min
     return *hi - *lo;
 }
 
+// How far the machine moved from steady over a run, in percent, by the run's own speed probes
+// (summary.json calibration.speed_reference): the larger of the probes' spread over the run and
+// their mean's distance from the calibration's reference, either side. NaN when the run took
+// no probes (a calibration without a reference).
+double runDisturbancePct(const nlohmann::json& summary) {
+    const nlohmann::json sp = summary.value("calibration", nlohmann::json::object())
+                                  .value("speed_reference", nlohmann::json::object());
+    const nlohmann::json spread = sp.value("run_spread_pct", nlohmann::json::object());
+    const nlohmann::json over = sp.value("run_over_reference", nlohmann::json());
+    if (!over.is_object())  // no probes were taken: run_spread_pct is 0 then, not a reading
+        return NAN;
+    double d = NAN;
+    for (const char* side : {"headset", "server"}) {
+        if (spread.contains(side) && spread[side].is_number())
+            d = std::fmax(d, spread[side].get<double>());
+        if (over.contains(side) && over[side].is_number())
+            d = std::fmax(d, 100.0 * std::fabs(over[side].get<double>() - 1.0));
+    }
+    return d;
+}
+
 std::string cell(double v, const char* f) {
     return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : std::string("—");
 }
@@ -162,6 +187,29 @@ int runValidate(const ValidateOptions& o) {
         std::fprintf(stderr, "qvr validate: empty --links, --scenes, --depths or --designs\n");
         return 2;
     }
+    if (!o.hardware.empty() && scenes.size() != 1) {
+        std::fprintf(stderr,
+                     "qvr validate: --hardware is one scene's calibration; give one "
+                     "--scenes\n");
+        return 2;
+    }
+    std::string hardware;  // absolute, as the runs are given it
+    if (!o.hardware.empty()) {
+        auto hw = loadHardwareConfig(o.hardware, 500.0);
+        if (!hw) {
+            std::fprintf(stderr, "qvr validate: --hardware: %s\n", hw.error().c_str());
+            return 2;
+        }
+        if (!hw->runtime_pipeline) {
+            std::fprintf(stderr,
+                         "qvr validate: --hardware: %s is not a calibration (qvr calibrate --out "
+                         "FILE writes one)\n",
+                         o.hardware.c_str());
+            return 2;
+        }
+        std::error_code aec;
+        hardware = fs::absolute(o.hardware, aec).string();
+    }
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (ec) {
@@ -181,6 +229,11 @@ int runValidate(const ValidateOptions& o) {
     // 1. One calibration per scene, before any run.
     std::map<std::string, std::string> calibration;
     for (const std::string& scene : scenes) {
+        if (!hardware.empty()) {
+            fmt::print("  using the calibration {} (--hardware) on {}\n", hardware, scene);
+            calibration[scene] = hardware;
+            continue;
+        }
         const std::string file = (out / ("calibration-" + safeName(scene) + ".toml")).string();
         const std::string cmd = fmt::format(
             "{} calibrate --scene {} --profile {} --out {} > {} 2>&1", shellQuote(*exe),
@@ -197,86 +250,125 @@ int runValidate(const ValidateOptions& o) {
         calibration[scene] = file;
     }
 
-    // 2. The runs.
-    std::map<std::string, Row> rows;  // key: scene|link|depth|design
+    // 2. The runs. A run whose speed probes moved over 10% across it, or whose mean was over
+    // 10% off the calibration's reference, was not measured on a steady machine: it is taken
+    // again, up to --retakes times, and the steadiest take counts (chosen by the probes alone,
+    // never by the prediction's error). The first takes' sheet is printed beside it.
+    std::map<std::string, Row> rows, rows_first;  // key: scene|link|depth|design
     std::vector<std::string> order;
-    int failures = 0;
-    std::vector<double> run_speed_spread;  // per run: the probes' largest spread, percent
+    int failures = 0, retaken = 0, still_unsteady = 0;
+    std::vector<double> run_speed_spread;  // per counted run: the probes' largest spread, percent
+    std::vector<double> run_disturbance;   // per counted run: runDisturbancePct
+    auto addRun = [](std::map<std::string, Row>& into, std::vector<std::string>* keys,
+                     const nlohmann::json& j, const std::string& scene, const std::string& link,
+                     int depth) {
+        for (auto it = j["designs"].begin(); it != j["designs"].end(); ++it) {
+            const nlohmann::json& d = it.value();
+            if (!d.contains("prediction_error_pct"))
+                continue;
+            const std::string key = fmt::format("{}|{}|{}|{}", scene, link, depth, it.key());
+            if (!into.count(key)) {
+                if (keys)
+                    keys->push_back(key);
+                Row row;
+                row.scene = scene;
+                row.link = link;
+                row.design = it.key();
+                row.depth = depth;
+                into[key] = std::move(row);
+            }
+            Row& r = into[key];
+            const nlohmann::json& e = d["prediction_error_pct"];
+            auto num = [](const nlohmann::json& v) {
+                return v.is_number() ? v.get<double>() : NAN;
+            };
+            r.fps_err.push_back(num(e["fps_mean"]));
+            r.mtp_err.push_back(num(e["mtp_ms_mean"]));
+            r.bytes_err.push_back(num(e["bytes_per_frame_mean"]));
+            r.e1_err_abs.push_back(num(d["prediction_error_abs"]["e1_deg_mean"]));
+            r.fps_meas.push_back(num(d["fps_mean"]));
+            r.fps_pred.push_back(num(d["predicted"]["fps_mean"]));
+            r.headset_err.push_back(num(e.value("headset_busy_ms_mean", nlohmann::json())));
+            r.server_err.push_back(num(e.value("server_busy_ms_mean", nlohmann::json())));
+            if (d.contains("prediction_error_pct_at_probe_speed"))
+                r.fps_err_probe_speed.push_back(
+                    num(d["prediction_error_pct_at_probe_speed"]["fps_mean"]));
+        }
+    };
     for (int rep = 0; rep < o.reps; ++rep)
         for (const std::string& scene : scenes)
             for (const std::string& link : links)
                 for (int depth : depths) {
-                    const fs::path dir = out / fmt::format("{}_{}_d{}_r{}", safeName(scene),
-                                                           safeName(link), depth, rep + 1);
-                    const std::string cmd = fmt::format(
-                        "{} run --scene {} --net {} --pipeline {} --designs {} --frames {} "
-                        "--profile {} --hardware {} --no-video --out {} > {} 2>&1",
-                        shellQuote(*exe), shellQuote(scene), shellQuote(link), depth,
-                        shellQuote(o.designs), o.frames, shellQuote(o.profile),
-                        shellQuote(calibration[scene]), shellQuote(dir.string()),
-                        shellQuote((dir.string()) + ".log"));
-                    fmt::print("  {} | {} | depth {} | rep {} ...", scene, link, depth, rep + 1);
-                    std::fflush(stdout);
-                    if (o.dry_run) {
-                        fmt::print("\n    {}\n", cmd);
+                    nlohmann::json first, best;
+                    double best_disturbance = INFINITY;
+                    for (int take = 0; take <= o.retakes; ++take) {
+                        const fs::path dir =
+                            out / fmt::format("{}_{}_d{}_r{}{}", safeName(scene), safeName(link),
+                                              depth, rep + 1,
+                                              take == 0 ? "" : fmt::format("_t{}", take + 1));
+                        const std::string cmd = fmt::format(
+                            "{} run --scene {} --net {} --pipeline {} --designs {} --frames {} "
+                            "--profile {} --hardware {} --no-video --out {} > {} 2>&1",
+                            shellQuote(*exe), shellQuote(scene), shellQuote(link), depth,
+                            shellQuote(o.designs), o.frames, shellQuote(o.profile),
+                            shellQuote(calibration[scene]), shellQuote(dir.string()),
+                            shellQuote((dir.string()) + ".log"));
+                        fmt::print("  {} | {} | depth {} | rep {}{} ...", scene, link, depth,
+                                   rep + 1, take == 0 ? "" : fmt::format(" take {}", take + 1));
+                        std::fflush(stdout);
+                        if (o.dry_run) {
+                            fmt::print("\n    {}\n", cmd);
+                            break;
+                        }
+                        const int rc = runCommand(cmd);
+                        nlohmann::json j;
+                        if (rc == 0) {
+                            std::ifstream f(dir / "summary.json");
+                            j = nlohmann::json::parse(f, nullptr, false);
+                        }
+                        if (rc != 0 || j.is_discarded() || !j.contains("designs")) {
+                            ++failures;
+                            fmt::print(" failed (exit {}), see {}.log\n", rc, dir.string());
+                            break;
+                        }
+                        const double dist = runDisturbancePct(j);
+                        if (take == 0)
+                            first = j;
+                        else
+                            ++retaken;
+                        if (!(dist >= best_disturbance)) {  // NaN (no probes) counts as steady
+                            best = j;
+                            best_disturbance = dist;
+                        }
+                        const bool steady = !std::isfinite(dist) || dist <= 10.0;
+                        fmt::print(" done{}\n",
+                                   std::isfinite(dist)
+                                       ? fmt::format(" (speed moved {:.0f}%{})", dist,
+                                                     steady             ? ""
+                                                     : take < o.retakes ? ": unsteady, again"
+                                                                        : ": unsteady")
+                                       : std::string());
+                        if (steady)
+                            break;
+                    }
+                    if (best.is_null())
                         continue;
-                    }
-                    const int rc = runCommand(cmd);
-                    nlohmann::json j;
-                    if (rc == 0) {
-                        std::ifstream f(dir / "summary.json");
-                        j = nlohmann::json::parse(f, nullptr, false);
-                    }
-                    if (rc != 0 || j.is_discarded() || !j.contains("designs")) {
-                        ++failures;
-                        fmt::print(" failed (exit {}), see {}.log\n", rc, dir.string());
-                        continue;
-                    }
+                    if (std::isfinite(best_disturbance) && best_disturbance > 10.0)
+                        ++still_unsteady;
                     {
-                        const nlohmann::json sp =
-                            j["calibration"].value("speed_reference", nlohmann::json::object());
                         const nlohmann::json spread_pct =
-                            sp.value("run_spread_pct", nlohmann::json::object());
+                            best["calibration"]
+                                .value("speed_reference", nlohmann::json::object())
+                                .value("run_spread_pct", nlohmann::json::object());
                         const double h = spread_pct.value("headset", NAN),
                                      sv = spread_pct.value("server", NAN);
                         if (std::isfinite(h) && std::isfinite(sv))
                             run_speed_spread.push_back(std::max(h, sv));
+                        if (std::isfinite(best_disturbance))
+                            run_disturbance.push_back(best_disturbance);
                     }
-                    fmt::print(" done\n");
-                    for (auto it = j["designs"].begin(); it != j["designs"].end(); ++it) {
-                        const nlohmann::json& d = it.value();
-                        if (!d.contains("prediction_error_pct"))
-                            continue;
-                        const std::string key =
-                            fmt::format("{}|{}|{}|{}", scene, link, depth, it.key());
-                        if (!rows.count(key)) {
-                            order.push_back(key);
-                            Row row;
-                            row.scene = scene;
-                            row.link = link;
-                            row.design = it.key();
-                            row.depth = depth;
-                            rows[key] = std::move(row);
-                        }
-                        Row& r = rows[key];
-                        const nlohmann::json& e = d["prediction_error_pct"];
-                        auto num = [](const nlohmann::json& v) {
-                            return v.is_number() ? v.get<double>() : NAN;
-                        };
-                        r.fps_err.push_back(num(e["fps_mean"]));
-                        r.mtp_err.push_back(num(e["mtp_ms_mean"]));
-                        r.bytes_err.push_back(num(e["bytes_per_frame_mean"]));
-                        r.e1_err_abs.push_back(num(d["prediction_error_abs"]["e1_deg_mean"]));
-                        r.fps_meas.push_back(num(d["fps_mean"]));
-                        r.fps_pred.push_back(num(d["predicted"]["fps_mean"]));
-                        r.headset_err.push_back(
-                            num(e.value("headset_busy_ms_mean", nlohmann::json())));
-                        r.server_err.push_back(
-                            num(e.value("server_busy_ms_mean", nlohmann::json())));
-                        if (d.contains("prediction_error_pct_at_probe_speed"))
-                            r.fps_err_probe_speed.push_back(
-                                num(d["prediction_error_pct_at_probe_speed"]["fps_mean"]));
-                    }
+                    addRun(rows, &order, best, scene, link, depth);
+                    addRun(rows_first, nullptr, first, scene, link, depth);
                 }
     if (o.dry_run)
         return 0;
@@ -341,6 +433,21 @@ int runValidate(const ValidateOptions& o) {
         seconds);
     const size_t unsteady = static_cast<size_t>(std::count_if(
         run_speed_spread.begin(), run_speed_spread.end(), [](double x) { return x > 10.0; }));
+    // The first takes alone, so that what the retakes changed is on the sheet.
+    std::vector<double> abs_fps_first;
+    for (const std::string& key : order)
+        if (rows_first.count(key))
+            if (const double fe = mean(rows_first[key].fps_err); std::isfinite(fe))
+                abs_fps_first.push_back(std::fabs(fe));
+    const size_t runs_counted =
+        static_cast<size_t>(o.reps) * scenes.size() * links.size() * depths.size() -
+        static_cast<size_t>(failures);
+    md += fmt::format(
+        "Runs taken again because their speed probes moved over 10% (across the run or from "
+        "the calibration's reference): {} (up to {} per run); still unsteady after them: {} of "
+        "{}. The first takes alone: FPS {} ({}).\n",
+        retaken, o.retakes, still_unsteady, runs_counted, cell(mean(abs_fps_first), "{:.1f}%"),
+        cell(worst(abs_fps_first), "{:.1f}%"));
     md += fmt::format(
         "With each design's costs at its speed probes' speed (predicted_at_probe_speed): FPS {} "
         "({}). The speed probes moved by a median {} over a run, over 10% in {} of {} runs.\n",
@@ -373,6 +480,12 @@ int runValidate(const ValidateOptions& o) {
         {"fps_abs_error_pct_worst_at_probe_speed", worst(abs_fps_probe_speed)},
         {"run_speed_spread_pct", run_speed_spread},
         {"runs_unsteady", unsteady},
+        {"retakes_max", o.retakes},
+        {"runs_retaken", retaken},
+        {"runs_unsteady_after_retakes", still_unsteady},
+        {"run_disturbance_pct", run_disturbance},
+        {"fps_abs_error_pct_mean_first_takes", mean(abs_fps_first)},
+        {"fps_abs_error_pct_worst_first_takes", worst(abs_fps_first)},
         {"rows", rows_json}};
     std::ofstream(out / "validation.json") << summary.dump(2) << "\n";
     fmt::print("  wrote {}/validation.md and validation.json\n", o.out);
@@ -397,6 +510,13 @@ static Registered registerValidate(CLI::App& app) {
     cmd->add_option("--reps", o->reps, "Repetitions of every condition")
         ->check(CLI::Range(1, 20))
         ->capture_default_str();
+    cmd->add_option("--retakes", o->retakes,
+                    "Take a run again, up to this many times, when its speed probes moved over "
+                    "10% across it or from the calibration's; the steadiest take counts")
+        ->check(CLI::Range(0, 5))
+        ->capture_default_str();
+    cmd->add_option("--hardware", o->hardware,
+                    "Use this calibration instead of calibrating (one scene)");
     cmd->add_option("--profile", o->profile, "Display profile")->capture_default_str();
     cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
     cmd->add_flag("--dry-run", o->dry_run, "Print the commands without running them");

@@ -250,6 +250,10 @@ expect_error "validate --depths 3" validate --depths 3 --dry-run --out "$tmp/val
 expect_error "validate --frames 2" validate --frames 2 --dry-run --out "$tmp/val"
 expect_error "validate --reps 0" validate --reps 0 --dry-run --out "$tmp/val"
 expect_error "validate --scenes ''" validate --scenes "" --dry-run --out "$tmp/val"
+expect_error "validate --retakes 6" validate --retakes 6 --dry-run --out "$tmp/val"
+expect_error "validate --retakes -1" validate --retakes -1 --dry-run --out "$tmp/val"
+expect_error "validate --hardware /nonexistent" validate --hardware /nonexistent.toml --scenes builtin:room --dry-run --out "$tmp/val"
+expect_error "validate --hardware with two scenes" validate --hardware "$tmp/rt_bad.toml" --dry-run --out "$tmp/val"
 if run_ok "validate --dry-run lists its commands" validate --dry-run --links wifi,lte --scenes builtin:room --depths 1,2 --out "$tmp/val"; then
     if [ "$(grep -c ' run --scene' "$tmp/out.json")" -eq 4 ] && grep -q ' calibrate --scene' "$tmp/out.json"; then
         pass "validate plans one calibration and 2 links x 2 depths runs"

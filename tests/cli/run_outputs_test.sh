@@ -199,6 +199,39 @@ print("PASS: beside each design's prediction, one at its probes' speed (local x%
       "another key gets no probes" % (d["designs"]["local"]["speed"]["headset_factor"],
                                                d["designs"]["local"]["speed"]["server_factor"]))
 PY
+# `qvr validate` takes a run again when its probes say the machine was not at its calibration's
+# speed: a reference half of what this machine measures puts every run ~100% off it, so the one
+# run is taken twice and counted as still unsteady; a calibration without a reference takes no
+# probes, so nothing is retaken however many retakes are allowed.
+awk '/^speed_reference_headset_ms = /{print "speed_reference_headset_ms = " $3 / 2; next} {print}' \
+    "$tmp/small.toml" >"$tmp/off.toml"
+for f in off rt; do
+    retakes=$([ $f = off ] && echo 1 || echo 2)
+    if ! timeout 300 "$QVR" validate --hardware "$tmp/$f.toml" --scenes builtin:room --links wifi \
+        --depths 1 --designs local,qvr --frames 24 --profile small --retakes "$retakes" \
+        --out "$tmp/val_$f" >"$tmp/val_$f.txt" 2>&1; then
+        echo "FAIL: qvr validate --hardware $f.toml: $(tail -c 600 "$tmp/val_$f.txt")"
+        exit 1
+    fi
+done
+python3 - "$tmp/val_off" "$tmp/val_rt" <<'PY' || exit 1
+import json, os, sys
+off = json.load(open(os.path.join(sys.argv[1], "validation.json")))
+rt = json.load(open(os.path.join(sys.argv[2], "validation.json")))
+assert off["runs_retaken"] == 1 and off["runs_unsteady_after_retakes"] == 1, off
+assert len(off["run_disturbance_pct"]) == 1 and off["run_disturbance_pct"][0] > 50, off
+for d in ["builtin_room_wifi_d1_r1", "builtin_room_wifi_d1_r1_t2"]:
+    assert os.path.isfile(os.path.join(sys.argv[1], d, "summary.json")), d
+assert not os.path.exists(os.path.join(sys.argv[1], "builtin_room_wifi_d1_r1_t3"))
+assert sorted(r["design"] for r in off["rows"]) == ["local", "qvr"], off["rows"]
+assert all(len(r["fps_error_pct"]) == 1 for r in off["rows"]), off["rows"]
+assert off["fps_abs_error_pct_mean_first_takes"] is not None, off
+assert "taken again" in open(os.path.join(sys.argv[1], "validation.md")).read()
+assert rt["runs_retaken"] == 0 and rt["run_disturbance_pct"] == [], rt
+assert not os.path.exists(os.path.join(sys.argv[2], "builtin_room_wifi_d1_r1_t2"))
+print("PASS: validate takes a run off its calibration's speed again (%.0f%% off) and a run "
+      "without probes once" % off["run_disturbance_pct"][0])
+PY
 # The probe's process (`qvr corun-load --mix probe`): one answer per "p", anything else ignored,
 # the end of its input its end (exit 0).
 out=$(printf 'x\nzz\np\n' | timeout 120 "$QVR" corun-load --scene builtin:room --profile small --core 0 \
