@@ -3,11 +3,16 @@
 // pipeline depths, every design, a few repetitions — each predicted with that calibration, and
 // prints one table of the signed prediction errors with their mean absolute and worst values.
 // docs/MODEL.md §8.
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -93,9 +98,43 @@ std::string safeName(const std::string& s) {
     return out.size() > 40 ? out.substr(out.size() - 40) : out;
 }
 
+// SIGINT/SIGTERM stop the sheet: the signal is passed to the calibration or run under way (a
+// run then ends its design and writes what it measured), no further one starts, and the sheet
+// of the runs that ended is written; the exit status is 130. (With std::system the parent
+// ignored SIGINT while a run went on, so Ctrl-C ended one run and the next one started; a
+// SIGTERM left the run behind, orphaned.)
+std::atomic<pid_t> g_validate_child{0};
+volatile std::sig_atomic_t g_validate_stop = 0;
+static_assert(std::atomic<pid_t>::is_always_lock_free);
+
+void onValidateSignal(int sig) {
+    g_validate_stop = sig;
+    if (const pid_t c = g_validate_child.load(); c > 0)
+        ::kill(c, sig);
+}
+
+// Runs `cmd` through /bin/sh (exec'd, so the shell's child is the command itself and the signal
+// above reaches it), stdin from /dev/null. The exit status, 128 + N for signal N, -1 when it
+// could not start.
 int runCommand(const std::string& cmd) {
-    const int st = std::system(cmd.c_str());
-    if (st == -1)
+    const std::string line = "exec " + cmd + " < /dev/null";
+    const pid_t pid = ::fork();
+    if (pid < 0)
+        return -1;
+    if (pid == 0) {
+        ::execl("/bin/sh", "sh", "-c", line.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    g_validate_child.store(pid);
+    if (g_validate_stop != 0)  // a signal between the fork and the store
+        ::kill(pid, g_validate_stop);
+    int st = 0;
+    pid_t w;
+    do {
+        w = ::waitpid(pid, &st, 0);
+    } while (w < 0 && errno == EINTR);
+    g_validate_child.store(0);
+    if (w < 0)
         return -1;
     return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
 }
@@ -185,6 +224,9 @@ int runValidate(const ValidateOptions& o) {
         std::fprintf(stderr, "qvr validate: %s\n", exe.error().c_str());
         return 1;
     }
+    g_validate_stop = 0;
+    std::signal(SIGINT, onValidateSignal);
+    std::signal(SIGTERM, onValidateSignal);
     if (o.frames < 5 || o.frames > 100000) {
         std::fprintf(stderr, "qvr validate: --frames must be within 5..100000\n");
         return 2;
@@ -282,7 +324,15 @@ int runValidate(const ValidateOptions& o) {
                 calibration[scene] = file;
                 break;
             }
-            if (const int rc = runCommand(cmd); rc != 0) {
+            const int rc = runCommand(cmd);
+            if (g_validate_stop != 0) {
+                std::fprintf(stderr,
+                             "\nqvr validate: stopped (signal %d) while calibrating; no "
+                             "sheet\n",
+                             int(g_validate_stop));
+                return 130;
+            }
+            if (rc != 0) {
                 std::fprintf(stderr,
                              "\nqvr validate: calibration on %s failed (exit %d), see %s.log\n",
                              scene.c_str(), rc, file.c_str());
@@ -316,6 +366,7 @@ int runValidate(const ValidateOptions& o) {
     std::map<std::string, Row> rows, rows_first;  // key: scene|link|depth|design
     std::vector<std::string> order;
     int failures = 0, retaken = 0, still_unsteady = 0;
+    size_t counted = 0;                    // runs on the sheet (one take each)
     std::vector<double> run_speed_spread;  // per counted run: the probes' largest spread, percent
     std::vector<double> run_disturbance;   // per counted run: runDisturbancePct
     auto addRun = [](std::map<std::string, Row>& into, std::vector<std::string>* keys,
@@ -354,10 +405,13 @@ int runValidate(const ValidateOptions& o) {
                     num(d["prediction_error_pct_at_probe_speed"]["fps_mean"]));
         }
     };
-    for (int rep = 0; rep < o.reps; ++rep)
+    bool stopped = false;
+    for (int rep = 0; rep < o.reps && !stopped; ++rep)
         for (const std::string& scene : scenes)
             for (const std::string& link : links)
                 for (int depth : depths) {
+                    if (stopped)
+                        break;
                     nlohmann::json first, best;
                     double best_disturbance = INFINITY;
                     for (int take = 0; take <= o.retakes; ++take) {
@@ -380,6 +434,11 @@ int runValidate(const ValidateOptions& o) {
                             break;
                         }
                         const int rc = runCommand(cmd);
+                        if (g_validate_stop != 0) {  // this run was cut short: not counted
+                            fmt::print(" stopped\n");
+                            stopped = true;
+                            break;
+                        }
                         nlohmann::json j;
                         if (rc == 0) {
                             std::ifstream f(dir / "summary.json");
@@ -427,6 +486,7 @@ int runValidate(const ValidateOptions& o) {
                             run_disturbance.push_back(best_disturbance);
                     }
                     addRun(rows, &order, best, scene, link, depth);
+                    ++counted;
                     addRun(rows_first, nullptr, first, scene, link, depth);
                 }
     if (o.dry_run)
@@ -498,9 +558,7 @@ int runValidate(const ValidateOptions& o) {
         if (rows_first.count(key))
             if (const double fe = mean(rows_first[key].fps_err); std::isfinite(fe))
                 abs_fps_first.push_back(std::fabs(fe));
-    const size_t runs_counted =
-        static_cast<size_t>(o.reps) * scenes.size() * links.size() * depths.size() -
-        static_cast<size_t>(failures);
+    const size_t runs_counted = counted;
     md += fmt::format(
         "Runs taken again because their speed probes moved over 10% (across the run or from "
         "the calibration's reference): {} (up to {} per run); still unsteady after them: {} of "
@@ -519,6 +577,10 @@ int runValidate(const ValidateOptions& o) {
             return fmt::format("{:.1f}%", v[v.size() / 2]);
         }(),
         unsteady, run_speed_spread.size());
+    if (stopped)
+        md += fmt::format("Stopped by a signal: the sheet has the {} runs that ended of {}.\n",
+                          runs_counted,
+                          size_t(o.reps) * scenes.size() * links.size() * depths.size());
     fmt::print("\n{}", md);
     std::ofstream(out / "validation.md") << md;
     const nlohmann::json summary = {
@@ -549,6 +611,10 @@ int runValidate(const ValidateOptions& o) {
         {"rows", rows_json}};
     std::ofstream(out / "validation.json") << summary.dump(2) << "\n";
     fmt::print("  wrote {}/validation.md and validation.json\n", o.out);
+    if (stopped) {
+        std::fprintf(stderr, "qvr validate: stopped by signal %d\n", int(g_validate_stop));
+        return 130;
+    }
     return failures > 0 ? 1 : 0;
 }
 

@@ -140,5 +140,34 @@ else
         "exit $rc: $(tail -c 400 "$tmp/run_err.txt"); $(head -c 300 "$tmp/run/summary.json" 2>/dev/null)"
 fi
 
+# --- qvr validate, SIGINT to it alone while its first run streams --------------------------------
+# The signal reaches the run under way (which writes what it measured), no further run starts,
+# the sheet of the runs that ended is written and validate exits 130, leaving no process behind.
+"$QVR" validate --hardware "$tmp/rt.toml" --scenes builtin:room --links wifi,lte --depths 1 \
+    --designs qvr,local --frames 100000 --profile small --retakes 0 --out "$tmp/val" \
+    >"$tmp/val_out.txt" 2>"$tmp/val_err.txt" &
+val_pid=$!
+pids+=("$val_pid")
+if ! wait_for "$tmp/val/builtin_room_wifi_d1_r1/server_stamps.csv" 40 180; then
+    fail "validate's first run streams frames" "$(head -c 300 "$tmp/val_out.txt")"
+fi
+interrupt "$val_pid"
+rc=$?
+sleep 1
+left=$(pgrep -f "$tmp/val/" || true)
+if [ $rc -eq 130 ] && [ -z "$left" ] && grep -q "stopped by signal 2" "$tmp/val_err.txt" &&
+    grep -q "Stopped by a signal" "$tmp/val/validation.md" && [ ! -e "$tmp/val/builtin_room_lte_d1_r1" ] &&
+    python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1] + '/builtin_room_wifi_d1_r1/summary.json'))
+assert d['interrupted'] is True, d.get('interrupted_note')
+v = json.load(open(sys.argv[1] + '/validation.json'))
+assert v['rows'] == [] and v['failed_runs'] == 0, v
+" "$tmp/val"; then
+    pass "validate SIGINT stops its run (which keeps its data), starts no other, writes the sheet, exits 130"
+else
+    fail "validate SIGINT" "exit $rc, left: $left; $(tail -c 300 "$tmp/val_err.txt"); $(tail -c 300 "$tmp/val_out.txt")"
+fi
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
