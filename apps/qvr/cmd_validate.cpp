@@ -363,7 +363,9 @@ int runValidate(const ValidateOptions& o) {
     // 10% off the calibration's reference, was not measured on a steady machine: it is taken
     // again, up to --retakes times, and the steadiest take counts (chosen by the probes alone,
     // never by the prediction's error). The first takes' sheet is printed beside it.
-    std::map<std::string, Row> rows, rows_first;  // key: scene|link|depth|design
+    // key: scene|link|depth|design. rows_steady: the counted runs whose probes stayed within 10%.
+    std::map<std::string, Row> rows, rows_first, rows_steady;
+    size_t counted_steady = 0;
     std::vector<std::string> order;
     int failures = 0, retaken = 0, still_unsteady = 0;
     size_t counted = 0;                    // runs on the sheet (one take each)
@@ -480,7 +482,8 @@ int runValidate(const ValidateOptions& o) {
                                 .value("run_spread_pct", nlohmann::json::object());
                         const double h = spread_pct.value("headset", NAN),
                                      sv = spread_pct.value("server", NAN);
-                        if (std::isfinite(h) && std::isfinite(sv))
+                        if (std::isfinite(h) && std::isfinite(sv) &&
+                            std::isfinite(best_disturbance))  // 0 when no probe was taken
                             run_speed_spread.push_back(std::max(h, sv));
                         if (std::isfinite(best_disturbance))
                             run_disturbance.push_back(best_disturbance);
@@ -488,6 +491,10 @@ int runValidate(const ValidateOptions& o) {
                     addRun(rows, &order, best, scene, link, depth);
                     ++counted;
                     addRun(rows_first, nullptr, first, scene, link, depth);
+                    if (best_disturbance <= 10.0) {  // NaN (no probes): not judged, not in it
+                        addRun(rows_steady, nullptr, best, scene, link, depth);
+                        ++counted_steady;
+                    }
                 }
     if (o.dry_run)
         return 0;
@@ -559,6 +566,22 @@ int runValidate(const ValidateOptions& o) {
             if (const double fe = mean(rows_first[key].fps_err); std::isfinite(fe))
                 abs_fps_first.push_back(std::fabs(fe));
     const size_t runs_counted = counted;
+    // The steady runs alone: the model's error where the machine held its calibration's speed.
+    std::vector<double> abs_fps_steady, abs_mtp_steady;
+    for (const std::string& key : order)
+        if (rows_steady.count(key)) {
+            if (const double fe = mean(rows_steady[key].fps_err); std::isfinite(fe))
+                abs_fps_steady.push_back(std::fabs(fe));
+            if (const double me = mean(rows_steady[key].mtp_err); std::isfinite(me))
+                abs_mtp_steady.push_back(std::fabs(me));
+        }
+    md += fmt::format(
+        "The steady runs alone ({} of {}: speed probes within 10% across the run and of the "
+        "calibration's reference; a run without probes is not judged): FPS {} ({}), MTP mean {} "
+        "({}) over {} cells.\n",
+        counted_steady, runs_counted, cell(mean(abs_fps_steady), "{:.1f}%"),
+        cell(worst(abs_fps_steady), "{:.1f}%"), cell(mean(abs_mtp_steady), "{:.1f}%"),
+        cell(worst(abs_mtp_steady), "{:.1f}%"), abs_fps_steady.size());
     md += fmt::format(
         "Runs taken again because their speed probes moved over 10% (across the run or from "
         "the calibration's reference): {} (up to {} per run); still unsteady after them: {} of "
@@ -607,6 +630,10 @@ int runValidate(const ValidateOptions& o) {
         {"runs_unsteady_after_retakes", still_unsteady},
         {"run_disturbance_pct", run_disturbance},
         {"fps_abs_error_pct_mean_first_takes", mean(abs_fps_first)},
+        {"runs_steady", counted_steady},
+        {"fps_abs_error_pct_mean_steady_runs", mean(abs_fps_steady)},
+        {"fps_abs_error_pct_worst_steady_runs", worst(abs_fps_steady)},
+        {"mtp_abs_error_pct_mean_steady_runs", mean(abs_mtp_steady)},
         {"fps_abs_error_pct_worst_first_takes", worst(abs_fps_first)},
         {"rows", rows_json}};
     std::ofstream(out / "validation.json") << summary.dump(2) << "\n";

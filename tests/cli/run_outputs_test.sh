@@ -227,7 +227,9 @@ assert sorted(r["design"] for r in off["rows"]) == ["local", "qvr"], off["rows"]
 assert all(len(r["fps_error_pct"]) == 1 for r in off["rows"]), off["rows"]
 assert off["fps_abs_error_pct_mean_first_takes"] is not None, off
 assert "taken again" in open(os.path.join(sys.argv[1], "validation.md")).read()
+assert off["runs_steady"] == 0 and off["fps_abs_error_pct_mean_steady_runs"] is None, off
 assert rt["runs_retaken"] == 0 and rt["run_disturbance_pct"] == [], rt
+assert rt["runs_steady"] == 0 and rt["run_speed_spread_pct"] == [], rt  # no probes: not judged
 assert not os.path.exists(os.path.join(sys.argv[2], "builtin_room_wifi_d1_r1_t2"))
 print("PASS: validate takes a run off its calibration's speed again (%.0f%% off) and a run "
       "without probes once" % off["run_disturbance_pct"][0])
