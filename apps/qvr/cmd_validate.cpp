@@ -214,6 +214,22 @@ double calibrationSpreadPct(const std::string& json_path) {
     return d;
 }
 
+// Steady by the speed probes: within 10%, or no probe taken (NaN: nothing to tell, so a take
+// without probes is never taken again).
+bool steadyByProbes(double pct) {
+    return !std::isfinite(pct) || pct <= 10.0;
+}
+
+// What follows a take's "done": how far its probes moved, and whether it is taken again.
+std::string takeNote(double pct, bool more_takes) {
+    if (!std::isfinite(pct))
+        return {};
+    return fmt::format(" (speed moved {:.0f}%{})", pct,
+                       steadyByProbes(pct) ? ""
+                       : more_takes        ? ": unsteady, again"
+                                           : ": unsteady");
+}
+
 std::string cell(double v, const char* f) {
     return std::isfinite(v) ? fmt::format(fmt::runtime(f), v) : std::string("—");
 }
@@ -344,14 +360,8 @@ int runValidate(const ValidateOptions& o) {
                 best_spread = sp;
                 best_take = take;
             }
-            const bool steady = !std::isfinite(sp) || sp <= 10.0;
-            fmt::print(" done{}\n", std::isfinite(sp)
-                                        ? fmt::format(" (speed probes {:.0f}% apart{})", sp,
-                                                      steady             ? ""
-                                                      : take < o.retakes ? ": unsteady, again"
-                                                                         : ": unsteady")
-                                        : std::string());
-            if (steady)
+            fmt::print(" done{}\n", takeNote(sp, take < o.retakes));
+            if (steadyByProbes(sp))
                 break;
         }
         if (best_take > 0)
@@ -460,15 +470,8 @@ int runValidate(const ValidateOptions& o) {
                             best = j;
                             best_disturbance = dist;
                         }
-                        const bool steady = !std::isfinite(dist) || dist <= 10.0;
-                        fmt::print(" done{}\n",
-                                   std::isfinite(dist)
-                                       ? fmt::format(" (speed moved {:.0f}%{})", dist,
-                                                     steady             ? ""
-                                                     : take < o.retakes ? ": unsteady, again"
-                                                                        : ": unsteady")
-                                       : std::string());
-                        if (steady)
+                        fmt::print(" done{}\n", takeNote(dist, take < o.retakes));
+                        if (steadyByProbes(dist))
                             break;
                     }
                     if (best.is_null())

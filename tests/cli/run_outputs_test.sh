@@ -200,10 +200,12 @@ print("PASS: beside each design's prediction, one at its probes' speed (local x%
                                                d["designs"]["local"]["speed"]["server_factor"]))
 PY
 # `qvr validate` takes a run again when its probes say the machine was not at its calibration's
-# speed: a reference half of what this machine measures puts every run ~100% off it, so the one
-# run is taken twice and counted as still unsteady; a calibration without a reference takes no
-# probes, so nothing is retaken however many retakes are allowed.
-awk '/^speed_reference_headset_ms = /{print "speed_reference_headset_ms = " $3 / 2; next} {print}' \
+# speed: a reference a tenth of what this machine measured puts every run several times off it
+# (a half was not enough: the small profile's probes moved x0.65 to x1.97 between calibration
+# and run, and a CI run came out 31% off), so the one run is taken twice and counted as still
+# unsteady; a calibration without a reference takes no probes, so nothing is retaken however
+# many retakes are allowed.
+awk '/^speed_reference_headset_ms = /{print "speed_reference_headset_ms = " $3 / 10; next} {print}' \
     "$tmp/small.toml" >"$tmp/off.toml"
 for f in off rt; do
     retakes=$([ $f = off ] && echo 1 || echo 2)
@@ -219,7 +221,7 @@ import json, os, sys
 off = json.load(open(os.path.join(sys.argv[1], "validation.json")))
 rt = json.load(open(os.path.join(sys.argv[2], "validation.json")))
 assert off["runs_retaken"] == 1 and off["runs_unsteady_after_retakes"] == 1, off
-assert len(off["run_disturbance_pct"]) == 1 and off["run_disturbance_pct"][0] > 50, off
+assert len(off["run_disturbance_pct"]) == 1 and off["run_disturbance_pct"][0] > 100, off
 for d in ["builtin_room_wifi_d1_r1", "builtin_room_wifi_d1_r1_t2"]:
     assert os.path.isfile(os.path.join(sys.argv[1], d, "summary.json")), d
 assert not os.path.exists(os.path.join(sys.argv[1], "builtin_room_wifi_d1_r1_t3"))
