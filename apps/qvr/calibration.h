@@ -111,5 +111,11 @@ std::string costLawText(const PartCost& cost);
 std::string machineDescriptionLine();
 // "h/s, h/s … ms headset/server" of speed probes.
 std::string speedProbesText(const std::vector<SpeedSample>& probes);
+// Each side's spread of speed probes (headset, server): largest over smallest, minus 1, in
+// percent; {0, 0} with fewer than two probes.
+std::array<double, 2> speedProbesSpreadPct(const std::vector<SpeedSample>& probes);
+// Probes further apart than this (or a run this far off its calibration's reference): the
+// machine was unsteady (calibrate, run, validate).
+inline constexpr double kUnsteadySpeedPct = 10.0;
 
 }  // namespace qvr::cli

@@ -1362,23 +1362,35 @@ Expected<SpeedSample> SpeedProbe::measure() {
     return m_impl->child->probe();
 }
 
+std::array<double, 2> speedProbesSpreadPct(const std::vector<SpeedSample>& probes) {
+    std::array<double, 2> out = {0.0, 0.0};
+    if (probes.size() < 2)
+        return out;
+    for (size_t side = 0; side < 2; ++side) {
+        double lo = 1e300, hi = 0.0;
+        for (const SpeedSample& p : probes) {
+            const double v = side == 0 ? p.headset_ms : p.server_ms;
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+        out[side] = 100.0 * (hi / lo - 1.0);
+    }
+    return out;
+}
+
 std::string speedProbesText(const std::vector<SpeedSample>& probes) {
     std::string s;
-    double lo_h = 1e300, hi_h = 0.0, lo_s = 1e300, hi_s = 0.0;
-    for (const SpeedSample& p : probes) {
+    for (const SpeedSample& p : probes)
         s += fmt::format("{}{:.2f}/{:.2f}", s.empty() ? "" : ", ", p.headset_ms, p.server_ms);
-        lo_h = std::min(lo_h, p.headset_ms);
-        hi_h = std::max(hi_h, p.headset_ms);
-        lo_s = std::min(lo_s, p.server_ms);
-        hi_s = std::max(hi_s, p.server_ms);
-    }
     if (probes.size() < 2)
         return s + " ms headset/server";
-    const double spread = 100.0 * std::max(hi_h / lo_h, hi_s / lo_s) - 100.0;
+    const auto sp = speedProbesSpreadPct(probes);
+    const double spread = std::max(sp[0], sp[1]);
     return s + fmt::format(" ms headset/server; spread {:.0f}%{}", spread,
-                           spread > 10.0 ? " (the machine was unsteady while it was measured: "
-                                           "calibrate again on a steady one)"
-                                         : "");
+                           spread > kUnsteadySpeedPct
+                               ? " (the machine was unsteady while it was measured: "
+                                 "calibrate again on a steady one)"
+                               : "");
 }
 
 }  // namespace qvr::cli

@@ -969,18 +969,9 @@ int runRun(const RunOptions& o) {
             speed_over_reference[0] /= calibrated.speed_reference_headset_ms;
             speed_over_reference[1] /= calibrated.speed_reference_server_ms;
         }
-        if (all.size() >= 2)
-            for (int side = 0; side < 2; ++side) {
-                double lo = 1e300, hi = 0.0;
-                for (const SpeedSample& p : all) {
-                    const double v = side == 0 ? p.headset_ms : p.server_ms;
-                    lo = std::min(lo, v);
-                    hi = std::max(hi, v);
-                }
-                speed_spread_pct[static_cast<size_t>(side)] = 100.0 * (hi / lo - 1.0);
-            }
+        speed_spread_pct = speedProbesSpreadPct(all);
     }
-    constexpr double kUnsteadyPct = 10.0;
+    constexpr double kUnsteadyPct = kUnsteadySpeedPct;
     const bool unsteady = std::max(speed_spread_pct[0], speed_spread_pct[1]) > kUnsteadyPct;
     // A second Ctrl-C while the report is written ends the process at once.
     std::signal(SIGINT, SIG_DFL);

@@ -199,25 +199,23 @@ double calibrationSpreadPct(const std::string& json_path) {
                                       .value("probes", nlohmann::json::array());
     if (!probes.is_array() || probes.size() < 2)
         return NAN;
-    double d = NAN;
-    for (const char* side : {"headset_frame_ms", "server_frame_ms"}) {
-        double lo = INFINITY, hi = 0.0;
-        for (const nlohmann::json& p : probes) {
-            const double v = p.value(side, NAN);
-            if (!(v > 0.0))
-                return NAN;
-            lo = std::min(lo, v);
-            hi = std::max(hi, v);
-        }
-        d = std::fmax(d, 100.0 * (hi / lo - 1.0));
+    std::vector<SpeedSample> samples;
+    for (const nlohmann::json& p : probes) {
+        SpeedSample s;
+        s.headset_ms = p.value("headset_frame_ms", NAN);
+        s.server_ms = p.value("server_frame_ms", NAN);
+        if (!(s.headset_ms > 0.0) || !(s.server_ms > 0.0))
+            return NAN;
+        samples.push_back(s);
     }
-    return d;
+    const auto sp = speedProbesSpreadPct(samples);
+    return std::max(sp[0], sp[1]);
 }
 
 // Steady by the speed probes: within 10%, or no probe taken (NaN: nothing to tell, so a take
 // without probes is never taken again).
 bool steadyByProbes(double pct) {
-    return !std::isfinite(pct) || pct <= 10.0;
+    return !std::isfinite(pct) || pct <= kUnsteadySpeedPct;
 }
 
 // What follows a take's "done": how far its probes moved, and whether it is taken again.
@@ -476,7 +474,7 @@ int runValidate(const ValidateOptions& o) {
                     }
                     if (best.is_null())
                         continue;
-                    if (std::isfinite(best_disturbance) && best_disturbance > 10.0)
+                    if (std::isfinite(best_disturbance) && best_disturbance > kUnsteadySpeedPct)
                         ++still_unsteady;
                     {
                         const nlohmann::json spread_pct =
@@ -494,7 +492,8 @@ int runValidate(const ValidateOptions& o) {
                     addRun(rows, &order, best, scene, link, depth);
                     ++counted;
                     addRun(rows_first, nullptr, first, scene, link, depth);
-                    if (best_disturbance <= 10.0) {  // NaN (no probes): not judged, not in it
+                    if (best_disturbance <=
+                        kUnsteadySpeedPct) {  // NaN (no probes): not judged, not in it
                         addRun(rows_steady, nullptr, best, scene, link, depth);
                         ++counted_steady;
                     }
@@ -560,8 +559,9 @@ int runValidate(const ValidateOptions& o) {
         cell(mean(abs_bytes), "{:.1f}%"), cell(worst(abs_bytes), "{:.1f}%"),
         cell(mean(abs_e1), "{:.1f}°"), cell(worst(abs_e1), "{:.1f}°"), order.size(), failures,
         seconds);
-    const size_t unsteady = static_cast<size_t>(std::count_if(
-        run_speed_spread.begin(), run_speed_spread.end(), [](double x) { return x > 10.0; }));
+    const size_t unsteady =
+        static_cast<size_t>(std::count_if(run_speed_spread.begin(), run_speed_spread.end(),
+                                          [](double x) { return x > kUnsteadySpeedPct; }));
     // The first takes alone, so that what the retakes changed is on the sheet.
     std::vector<double> abs_fps_first;
     for (const std::string& key : order)
