@@ -42,10 +42,14 @@ Outcome run(const std::string& args) {
     const int raw = std::system(cmd.c_str());
     Outcome o;
     o.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    std::ifstream in(err_file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    o.err = ss.str();
+    {
+        std::ifstream in(err_file);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        o.err = ss.str();
+    }
+    std::error_code ec;
+    fs::remove_all(tmp, ec);  // nothing of a test left in the temporary directory
     return o;
 }
 

@@ -28,6 +28,17 @@ std::string tempPath(const std::string& name) {
         .string();
 }
 
+// Removes the motion file writeMotion leaves for the recordings once every test has run.
+class RemoveMotionFile : public ::testing::Environment {
+public:
+    void TearDown() override {
+        std::error_code ec;
+        std::filesystem::remove(tempPath("motion.csv"), ec);
+    }
+};
+const ::testing::Environment* const g_remove_motion =
+    ::testing::AddGlobalTestEnvironment(new RemoveMotionFile);
+
 // A head that turns 20°/s and walks a little, as a pose CSV (no mocap file needed).
 std::string writeMotion(int frames) {
     PoseTrace t;
