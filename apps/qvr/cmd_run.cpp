@@ -971,8 +971,7 @@ int runRun(const RunOptions& o) {
         }
         speed_spread_pct = speedProbesSpreadPct(all);
     }
-    constexpr double kUnsteadyPct = kUnsteadySpeedPct;
-    const bool unsteady = std::max(speed_spread_pct[0], speed_spread_pct[1]) > kUnsteadyPct;
+    const bool unsteady = std::max(speed_spread_pct[0], speed_spread_pct[1]) > kUnsteadySpeedPct;
     // A second Ctrl-C while the report is written ends the process at once.
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
@@ -1682,7 +1681,7 @@ int runRun(const RunOptions& o) {
                 "between designs, over {:.0f}%): a design's FPS moves with it within the seconds "
                 "it runs, which no prediction made around it follows; measure on a steady "
                 "machine to judge the model (summary.json calibration.speed_reference)\n",
-                std::max(speed_spread_pct[0], speed_spread_pct[1]), kUnsteadyPct);
+                std::max(speed_spread_pct[0], speed_spread_pct[1]), kUnsteadySpeedPct);
     }
     if (const double off = std::max(std::fabs(speed_over_reference[0] - 1.0),
                                     std::fabs(speed_over_reference[1] - 1.0));

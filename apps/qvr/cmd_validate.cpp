@@ -474,7 +474,7 @@ int runValidate(const ValidateOptions& o) {
                     }
                     if (best.is_null())
                         continue;
-                    if (std::isfinite(best_disturbance) && best_disturbance > kUnsteadySpeedPct)
+                    if (!steadyByProbes(best_disturbance))
                         ++still_unsteady;
                     {
                         const nlohmann::json spread_pct =
@@ -492,8 +492,8 @@ int runValidate(const ValidateOptions& o) {
                     addRun(rows, &order, best, scene, link, depth);
                     ++counted;
                     addRun(rows_first, nullptr, first, scene, link, depth);
-                    if (best_disturbance <=
-                        kUnsteadySpeedPct) {  // NaN (no probes): not judged, not in it
+                    // NaN (no probes): not judged, so not in the steady runs' sheet either.
+                    if (best_disturbance <= kUnsteadySpeedPct) {
                         addRun(rows_steady, nullptr, best, scene, link, depth);
                         ++counted_steady;
                     }
