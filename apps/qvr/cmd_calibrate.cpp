@@ -123,7 +123,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 14;
+    constexpr int kCalibrationVersion = 15;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -193,6 +193,10 @@ nlohmann::json Calibration::toJson() const {
             {"bits_mean_over_geometric", bits_mean_over_geometric},
             {"bits_full_frame_per_px", costs.bits_full_frame_per_px},
             {"bits_full_frame_samples", bits_full_frame_samples},
+            {"bits_frame",
+             {{"content_key", costs.bits_frame_key},
+              {"middle_over_law", costs.bits_frame_middle},
+              {"outer_over_law", costs.bits_frame_outer}}},
             {"keyframe_bits_ratio", costs.keyframe_bits_ratio},
             {"keyframe_outer_bits_ratio", costs.keyframe_outer_bits_ratio},
             {"padding_bits_ratio", costs.padding_bits_ratio},
@@ -217,6 +221,45 @@ nlohmann::json Calibration::toJson() const {
                }()}}}};
 }
 
+namespace {
+
+// The frame-by-frame bits in a line: how many frames, and the middle's and outer's mean over
+// the law in the motion's first second (frames up to 30) and after it, with their range.
+std::string bitsByFrameText(const RuntimeCosts& c) {
+    std::array<std::array<double, 3>, 4> acc{};  // {sum, min, max} middle/outer × early/late
+    std::array<int, 2> n{};
+    for (auto& a : acc)
+        a = {0.0, 1e9, 0.0};
+    for (size_t k = 0; k < c.bits_frame_key.size(); ++k) {
+        if (c.bits_frame_key[k] == 0.0)
+            continue;
+        const size_t late = k < 30 ? 0 : 1;
+        ++n[late];
+        for (size_t li = 0; li < 2; ++li) {
+            const double f = li == 0 ? c.bits_frame_middle[k] : c.bits_frame_outer[k];
+            auto& a = acc[li * 2 + late];
+            a[0] += f;
+            a[1] = std::min(a[1], f);
+            a[2] = std::max(a[2], f);
+        }
+    }
+    if (n[0] + n[1] == 0)
+        return "none (the law alone)";
+    auto part = [&](size_t late, const char* what) {
+        if (n[late] == 0)
+            return std::string();
+        return fmt::format(
+            "{} {} frames: middle {:.3f}x [{:.2f}, {:.2f}], outer {:.3f}x "
+            "[{:.2f}, {:.2f}]",
+            what, n[late], acc[late][0] / n[late], acc[late][1], acc[late][2],
+            acc[2 + late][0] / n[late], acc[2 + late][1], acc[2 + late][2]);
+    };
+    std::string early = part(0, "frames < 30,"), later = part(1, "frames >= 30,");
+    return early + (early.empty() || later.empty() ? "" : "; ") + later + " of the law";
+}
+
+}  // namespace
+
 std::string Calibration::toToml() const {
     std::string s = fmt::format(
         "# qvr calibrate: this machine's runtime costs (docs/MODEL.md §8).\n# {}\n# {}, {:.0f} s, "
@@ -237,6 +280,7 @@ std::string Calibration::toToml() const {
         bits_mean_over_geometric[1]);
     s += fmt::format("# bits per whole-frame pixel (remote's layer): {:.4f}, over {} P-frames\n",
                      costs.bits_full_frame_per_px, bits_full_frame_samples);
+    s += "# bits frame by frame on the calibration's motion: " + bitsByFrameText(costs) + "\n";
     s += fmt::format(
         "# key frame of a new encoder: {:.2f}x a P-frame's bits (middle), {:.2f}x (outer); "
         "periodic: {:.2f}x; padding beyond the snug canvas: {:.3f} of a layer pixel's bits per "
@@ -982,7 +1026,9 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             std::array<std::vector<double>, 2> bits_px;  // this e1's P-frames: middle, outer
             std::array<double, 2> scale{};
             for (int step = 0; step < pass_frames; ++step) {
-                const double t_ms = frame_ms * step;
+                // As `qvr run` times its frame `step` (its prediction's trace), to the last bit:
+                // the frame-by-frame bits below apply where the head poses agree.
+                const double t_ms = 1000.0 * static_cast<double>(step) / profile->refresh_hz;
                 const Pose head = poseAt(inputs->traces.motion, t_ms);
                 const Gaze gaze = gazeAt(inputs->traces.gaze, t_ms);
                 const LayerPlan plan = planner.plan(gaze, e1);
@@ -1030,7 +1076,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                                                           double(rect.pixels()));
                             scale[size_t(li)] = rect.scale;
                             bits[middle ? 0 : 1].push_back({rect.scale, double(rect.pixels()),
-                                                            8.0 * double(enc->bytes.size())});
+                                                            8.0 * double(enc->bytes.size()), step});
                             p_bytes[sid].push_back(double(enc->bytes.size()));
                         }
                         Chain& pc = padded[sid];
@@ -1185,6 +1231,45 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
         cal.bits_mean_over_geometric[static_cast<size_t>(li)] =
             law.bits_per_px_at_1 / law.geometric_b;
         cal.bits_samples += static_cast<int>(bits[static_cast<size_t>(li)].size());
+    }
+    // Frame by frame: what each motion frame's layers spent, over every e1 and both eyes, over
+    // what the law gives the same layers. The law is their mean; a 40-frame run measures the
+    // motion's densest second, whose P-frames sit 12–15% over it (docs/MODEL.md §8 "Bits frame
+    // by frame").
+    {
+        const int frames = o.quick ? 40 : 120;
+        std::array<std::vector<double>, 2> spent, law_bits;
+        for (int li = 0; li < 2; ++li) {
+            spent[size_t(li)].assign(size_t(frames), 0.0);
+            law_bits[size_t(li)].assign(size_t(frames), 0.0);
+            for (const BitsSample& b : bits[size_t(li)]) {
+                if (b.frame < 0 || b.frame >= frames)
+                    continue;
+                spent[size_t(li)][size_t(b.frame)] += b.bits;
+                law_bits[size_t(li)][size_t(b.frame)] +=
+                    b.pixels * cal.costs.bitsPerPx(b.scale, li == 1);
+            }
+        }
+        RuntimeCosts& rc = cal.costs;
+        rc.bits_frame_key.assign(size_t(frames), 0.0);
+        rc.bits_frame_middle.assign(size_t(frames), 1.0);
+        rc.bits_frame_outer.assign(size_t(frames), 1.0);
+        for (int k = 0; k < frames; ++k) {
+            const size_t i = size_t(k);
+            if (!(law_bits[0][i] > 0.0) || !(law_bits[1][i] > 0.0) || !(spent[0][i] > 0.0) ||
+                !(spent[1][i] > 0.0))
+                continue;  // the warm-up's frames, a key frame: the law alone
+            const double t_ms = 1000.0 * static_cast<double>(k) / profile->refresh_hz;
+            rc.bits_frame_key[i] = double(frameContentKey(poseAt(inputs->traces.motion, t_ms)));
+            rc.bits_frame_middle[i] = std::clamp(spent[0][i] / law_bits[0][i], 0.05, 20.0);
+            rc.bits_frame_outer[i] = std::clamp(spent[1][i] / law_bits[1][i], 0.05, 20.0);
+        }
+        // The hardware file holds only the frames measured: trailing law-only frames are dropped.
+        while (!rc.bits_frame_key.empty() && rc.bits_frame_key.back() == 0.0) {
+            rc.bits_frame_key.pop_back();
+            rc.bits_frame_middle.pop_back();
+            rc.bits_frame_outer.pop_back();
+        }
     }
     // The render passes may follow the power law (llvmpipe's fovea pass is not linear over
     // 3 kpx … 4 Mpx); the whole frame gets its own scale (MODEL.md §8).
@@ -1443,6 +1528,8 @@ int runCalibrate(CalibrateCmdOptions& o) {
         cal->padding_samples);
     fmt::print("  codec: P-frame bits per whole-frame pixel (remote) {:.4f} ({} P-frames)\n",
                cal->costs.bits_full_frame_per_px, cal->bits_full_frame_samples);
+    fmt::print("  codec: bits frame by frame on the calibration's motion: {}\n",
+               bitsByFrameText(cal->costs));
     fmt::print("  co-running, headset: {}\n", cal->corun_headset.note);
     fmt::print("  co-running, server: {}\n", cal->corun_server.note);
     fmt::print(

@@ -1063,6 +1063,7 @@ int runRun(const RunOptions& o) {
     const RuntimeCosts& rcosts = calibration->hardware.runtime;
     Expected<WorkloadTrace> trace = makeError("no workload");
     std::string trace_source;
+    size_t bits_frames_own = 0;  // predicted frames charged the calibration's own bits for them
     auto draw_list = std::make_shared<DrawList>(buildDrawList(*scene));
     if (o.lod_px > 0.0f)
         buildLods(*draw_list, *scene);
@@ -1107,15 +1108,20 @@ int runRun(const RunOptions& o) {
             for (size_t k = 0; k < wf.bits_per_pixel.size(); ++k)
                 wf.bits_per_pixel[k] = rcosts.bits_per_px_at_1 *
                                        std::pow(t.header.scales[k], rcosts.bits_scale_exponent);
+            // The calibration coded this very head pose as its frame i: the frame's own bits.
+            if (rcosts.bitsFrameMeasured(i, frameContentKey(wf.head)))
+                ++bits_frames_own;
             t.frames.push_back(std::move(wf));
         }
         trace = std::move(t);
         trace_source = fmt::format(
             "the run's poses and gazes, {} ring counts computed after the run ({:.1f} s), bits "
-            "per pixel from the calibration; layer triangles drawn (LOD, holes) counted off the "
-            "clock",
+            "per pixel from the calibration ({} of {} frames their own, coded by the calibration "
+            "on the same head pose; the rest its law); layer triangles drawn (LOD, holes) counted "
+            "off the clock",
             o.ring_counts,
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+            bits_frames_own, predict_frames);
     } else if (recorded_workload) {
         trace = loadWorkloadTrace(workload_path.string());
         trace_source = "workload.jsonl recorded by the qvr design";
@@ -1344,9 +1350,10 @@ int runRun(const RunOptions& o) {
                       sim_json["remote"]["bytes_per_frame_mean"].get<double>();
     j["ratios"] = ratios;
     j["sim_prediction"] = sim_json;  // the paper-hardware model, as before
-    j["calibration"] = {{"source", calibration->source},   {"path", calibration->path},
-                        {"seconds", calibration->seconds}, {"note", calibration->note},
-                        {"workload", trace_source},        {"pipeline_depth", o.pipeline_depth}};
+    j["calibration"] = {{"source", calibration->source},      {"path", calibration->path},
+                        {"seconds", calibration->seconds},    {"note", calibration->note},
+                        {"bits_frames_own", bits_frames_own}, {"workload", trace_source},
+                        {"pipeline_depth", o.pipeline_depth}};
     // The speed reference the per-design probes (designs.<d>.speed) are read against.
     j["calibration"]["speed_reference"] = {
         {"headset_frame_ms", calibrated.speed_reference_headset_ms},

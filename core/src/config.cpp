@@ -123,6 +123,40 @@ std::string ConfigReader::string(std::string_view path, std::string default_valu
     return *node.value<std::string>();
 }
 
+std::vector<double> ConfigReader::numbers(std::string_view path, double min_value, double max_value,
+                                          size_t max_count) {
+    markUsed(path);
+    const auto node = m_table.at_path(path);
+    if (!node)
+        return {};
+    const toml::array* arr = node.as_array();
+    if (!arr) {
+        fail(fmt::format("'{}' must be an array of numbers", path));
+        return {};
+    }
+    if (arr->size() > max_count) {
+        fail(fmt::format("'{}' has {} values, more than {}", path, arr->size(), max_count));
+        return {};
+    }
+    std::vector<double> out;
+    out.reserve(arr->size());
+    for (size_t i = 0; i < arr->size(); ++i) {
+        const toml::node& e = *arr->get(i);
+        std::optional<double> v = e.value<double>();
+        if (!v || !(e.is_floating_point() || e.is_integer())) {
+            fail(fmt::format("'{}'[{}] must be a number", path, i));
+            return {};
+        }
+        if (!std::isfinite(*v) || *v < min_value || *v > max_value) {
+            fail(fmt::format("'{}'[{}] = {} is outside [{}, {}]", path, i, *v, min_value,
+                             max_value));
+            return {};
+        }
+        out.push_back(*v);
+    }
+    return out;
+}
+
 Status ConfigReader::finish() {
     // Walk every key of the file; anything not asked for is unknown.
     std::function<void(const toml::table&, const std::string&)> walk =

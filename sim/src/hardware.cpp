@@ -2,6 +2,8 @@
 // sources: docs/MODEL.md.
 #include "qvr/sim/hardware.h"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "qvr/core/config.h"
@@ -164,8 +166,24 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     rc.speed_reference_server_ms =
         r.number("runtime.speed_reference_server_ms", rc.speed_reference_server_ms, 0.0, 1e5);
     rc.speed_reference_key = r.string("runtime.speed_reference_key", rc.speed_reference_key);
+    constexpr size_t kMaxFrames = 100000;
+    rc.bits_frame_key = r.numbers("runtime.bits_frame_key", 0.0, 4294967295.0, kMaxFrames);
+    rc.bits_frame_middle = r.numbers("runtime.bits_frame_middle", 0.05, 20.0, kMaxFrames);
+    rc.bits_frame_outer = r.numbers("runtime.bits_frame_outer", 0.05, 20.0, kMaxFrames);
     if (auto st = r.finish(); !st)
         return makeError(st.error());
+    for (double k : rc.bits_frame_key)
+        if (k != std::floor(k))
+            return makeError(std::string(source_name) +
+                             ": runtime.bits_frame_key must hold integers, got " +
+                             fmt::format("{}", k));
+    if (rc.bits_frame_middle.size() != rc.bits_frame_key.size() ||
+        rc.bits_frame_outer.size() != rc.bits_frame_key.size())
+        return makeError(fmt::format(
+            "{}: runtime.bits_frame_key, bits_frame_middle and bits_frame_outer must be as long "
+            "as one another, got {}, {} and {}",
+            source_name, rc.bits_frame_key.size(), rc.bits_frame_middle.size(),
+            rc.bits_frame_outer.size()));
     return hw;
 }
 
@@ -230,6 +248,17 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
         put("corun_headset_slowdown", c.corun_headset_slowdown);
     if (c.corun_server_slowdown > 0.0)
         put("corun_server_slowdown", c.corun_server_slowdown);
+    if (!c.bits_frame_key.empty()) {
+        auto putArray = [&](const char* key, const std::vector<double>& v, const char* f) {
+            s += fmt::format("{} = [", key);
+            for (size_t i = 0; i < v.size(); ++i)
+                s += fmt::format(fmt::runtime(i ? std::string(", ") + f : std::string(f)), v[i]);
+            s += "]\n";
+        };
+        putArray("bits_frame_key", c.bits_frame_key, "{:.0f}");
+        putArray("bits_frame_middle", c.bits_frame_middle, "{:.4f}");
+        putArray("bits_frame_outer", c.bits_frame_outer, "{:.4f}");
+    }
     if (c.speed_reference_headset_ms > 0.0 && c.speed_reference_server_ms > 0.0) {
         put("speed_reference_headset_ms", c.speed_reference_headset_ms);
         put("speed_reference_server_ms", c.speed_reference_server_ms);

@@ -367,9 +367,17 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
                 jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true,
                                 eye * 2, header.profile.width_px, header.profile.height_px});
         } else {
+            // The calibration's own frame j, where this frame's head pose is the one it coded: its
+            // bits over the law (RuntimeCosts::bitsFrameFactor).
+            const uint32_t key = c.bits_frame_key.empty() ? 0u : frameContentKey(wf.head);
+            const double f_mid =
+                c.bits_per_px_at_1 > 0.0 ? c.bitsFrameFactor(size_t(j), key, false) : 1.0;
+            const double f_out =
+                c.bits_per_px_at_1 > 0.0 ? c.bitsFrameFactor(size_t(j), key, true) : 1.0;
             const PeripheryBytes pb = {
-                2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1, false) / 8.0,
-                2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2, true) / 8.0};
+                2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1, false) * f_mid /
+                    8.0,
+                2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2, true) * f_out / 8.0};
             const double mid_tris =
                 sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e2_deg);
             for (int eye = 0; eye < 2; ++eye) {

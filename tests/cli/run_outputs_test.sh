@@ -138,6 +138,21 @@ if ! timeout 120 "$QVR" calibrate --quick --profile small --out "$tmp/small.toml
     exit 1
 fi
 grep -q '^speed_reference_key = "' "$tmp/small.toml" || { echo "FAIL: no speed reference key"; exit 1; }
+# The codec's bits frame by frame on the calibration's own motion (version 15): --quick codes 40
+# frames, its warm-up (10) the law alone, so 30 frames carry a content key and their factors.
+python3 - "$tmp/small.toml" <<'PY' || exit 1
+import sys, tomllib
+r = tomllib.load(open(sys.argv[1], "rb"))["runtime"]
+keys, mid, out = r["bits_frame_key"], r["bits_frame_middle"], r["bits_frame_outer"]
+assert len(keys) == len(mid) == len(out) == 40, (len(keys), len(mid), len(out))
+assert all(k == 0 for k in keys[:10]) and all(k > 0 for k in keys[10:]), keys
+assert len(set(keys[10:])) == 30, "each frame's head pose its own key"
+assert all(0.05 <= f <= 20 for f in mid + out), (mid, out)
+m = sum(mid[10:]) / 30
+assert 0.5 < m < 2, m  # the law is their mean over the frames measured
+print("PASS: the calibration keeps its bits frame by frame (middle %.3f-%.3f of the law)"
+      % (min(mid[10:]), max(mid[10:])))
+PY
 # A probe that cannot start (its core does not exist) leaves the file without a reference, and
 # the calibration says why; the costs are still measured.
 if ! timeout 120 "$QVR" calibrate --quick --profile small --core 4095 --out "$tmp/noprobe.toml" \
@@ -195,6 +210,9 @@ assert "at the probes' speed" in html and "speed ×" in html, "no speed in the r
 o = json.load(open(sys.argv[2]))
 assert "another machine" in o["calibration"]["speed_reference"]["note"], o["calibration"]
 assert "headset_factor" not in o["designs"]["qvr"]["speed"], o["designs"]["qvr"]
+# The run's motion is the calibration's: its frames 10-23 are charged their own bits.
+assert d["calibration"]["bits_frames_own"] == 14, d["calibration"]["bits_frames_own"]
+assert o["calibration"]["bits_frames_own"] == 14, o["calibration"]["bits_frames_own"]
 print("PASS: beside each design's prediction, one at its probes' speed (local x%.3f/x%.3f); "
       "another key gets no probes" % (d["designs"]["local"]["speed"]["headset_factor"],
                                                d["designs"]["local"]["speed"]["server_factor"]))

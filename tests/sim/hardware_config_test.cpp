@@ -78,6 +78,9 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.speed_reference_headset_ms = 9.5;
     c.speed_reference_server_ms = 21.25;
     c.speed_reference_key = "0123456789abcdef";
+    c.bits_frame_key = {0.0, 4294967295.0, 17.0};
+    c.bits_frame_middle = {1.0, 1.25, 0.875};
+    c.bits_frame_outer = {1.0, 0.5, 19.5};
     auto hw = parseHardwareConfig(runtimeCostsToml(c), "cal.toml", 500.0);
     ASSERT_TRUE(hw.ok()) << hw.error();
     EXPECT_TRUE(hw->runtime_pipeline);
@@ -106,6 +109,18 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.speed_reference_headset_ms, 9.5);
     EXPECT_EQ(hw->runtime.speed_reference_server_ms, 21.25);
     EXPECT_EQ(hw->runtime.speed_reference_key, "0123456789abcdef");
+    EXPECT_EQ(hw->runtime.bits_frame_key, c.bits_frame_key);
+    EXPECT_EQ(hw->runtime.bits_frame_middle, c.bits_frame_middle);
+    EXPECT_EQ(hw->runtime.bits_frame_outer, c.bits_frame_outer);
+    EXPECT_EQ(hw->runtime.bitsFrameFactor(1, 4294967295u, false), 1.25);
+    EXPECT_EQ(hw->runtime.bitsFrameFactor(1, 4294967295u, true), 0.5);
+    EXPECT_EQ(hw->runtime.bitsFrameFactor(1, 16u, true), 1.0);   // another pose: the law
+    EXPECT_EQ(hw->runtime.bitsFrameFactor(0, 0u, false), 1.0);   // not measured
+    EXPECT_EQ(hw->runtime.bitsFrameFactor(3, 17u, false), 1.0);  // past the frames measured
+    // Without frame-by-frame bits (a calibration before version 15) none are written.
+    RuntimeCosts law_only = c;
+    law_only.bits_frame_key.clear();
+    EXPECT_EQ(runtimeCostsToml(law_only).find("bits_frame"), std::string::npos);
     // Without a speed reference (a calibration before version 14) none is written or read.
     RuntimeCosts no_speed = c;
     no_speed.speed_reference_headset_ms = 0.0;
@@ -157,7 +172,23 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\nfovea_tri_exponent = \"x\"\n",
                             "[runtime]\nspeed_reference_headset_ms = -1\n",
                             "[runtime]\nspeed_reference_server_ms = \"fast\"\n",
-                            "[runtime]\nspeed_reference_key = 12\n"}) {
+                            "[runtime]\nspeed_reference_key = 12\n",
+                            "[runtime]\nbits_frame_key = 3\n",
+                            "[runtime]\nbits_frame_key = [\"a\"]\n"
+                            "bits_frame_middle = [1.0]\nbits_frame_outer = [1.0]\n",
+                            "[runtime]\nbits_frame_key = [1.5]\n"
+                            "bits_frame_middle = [1.0]\nbits_frame_outer = [1.0]\n",
+                            "[runtime]\nbits_frame_key = [-1]\n"
+                            "bits_frame_middle = [1.0]\nbits_frame_outer = [1.0]\n",
+                            "[runtime]\nbits_frame_key = [4294967296]\n"
+                            "bits_frame_middle = [1.0]\nbits_frame_outer = [1.0]\n",
+                            "[runtime]\nbits_frame_key = [1, 2]\n"
+                            "bits_frame_middle = [1.0]\nbits_frame_outer = [1.0, 1.0]\n",
+                            "[runtime]\nbits_frame_key = [1]\n"
+                            "bits_frame_middle = [0.01]\nbits_frame_outer = [1.0]\n",
+                            "[runtime]\nbits_frame_key = [1]\n"
+                            "bits_frame_middle = [1.0]\nbits_frame_outer = [21]\n",
+                            "[runtime]\nbits_frame_middle = [1.0]\n"}) {
         auto r = parseHardwareConfig(bad, "bad.toml", 500.0);
         EXPECT_FALSE(r.ok()) << bad;
         if (!r.ok()) {

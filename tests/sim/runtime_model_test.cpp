@@ -118,6 +118,41 @@ TEST(RuntimeModel, TheMiddleAndOuterLayersTakeTheirOwnBitsLaw) {
     EXPECT_NEAR(run(Design::Ffr, c, 2, 20).summary.bytes_per_frame_mean, one_law, 1e-6 * one_law);
 }
 
+TEST(RuntimeModel, AFrameTheCalibrationCodedTakesItsOwnBitsOverTheLaw) {
+    // The calibration's frame-by-frame bits (calibration version 15): frame k's middle and
+    // outer layers spend the law times the calibration's factors for its frame k, but only
+    // where frame k's head pose is the one the calibration coded (its content key); anywhere
+    // else, and past the frames it measured, the law alone.
+    RuntimeCosts c = flatCosts(1.0, 1.0, 1.0);
+    c.bits_per_px_at_1 = 0.4;
+    c.bits_outer_per_px_at_1 = 0.1;
+    const double key = double(frameContentKey(Pose{}));  // every flat frame's head pose
+    Pose moved;
+    moved.position_m.x = 0.5f;
+    ASSERT_NE(frameContentKey(moved), frameContentKey(Pose{}));
+    c.bits_frame_key = {0.0, key, double(frameContentKey(moved)), key};
+    c.bits_frame_middle = {5.0, 1.5, 2.0, 1.0};
+    c.bits_frame_outer = {5.0, 0.5, 2.0, 3.0};
+    const WorkloadTrace trace = flatTrace(8);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(Gaze{}, 5.0);
+    const double middle = 2.0 * double(plan.middle_pixels) * 0.4 / 8.0;  // both eyes; γ = 0
+    const double outer = 2.0 * double(plan.outer_pixels) * 0.1 / 8.0;
+    const RuntimeRunResult r = run(Design::Ffr, c, 2, 8);
+    ASSERT_EQ(r.frames.size(), 8u);
+    for (const RuntimeFrame& f : r.frames) {
+        const double want = f.index == 1   ? 1.5 * middle + 0.5 * outer
+                            : f.index == 3 ? middle + 3.0 * outer
+                                           : middle + outer;
+        EXPECT_NEAR(f.bytes, want, 1e-6 * want) << "frame " << f.index;
+    }
+    // remote's whole frame keeps its own measured bits per pixel.
+    c.bits_full_frame_per_px = 0.15;
+    const double eye_px =
+        double(trace.header.profile.width_px) * double(trace.header.profile.height_px);
+    for (const RuntimeFrame& f : run(Design::Remote, c, 2, 8).frames)
+        EXPECT_NEAR(f.bytes, 2.0 * eye_px * 0.15 / 8.0, 1e-6 * eye_px) << "frame " << f.index;
+}
+
 TEST(RuntimeModel, RemotesWholeFrameTakesItsOwnMeasuredBitsPerPixel) {
     // remote sends one layer per eye at scale 1: its measured bits per pixel when the
     // calibration has it, else the layers' law at scale 1.

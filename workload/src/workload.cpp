@@ -33,6 +33,23 @@ double sumTotal(const std::vector<double>& per_ring) {
     return sum;
 }
 
+uint32_t frameContentKey(const Pose& head) {
+    const double values[] = {head.position_m.x * 1e4,  head.position_m.y * 1e4,
+                             head.position_m.z * 1e4,  head.orientation.w * 1e5,
+                             head.orientation.x * 1e5, head.orientation.y * 1e5,
+                             head.orientation.z * 1e5};
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the rounded values
+    for (double v : values) {
+        const int64_t q = std::isfinite(v) ? std::llround(v) : 0;
+        for (int b = 0; b < 8; ++b) {
+            h ^= static_cast<uint64_t>(q >> (8 * b)) & 0xffu;
+            h *= 1099511628211ull;
+        }
+    }
+    const auto key = static_cast<uint32_t>(h ^ (h >> 32));
+    return key == 0 ? 1u : key;
+}
+
 double bitsPerPixelAt(const WorkloadHeader& header, const WorkloadFrame& frame, double scale) {
     const auto& s = header.scales;
     const auto& b = frame.bits_per_pixel;

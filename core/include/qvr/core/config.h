@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <toml++/toml.h>
 
@@ -29,6 +30,10 @@ public:
     double number(std::string_view path, double default_value, double min_value, double max_value);
     int integer(std::string_view path, int default_value, int min_value, int max_value);
     std::string string(std::string_view path, std::string default_value);
+    // An array of numbers, each within [min_value, max_value], at most max_count of them. Empty
+    // when absent; records an error (and returns empty) when present but not such an array.
+    std::vector<double> numbers(std::string_view path, double min_value, double max_value,
+                                size_t max_count);
     bool has(std::string_view path) const;
 
     // Fails if the file holds keys that nothing asked for.

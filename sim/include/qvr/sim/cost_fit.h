@@ -44,6 +44,7 @@ struct BitsSample {
     double scale = 1.0;
     double pixels = 0.0;
     double bits = 0.0;
+    int frame = -1;  // the motion frame it coded (-1: not one of a motion's frames)
 };
 
 // The bits law b·s^γ bits per layer pixel. geometric_b is what least squares on logs alone gives

@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "qvr/core/expected.h"
 #include "qvr/workload/cost_model.h"
@@ -142,6 +144,27 @@ struct RuntimeCosts {
                std::pow(std::max(scale, 1.0),
                         own ? bits_outer_scale_exponent : bits_scale_exponent);
     }
+    // The laws above are a mean over the calibration's motion; its frames do not cost alike (a
+    // default run's first second looks at denser geometry: its P-frames 12–15% over the mean).
+    // Frame by frame, on the calibration's own motion: bits_frame_key[k] is frame k's content
+    // key (frameContentKey of its head pose, 0: none measured) and
+    // bits_frame_middle[k] / bits_frame_outer[k] what its periphery layers spent over the law
+    // (calibration version 15, docs/MODEL.md §8 "Bits frame by frame"). Empty: the law alone.
+    std::vector<double> bits_frame_key;
+    std::vector<double> bits_frame_middle;
+    std::vector<double> bits_frame_outer;
+    // Whether the calibration coded this very content as its frame k.
+    bool bitsFrameMeasured(size_t frame, uint32_t content_key) const {
+        return frame < bits_frame_key.size() && bits_frame_key[frame] != 0.0 &&
+               bits_frame_key[frame] == double(content_key);
+    }
+    // Frame k's factor on the law (1 unless the calibration coded this very content at frame k).
+    double bitsFrameFactor(size_t frame, uint32_t content_key, bool outer) const {
+        if (!bitsFrameMeasured(frame, content_key))
+            return 1.0;
+        const std::vector<double>& f = outer ? bits_frame_outer : bits_frame_middle;
+        return frame < f.size() ? f[frame] : 1.0;
+    }
     // Each stream's canvas and key frames as the x264 encoder makes them (codec/video_codec.h
     // CodecConfig, core/canvas_policy.h), replayed per stream: a P-frame in a canvas larger than
     // the snug one the bits law was measured in pays padding_bits_ratio of a layer pixel's bits
@@ -268,7 +291,9 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             (0…1), canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
 //             keyframe_bits_ratio, keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio
 //             (0…1000), padding_bits_ratio (0…10), corun_slowdown, corun_headset_slowdown,
-//             corun_server_slowdown (1…4)
+//             corun_server_slowdown (1…4); bits_frame_key (arrays of integers 0…2^32−1),
+//             bits_frame_middle, bits_frame_outer (arrays of 0.05…20), as long as one another,
+//             at most 100000
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);

@@ -69,6 +69,13 @@ struct WorkloadTrace {
 double sumWithinDeg(const std::vector<double>& per_ring, double ring_deg, double e_deg);
 double sumTotal(const std::vector<double>& per_ring);
 
+// What a frame shows, as a 32-bit key (never 0) of its head pose rounded to 0.1 mm and 1e-5 of
+// a quaternion component: the calibration's bits frame by frame (RuntimeCosts::bits_frame_key)
+// apply to a run's frame only where the keys agree. Not the gaze: the periphery's two layers
+// together cover the whole view wherever the eye looks, and the calibration's gaze (seed 7) is
+// not a run's (seed 1).
+uint32_t frameContentKey(const Pose& head);
+
 // Bits per pixel at scale s, interpolated log-log between the header's scales and held
 // constant beyond either end.
 double bitsPerPixelAt(const WorkloadHeader& header, const WorkloadFrame& frame, double scale);
