@@ -1008,11 +1008,12 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     std::array<std::vector<double>, 2> key_ratio;  // a new encoder's IDR: middle, outer
     std::vector<double> periodic_ratio;            // the IDR at keyint_frames, both kinds
     nlohmann::json codec_by_e1 = nlohmann::json::array();
+    // The motion frames the codec pass codes (the frame-by-frame bits below are kept for them).
+    const int bits_frames = o.quick ? 40 : 120;
     {
         // One frame past keyint_frames when the pass reaches it: the periodic IDR of a running
         // stream costs less than a new encoder's first frame (3.9× against 7× a P-frame at
         // e1 = 5°, measured in a default run).
-        const int bits_frames = o.quick ? 40 : 120;
         const int pass_frames = codec.keyint_frames == bits_frames ? bits_frames + 1 : bits_frames;
         const int warmup = 10;
         std::array<Chain, 4> padded;
@@ -1026,9 +1027,9 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             std::array<std::vector<double>, 2> bits_px;  // this e1's P-frames: middle, outer
             std::array<double, 2> scale{};
             for (int step = 0; step < pass_frames; ++step) {
-                // As `qvr run` times its frame `step` (its prediction's trace), to the last bit:
-                // the frame-by-frame bits below apply where the head poses agree.
-                const double t_ms = 1000.0 * static_cast<double>(step) / profile->refresh_hz;
+                // As `qvr run` times its frame `step`: the frame-by-frame bits below apply where
+                // the head poses agree.
+                const double t_ms = contentTimeMs(step, profile->refresh_hz);
                 const Pose head = poseAt(inputs->traces.motion, t_ms);
                 const Gaze gaze = gazeAt(inputs->traces.gaze, t_ms);
                 const LayerPlan plan = planner.plan(gaze, e1);
@@ -1237,7 +1238,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // motion's densest second, whose P-frames sit 12–15% over it (docs/MODEL.md §8 "Bits frame
     // by frame").
     {
-        const int frames = o.quick ? 40 : 120;
+        const int frames = bits_frames;
         std::array<std::vector<double>, 2> spent, law_bits;
         for (int li = 0; li < 2; ++li) {
             spent[size_t(li)].assign(size_t(frames), 0.0);
@@ -1259,8 +1260,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
             if (!(law_bits[0][i] > 0.0) || !(law_bits[1][i] > 0.0) || !(spent[0][i] > 0.0) ||
                 !(spent[1][i] > 0.0))
                 continue;  // the warm-up's frames, a key frame: the law alone
-            const double t_ms = 1000.0 * static_cast<double>(k) / profile->refresh_hz;
-            rc.bits_frame_key[i] = double(frameContentKey(poseAt(inputs->traces.motion, t_ms)));
+            rc.bits_frame_key[i] = double(frameContentKey(
+                poseAt(inputs->traces.motion, contentTimeMs(k, profile->refresh_hz))));
             rc.bits_frame_middle[i] = std::clamp(spent[0][i] / law_bits[0][i], 0.05, 20.0);
             rc.bits_frame_outer[i] = std::clamp(spent[1][i] / law_bits[1][i], 0.05, 20.0);
         }

@@ -1075,7 +1075,7 @@ int runRun(const RunOptions& o) {
             frame, static_cast<int64_t>(std::llround(plan.e1_deg * 1000.0)), eye, kind);
         if (auto it = drawn_cache.find(cache_key); it != drawn_cache.end())
             return it->second;
-        const double content_ms = 1000.0 * double(frame) / profile->refresh_hz;
+        const double content_ms = contentTimeMs(frame, profile->refresh_hz);
         const LayerKind lk = kind == 0   ? LayerKind::kFovea
                              : kind == 1 ? LayerKind::kMiddle
                                          : LayerKind::kOuter;
@@ -1101,7 +1101,7 @@ int runRun(const RunOptions& o) {
                 predict_frames = std::max(predict_frames, r.result.frames.size());
         }
         for (size_t i = 0; i < predict_frames; ++i) {
-            const double content_ms = 1000.0 * static_cast<double>(i) / profile->refresh_hz;
+            const double content_ms = contentTimeMs(static_cast<int64_t>(i), profile->refresh_hz);
             WorkloadFrame wf =
                 probe.frame(static_cast<int64_t>(i), content_ms, poseAt(traces.motion, content_ms),
                             gazeAt(traces.gaze, content_ms), 180.0);

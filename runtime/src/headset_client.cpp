@@ -255,7 +255,7 @@ private:
             it = it->telemetry < m_frames_base ? m_pending.erase(it) : std::next(it);
     }
     int64_t rel(int64_t t_ns) const { return t_ns - m_origin_ns; }
-    double frameTimeMs(int64_t i) const { return 1000.0 * double(i) / m_config.profile.refresh_hz; }
+    double frameTimeMs(int64_t i) const { return contentTimeMs(i, m_config.profile.refresh_hz); }
 
     void tryConnect(bool force) {
         const int64_t now_ns = m_clock.nowNs();

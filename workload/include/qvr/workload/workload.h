@@ -75,6 +75,11 @@ double sumTotal(const std::vector<double>& per_ring);
 // together cover the whole view wherever the eye looks, and the calibration's gaze (seed 7) is
 // not a run's (seed 1).
 uint32_t frameContentKey(const Pose& head);
+// Frame i's time in its head motion and gaze, the one formula the headset, `qvr run`'s prediction
+// and the calibration all use, so their poses agree to the bit (and with them the keys above).
+inline double contentTimeMs(int64_t frame, double refresh_hz) {
+    return 1000.0 * static_cast<double>(frame) / refresh_hz;
+}
 
 // Bits per pixel at scale s, interpolated log-log between the header's scales and held
 // constant beyond either end.
