@@ -36,6 +36,7 @@ struct CalibratedPart {
     double residual_rms_pct = 0.0;                         // RMS of (measured − fit) / measured
     std::vector<std::array<double, 3>> samples_ms_px_tri;  // every sample, in the JSON
     std::vector<int> samples_full_frame;                   // 1 where that sample is a whole frame
+    std::vector<double> samples_fragments;  // its shaded fragments (−1: not counted)
 };
 
 // One speed probe (SpeedProbe below).

@@ -58,6 +58,12 @@ double msSince(Clock::time_point t0) {
 
 using Sample = CostSample;
 
+// A pass's shaded fragments for its cost sample; −1 (not counted) where the driver has no
+// pipeline statistics.
+double fragmentsOf(const RenderStats& st) {
+    return st.fragment_invocations > 0 ? double(st.fragment_invocations) : -1.0;
+}
+
 CalibratedPart summarise(const std::string& name, const std::string& what,
                          const std::vector<Sample>& s, const PartCost& cost) {
     CalibratedPart p;
@@ -77,6 +83,7 @@ CalibratedPart summarise(const std::string& name, const std::string& what,
     p.residual_rms_pct = costResidualRmsPct(s, cost);
     for (const Sample& x : s) {
         p.samples_ms_px_tri.push_back({x.ms, x.pixels, x.triangles});
+        p.samples_fragments.push_back(x.fragments);
         p.samples_full_frame.push_back(x.full_frame ? 1 : 0);
     }
     return p;
@@ -112,6 +119,9 @@ std::string costLawText(const PartCost& c) {
                                       c.px_exponent, c.tri_exponent)
                         : fmt::format("{:.3f} + {:.3f}·Mpx + {:.4f}·ktri", c.base_ms, c.ms_per_mpx,
                                       c.ms_per_ktri);
+    if (c.power_coef_ms <= 0.0 && c.ms_per_mfrag > 0.0)
+        s += fmt::format(" + {:.3f}·Mfrag ({:.2f} fragments a pixel)", c.ms_per_mfrag,
+                         c.frag_per_px);
     if (c.full_frame_scale != 1.0)
         s += fmt::format("; whole frame {:.3f}×", c.full_frame_scale);
     return s;
@@ -123,7 +133,7 @@ std::string machineDescriptionLine() {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // What the calibration measures and how; a cached calibration of another version is not reused.
-    constexpr int kCalibrationVersion = 15;
+    constexpr int kCalibrationVersion = 16;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescriptionLine(),
                     o.profile, o.scene, o.codec, o.lod_px, o.core);
@@ -169,12 +179,15 @@ nlohmann::json Calibration::toJson() const {
                               {"power_coef_ms", p.cost.power_coef_ms},
                               {"px_exponent", p.cost.px_exponent},
                               {"tri_exponent", p.cost.tri_exponent},
+                              {"ms_per_mfrag", p.cost.ms_per_mfrag},
+                              {"frag_per_px", p.cost.frag_per_px},
                               {"full_frame_scale", p.cost.full_frame_scale},
                               {"median_ms", p.median_ms},
                               {"min_ms", p.min_ms},
                               {"max_ms", p.max_ms},
                               {"residual_rms_pct", p.residual_rms_pct},
                               {"samples_ms_px_tri", p.samples_ms_px_tri},
+                              {"samples_fragments", p.samples_fragments},
                               {"samples_full_frame", p.samples_full_frame}});
     return {{"machine", machine},
             {"date", date},
@@ -880,7 +893,8 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                         const double ms = msSince(t0);
                         if (step == 0)
                             fovea.push_back({ms, double(layers.fovea.pixels()),
-                                             drawnTriangles(plan, p.head, eye, LayerKind::kFovea)});
+                                             drawnTriangles(plan, p.head, eye, LayerKind::kFovea),
+                                             false, fragmentsOf(*st)});
                     }
                     for (int li = 0; li < 2; ++li) {
                         const bool middle = li == 0;
@@ -954,7 +968,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
                 return makeError("full render: " + st.error());
             const double ms = msSince(t0);
             const double tris = drawnTriangles(full, p.head, eye, LayerKind::kFovea);
-            fovea.push_back({ms, eye_px, tris, true});
+            fovea.push_back({ms, eye_px, tris, true, fragmentsOf(*st)});
             // The server's whole-frame layer is the same view at scale 1.
             server.push_back({ms, eye_px, tris, true});
         }
@@ -1276,7 +1290,12 @@ Expected<Calibration> runCalibration(const CalibrateOptions& o) {
     // 3 kpx … 4 Mpx); the whole frame gets its own scale (MODEL.md §8).
     const CostFitOptions render_fit{.use_px = true, .use_tri = true, .allow_power = true};
     const CostFitOptions px_only{.use_px = true, .use_tri = false, .allow_power = false};
-    cal.costs.fovea = fitPartCost(fovea, render_fit);
+    // The fovea pass charges its shaded fragments (its overdraw) and triangles, not its pixels:
+    // over the same samples the pixels' law left 17–20% RMS, two poses with the same pixels and
+    // triangles 2× apart; the fragments' 7% (docs/MODEL.md §8, "Fragments"; version 16).
+    CostFitOptions fovea_fit = render_fit;
+    fovea_fit.use_frag = true;
+    cal.costs.fovea = fitPartCost(fovea, fovea_fit);
     cal.costs.server_render = fitPartCost(server, render_fit);
     cal.costs.encode = fitPartCost(encode, px_only);
     cal.costs.decode = fitPartCost(decode, px_only);

@@ -36,6 +36,7 @@
 #include "qvr/compose/test_pattern.h"
 #include "qvr/compose/warp.h"
 #include "qvr/foveation/eye_geometry.h"
+#include "qvr/foveation/layer_plan.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/render/camera.h"
 #include "qvr/render/renderer.h"
@@ -1085,6 +1086,35 @@ int runRun(const RunOptions& o) {
         drawn_cache.emplace(cache_key, tris);
         return tris;
     };
+    // The fragments a design's fovea pass shaded at frame k, as its own run's headset counted them
+    // (FrameTelemetry::fovea_fragments, both eyes): the overdraw the fovea law charges (docs/
+    // MODEL.md §8, "Fragments"). A count of the content at that pose and e1, as the triangles
+    // are, not a time. Where the model's e1 differs from the run's (LIWC's choices), the run's
+    // fragments per fovea pixel times the model's pixels; none counted: −1, the law's mean.
+    const LayerPlanner fragment_planner(*profile);
+    auto foveaFragmentsOf = [&](const DesignRun& r) {
+        std::vector<std::pair<double, double>> by_frame;  // e1, fragments per eye
+        for (const FrameTelemetry& t : r.result.frames) {
+            if (t.frame < 0 || t.frame > 1000000)
+                continue;
+            if (by_frame.size() <= size_t(t.frame))
+                by_frame.resize(size_t(t.frame) + 1, {0.0, -1.0});
+            by_frame[size_t(t.frame)] = {t.e1_deg,
+                                         t.fovea_fragments > 0.0 ? t.fovea_fragments / 2.0 : -1.0};
+        }
+        return [&, by_frame](int64_t frame, const LayerPlan& plan, int eye) -> double {
+            if (frame < 0 || size_t(frame) >= by_frame.size() || by_frame[size_t(frame)].second < 0)
+                return -1.0;
+            const auto [e1, frags] = by_frame[size_t(frame)];
+            const LayerRect& model = plan.eyes[size_t(eye)].fovea;
+            if (std::fabs(plan.e1_deg - e1) < 1e-3 || model.empty())
+                return frags;
+            const double content_ms = contentTimeMs(frame, profile->refresh_hz);
+            const LayerPlan run_plan = fragment_planner.plan(gazeAt(traces.gaze, content_ms), e1);
+            const double run_px = double(run_plan.eyes[size_t(eye)].fovea.pixels());
+            return run_px > 0.0 ? frags * double(model.pixels()) / run_px : -1.0;
+        };
+    };
     if (rcosts.bits_per_px_at_1 > 0.0) {
         const auto t0 = std::chrono::steady_clock::now();
         WorkloadProbe probe(*profile, bvh);
@@ -1143,7 +1173,7 @@ int runRun(const RunOptions& o) {
         std::ofstream predicted_csv(out / "predicted_frames.csv");
         predicted_csv << "design,frame,e1_deg,pose_ms,t_local_ms,t_remote_ms,headset_busy_ms,"
                          "decision_ms,remote_done_ms,uca_end_ms,display_ms,mtp_ms,uca_ms,bytes,"
-                         "reused,served\n";
+                         "reused,served,server_render_ms,server_encode_ms,key_frames\n";
         if (trace && !trace->frames.empty()) {
             for (const DesignRun& r : runs) {
                 const std::string name = r.label();
@@ -1173,6 +1203,7 @@ int runRun(const RunOptions& o) {
                     rc.record_scanout = o.video;  // every design's headset copies its scan-out
                     // The trace's frame k is the run's frame k (same poses).
                     rc.layer_triangles = layer_triangles;
+                    rc.fovea_fragments = foveaFragmentsOf(r);
                     const RuntimeRunResult pr = simulateRuntime(*trace, rc, **rt_link);
                     const RuntimeSummary& ps = pr.summary;
                     if (pass == 1) {
@@ -1187,11 +1218,12 @@ int runRun(const RunOptions& o) {
                     for (const RuntimeFrame& f : pr.frames)
                         predicted_csv << fmt::format(
                             "{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},"
-                            "{:.3f},{:.3f},{:.0f},{:d},{:d}\n",
+                            "{:.3f},{:.3f},{:.0f},{:d},{:d},{:.3f},{:.3f},{:d}\n",
                             name, f.index, f.e1_deg, f.pose_ms, f.t_local_ms, f.t_remote_ms,
                             f.headset_busy_ms, f.decision_ms, f.remote_done_ms, f.uca_end_ms,
                             f.display_ms, f.mtp_ms, f.uca_end_ms - f.uca_start_ms, f.bytes,
-                            int(f.reused), int(f.served));
+                            int(f.reused), int(f.served), f.server_render_ms, f.server_encode_ms,
+                            f.key_frames);
                     predicted[name] = predictionJson(ps.fps_mean, ps.mtp_ms_mean, ps.mtp_ms_p99,
                                                      ps.bytes_per_frame_mean, ps.e1_deg_mean);
                     predicted[name]["headset_busy_ms_mean"] = ps.headset_busy_ms_mean;

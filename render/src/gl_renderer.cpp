@@ -29,6 +29,7 @@ namespace {
 // GL_ARB_pipeline_statistics_query tokens (not in glcorearb.h before GL 4.6).
 constexpr GLenum kClippingInputPrimitives = 0x82F6;
 constexpr GLenum kClippingOutputPrimitives = 0x82F7;
+constexpr GLenum kFragmentShaderInvocations = 0x82F4;
 
 constexpr const char* kVertexShader = R"(#version 450 core
 layout(location = 0) in vec3 a_position;
@@ -171,6 +172,7 @@ struct GlRenderer::Impl {
     GLuint query_primitives = 0;
     GLuint query_clip_in = 0;
     GLuint query_clip_out = 0;
+    GLuint query_fragments = 0;
     GLuint count_program = 0;
     GLuint query_count = 0;
 
@@ -180,8 +182,9 @@ struct GlRenderer::Impl {
         releaseScene();
         for (auto& [size, fb] : framebuffers)
             releaseFramebuffer(fb);
-        const GLuint queries[] = {query_time, query_primitives, query_clip_in, query_clip_out};
-        glDeleteQueries(4, queries);
+        const GLuint queries[] = {query_time, query_primitives, query_clip_in, query_clip_out,
+                                  query_fragments};
+        glDeleteQueries(5, queries);
         glDeleteTextures(1, &white);
         glDeleteVertexArrays(1, &vao);
         glDeleteProgram(program);
@@ -288,6 +291,7 @@ struct GlRenderer::Impl {
         if (info.pipeline_statistics) {
             glGenQueries(1, &query_clip_in);
             glGenQueries(1, &query_clip_out);
+            glGenQueries(1, &query_fragments);
         }
         return checkGl("query creation");
     }
@@ -517,6 +521,7 @@ struct GlRenderer::Impl {
         if (info.pipeline_statistics) {
             glBeginQuery(kClippingInputPrimitives, query_clip_in);
             glBeginQuery(kClippingOutputPrimitives, query_clip_out);
+            glBeginQuery(kFragmentShaderInvocations, query_fragments);
         }
         for (const DrawRange& d : selection.draws) {
             const SceneBatch& b = batches[d.batch];
@@ -528,6 +533,7 @@ struct GlRenderer::Impl {
                            reinterpret_cast<const void*>(offset));
         }
         if (info.pipeline_statistics) {
+            glEndQuery(kFragmentShaderInvocations);
             glEndQuery(kClippingOutputPrimitives);
             glEndQuery(kClippingInputPrimitives);
         }
@@ -572,6 +578,9 @@ struct GlRenderer::Impl {
             glGetQueryObjectui64v(query_clip_out, GL_QUERY_RESULT, &clip_out);
             stats.clipping_input_primitives = clip_in;
             stats.clipping_output_primitives = clip_out;
+            GLuint64 fragments = 0;
+            glGetQueryObjectui64v(query_fragments, GL_QUERY_RESULT, &fragments);
+            stats.fragment_invocations = fragments;
         }
         stats.clusters_drawn = selection.clusters_drawn;
         stats.clusters_culled = selection.clusters_culled;

@@ -569,6 +569,7 @@ private:
         // 4. The fovea (or the whole frame) locally.
         const int64_t local_start_ns = m_clock.nowNs();
         t->local_start_ns = rel(local_start_ns);
+        double fragments = 0.0;
         for (int eye = 0; eye < 2; ++eye) {
             if (plan.eyes[static_cast<size_t>(eye)].fovea.empty())
                 continue;
@@ -576,10 +577,13 @@ private:
                                   LayerKind::kFovea, layers->eyes[static_cast<size_t>(eye)].fovea);
             if (!rs)
                 ++m_stats.render_failures;
+            else
+                fragments += double(rs->fragment_invocations);
         }
         const int64_t local_end_ns = m_clock.nowNs();
         t = &tel(ti);
         t->local_end_ns = rel(local_end_ns);
+        t->fovea_fragments = fragments;
         t->t_local_ms = double(local_end_ns - local_start_ns) * 1e-6;
 
         // 5. Wait for this frame's remote layers, decoding each as it arrives.

@@ -53,7 +53,8 @@ std::vector<double> leastSquares(const std::vector<CostSample>& s,
     return solve(std::move(a));
 }
 
-PartCost fitLinear(const std::vector<CostSample>& s, bool use_px, bool use_tri) {
+PartCost fitLinear(const std::vector<CostSample>& s, bool use_px, bool use_tri,
+                   bool use_frag = false) {
     bool use_base = true;
     for (;;) {
         std::vector<std::function<double(const CostSample&)>> f;
@@ -61,6 +62,8 @@ PartCost fitLinear(const std::vector<CostSample>& s, bool use_px, bool use_tri) 
             f.push_back([](const CostSample&) { return 1.0; });
         if (use_px)
             f.push_back([](const CostSample& x) { return x.pixels * 1e-6; });
+        if (use_frag)
+            f.push_back([](const CostSample& x) { return x.fragments * 1e-6; });
         if (use_tri)
             f.push_back([](const CostSample& x) { return x.triangles * 1e-3; });
         PartCost cost;
@@ -74,8 +77,15 @@ PartCost fitLinear(const std::vector<CostSample>& s, bool use_px, bool use_tri) 
             cost.base_ms = beta[idx++];
         if (use_px)
             cost.ms_per_mpx = beta[idx++];
+        if (use_frag)
+            cost.ms_per_mfrag = beta[idx++];
         if (use_tri)
             cost.ms_per_ktri = beta[idx++];
+        if (use_frag && cost.ms_per_mfrag <= 0) {
+            use_frag = false;  // fragments that cost nothing: the pixels' law instead
+            use_px = true;
+            continue;
+        }
         if (use_tri && cost.ms_per_ktri < 0) {
             use_tri = false;
             continue;
@@ -131,8 +141,8 @@ double costResidualRmsPct(const std::vector<CostSample>& samples, const PartCost
     for (const CostSample& x : samples) {
         if (x.ms <= 0.0)
             continue;
-        const double p =
-            x.full_frame ? cost.atFullFrame(x.pixels, x.triangles) : cost.at(x.pixels, x.triangles);
+        const double p = x.full_frame ? cost.atFullFrame(x.pixels, x.triangles, x.fragments)
+                                      : cost.at(x.pixels, x.triangles, x.fragments);
         const double r = (x.ms - p) / x.ms;
         sq += r * r;
         ++n;
@@ -148,8 +158,18 @@ PartCost fitPartCost(const std::vector<CostSample>& samples, const CostFitOption
     const bool only_full = layers.empty();
     if (only_full)
         layers = full;
-    PartCost cost = fitLinear(layers, o.use_px, o.use_tri);
-    if (o.allow_power) {
+    bool use_frag = o.use_frag && !samples.empty();
+    double frag = 0.0, px = 0.0;
+    for (const CostSample& x : samples) {
+        use_frag = use_frag && x.fragments >= 0.0;
+        frag += std::max(x.fragments, 0.0);
+        px += x.pixels;
+    }
+    PartCost cost = use_frag ? fitLinear(layers, false, o.use_tri, true)
+                             : fitLinear(layers, o.use_px, o.use_tri);
+    if (cost.ms_per_mfrag > 0.0)
+        cost.frag_per_px = px > 0.0 ? frag / px : 0.0;
+    if (o.allow_power && cost.ms_per_mfrag <= 0.0) {
         const PartCost power = fitPower(layers, o.use_px, o.use_tri);
         if (power.power_coef_ms > 0.0 &&
             costResidualRmsPct(layers, power) < costResidualRmsPct(layers, cost))
@@ -157,7 +177,7 @@ PartCost fitPartCost(const std::vector<CostSample>& samples, const CostFitOption
     }
     std::vector<double> ratio;
     for (const CostSample& x : full) {
-        const double p = cost.at(x.pixels, x.triangles);
+        const double p = cost.at(x.pixels, x.triangles, x.fragments);
         if (x.ms > 0.0 && p > 0.0 && !only_full)
             ratio.push_back(x.ms / p);
     }

@@ -104,6 +104,9 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
         pc.tri_exponent = r.number("runtime." + part + "_tri_exponent", pc.tri_exponent, -4.0, 4.0);
         pc.full_frame_scale =
             r.number("runtime." + part + "_full_frame_scale", pc.full_frame_scale, 0.01, 100.0);
+        pc.ms_per_mfrag =
+            r.number("runtime." + part + "_ms_per_mfrag", pc.ms_per_mfrag, 0.0, 10000.0);
+        pc.frag_per_px = r.number("runtime." + part + "_frag_per_px", pc.frag_per_px, 0.0, 1000.0);
     };
     cost("decision_base_ms", rc.decision.base_ms);
     cost("decision_ms_per_ktri", rc.decision.ms_per_ktri);
@@ -206,6 +209,8 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
         put((part + "_px_exponent").c_str(), pc.px_exponent);
         put((part + "_tri_exponent").c_str(), pc.tri_exponent);
         put((part + "_full_frame_scale").c_str(), pc.full_frame_scale);
+        put((part + "_ms_per_mfrag").c_str(), pc.ms_per_mfrag);
+        put((part + "_frag_per_px").c_str(), pc.frag_per_px);
     };
     put("decision_base_ms", c.decision.base_ms);
     put("decision_ms_per_ktri", c.decision.ms_per_ktri);

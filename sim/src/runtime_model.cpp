@@ -41,6 +41,8 @@ struct FrameState {
     double received_bytes = 0.0;
     double middle_bytes = 0.0, outer_bytes = 0.0;
     bool served = false;
+    double server_render_ms = 0.0, server_encode_ms = 0.0;  // the server's work on it
+    int key_frames = 0;                                     // its streams coded as IDRs
     bool closed = false;  // its pending entry is gone: LIWC does not see later streams
 };
 
@@ -403,6 +405,9 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
                                       ? c.server_render.atFullFrame(job.pixels, job.triangles)
                                       : c.server_render.at(job.pixels, job.triangles);
             const double encode = c.encode.at(coded_px, 0.0);
+            fs.server_render_ms += render;
+            fs.server_encode_ms += encode;
+            fs.key_frames += codecs.lastWasKey() ? 1 : 0;
             const double layer_start = t;
             t = serverWork(t, render + encode);
             server_busy_total += t - layer_start;
@@ -533,7 +538,10 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
                     continue;
                 const double px = double(e.fovea.pixels());
                 const double drawn_tris = drawn(i, fs.plan, eye, 0, tris, 1.0);
-                work(local_only ? c.fovea.atFullFrame(px, drawn_tris) : c.fovea.at(px, drawn_tris));
+                const double frags =
+                    config.fovea_fragments ? config.fovea_fragments(i, fs.plan, eye) : -1.0;
+                work(local_only ? c.fovea.atFullFrame(px, drawn_tris, frags)
+                                : c.fovea.at(px, drawn_tris, frags));
             }
         }
         rf.local_end_ms = hs;
@@ -628,8 +636,14 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         ahead.pop_front();
     }
     // A frame the server rendered after the headset had shown it (reused) was still served.
-    for (int64_t i = 0; i < n_frames; ++i)
-        result.frames[static_cast<size_t>(i)].served = state[static_cast<size_t>(i)].served;
+    for (int64_t i = 0; i < n_frames; ++i) {
+        RuntimeFrame& rf = result.frames[static_cast<size_t>(i)];
+        const FrameState& fs = state[static_cast<size_t>(i)];
+        rf.served = fs.served;
+        rf.server_render_ms = fs.server_render_ms;
+        rf.server_encode_ms = fs.server_encode_ms;
+        rf.key_frames = fs.key_frames;
+    }
 
     // Summary, as summarizeRun (runtime/telemetry.cpp) computes it.
     RuntimeSummary& s = result.summary;

@@ -189,6 +189,41 @@ TEST(GlRenderer, PrimitivesGeneratedEqualTheTrianglesSubmitted) {
     }
 }
 
+// The fovea law charges the fragments a pass shades (calibration version 16): every covered pixel
+// is shaded at least once, the count is the same for the same view, and it follows the view's
+// content, not only its size.
+TEST(GlRenderer, FragmentInvocationsCoverEveryDrawnPixelAndAreDeterministic) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    if (!gl->info().pipeline_statistics)
+        GTEST_SKIP() << "the driver has no ARB_pipeline_statistics_query";
+    const Scene room = test::texturedRoom();
+    const HmdProfile profile = test::smallProfile();
+    ASSERT_TRUE(gl->upload(room));
+    ImageRgba8 img;
+    std::vector<uint64_t> counts;
+    for (double yaw : {0.0, 0.0, 90.0}) {
+        Pose head;
+        head.orientation = quatFromEulerDeg({yaw, 10.0, 0.0});
+        const RenderView v = fullFrameView(profile, head, Eye::kLeft);
+        auto g = gl->render(v, img);
+        ASSERT_TRUE(g) << g.error();
+        uint64_t covered = 0;
+        for (int y = 0; y < img.height(); ++y)
+            for (int x = 0; x < img.width(); ++x) {
+                const uint8_t* p = img.row(y) + 4 * x;
+                covered +=
+                    !(p[0] == kClearRgba[0] && p[1] == kClearRgba[1] && p[2] == kClearRgba[2]);
+            }
+        std::printf("yaw %.0f: %llu fragments for %llu covered of %d pixels\n", yaw,
+                    static_cast<unsigned long long>(g->fragment_invocations),
+                    static_cast<unsigned long long>(covered), img.width() * img.height());
+        EXPECT_GT(covered, 0u);
+        EXPECT_GE(g->fragment_invocations, covered) << "yaw " << yaw;
+        counts.push_back(g->fragment_invocations);
+    }
+    EXPECT_EQ(counts[0], counts[1]);
+}
+
 TEST(GlRenderer, MalformedScenesAreErrorsNotCrashes) {
     QVR_GL_RENDERER_OR_SKIP(gl);
     Scene bad_index = test::texturedRoom();

@@ -106,6 +106,41 @@ TEST(CostFit, OnlyWholeFramesOrNoSamples) {
     EXPECT_EQ(none.at(1e5, 1e4), 0.0);
 }
 
+// llvmpipe's fovea pass follows the fragments it shades (the overdraw), not its pixels: two poses
+// with the same pixels and triangles measured 2× apart (calibration version 16). Samples whose
+// time is a law of fragments and triangles, with depth complexity varying 1.5–8× independently
+// of the pixels: the fragments' law is recovered exactly, where the pixels' law cannot be.
+TEST(CostFit, TheFragmentsLawRecoversOverdrawThePixelsCannot) {
+    std::vector<CostSample> s;
+    const double depth[] = {1.5, 4.0, 8.0, 2.5};
+    int k = 0;
+    double frags = 0.0, px_sum = 0.0;
+    for (double px : {3e3, 1e4, 3e4, 1e5, 3e5})
+        for (double tri : {1e3, 5e3, 2e4, 6e4}) {
+            const double f = px * depth[k++ % 4];
+            frags += f;
+            px_sum += px;
+            s.push_back({0.2 + 18.0 * f * 1e-6 + 0.05 * tri * 1e-3, px, tri, false, f});
+        }
+    const PartCost c = fitPartCost(s, {.use_px = true, .use_tri = true, .use_frag = true});
+    EXPECT_NEAR(c.base_ms, 0.2, 1e-9);
+    EXPECT_NEAR(c.ms_per_mfrag, 18.0, 1e-7);
+    EXPECT_NEAR(c.ms_per_ktri, 0.05, 1e-9);
+    EXPECT_EQ(c.ms_per_mpx, 0.0);
+    EXPECT_NEAR(c.frag_per_px, frags / px_sum, 1e-12);
+    EXPECT_NEAR(costResidualRmsPct(s, c), 0.0, 1e-6);
+    const PartCost px_law = fitPartCost(s, {.use_px = true, .use_tri = true, .allow_power = true});
+    EXPECT_GT(costResidualRmsPct(s, px_law), 20.0);
+    // A pass whose fragments are not known is charged the samples' mean depth complexity.
+    EXPECT_NEAR(c.at(1e5, 2e4), 0.2 + 18.0 * 1e5 * c.frag_per_px * 1e-6 + 0.05 * 20.0, 1e-9);
+    EXPECT_NEAR(c.at(1e5, 2e4, 6e5), 0.2 + 18.0 * 0.6 + 0.05 * 20.0, 1e-9);
+    // One sample without a count: the pixels' law, as before version 16.
+    s.back().fragments = -1.0;
+    const PartCost mixed = fitPartCost(s, {.use_px = true, .use_tri = true, .use_frag = true});
+    EXPECT_EQ(mixed.ms_per_mfrag, 0.0);
+    EXPECT_GT(mixed.ms_per_mpx, 0.0);
+}
+
 // The bits law b·s^γ: exact samples give it back, and noisy ones give the b whose total is the
 // samples' total (the mean), not the geometric mean a log fit alone gives.
 TEST(BitsLaw, RecoversAnExactLawAndItsTotal) {

@@ -74,6 +74,8 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.server_render.tri_exponent = 0.75;
     c.server_render.full_frame_scale = 1.75;
     c.fovea.full_frame_scale = 0.875;
+    c.server_render.ms_per_mfrag = 18.5;
+    c.server_render.frag_per_px = 2.75;
     c.scanout_record_ms = 1.25;
     c.speed_reference_headset_ms = 9.5;
     c.speed_reference_server_ms = 21.25;
@@ -135,6 +137,11 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                      1.75 * 3.5 * 2.0 * std::pow(9.0, 0.75));
     EXPECT_EQ(hw->runtime.fovea.power_coef_ms, 0.0);  // linear: the law above
     EXPECT_DOUBLE_EQ(hw->runtime.fovea.atFullFrame(1e6, 8e3), 0.875 * (3.5 + 41.0 + 1.0));
+    // A fragments term (version 16) reads back; without one (fovea here) none is charged.
+    EXPECT_EQ(hw->runtime.server_render.ms_per_mfrag, 18.5);
+    EXPECT_EQ(hw->runtime.server_render.frag_per_px, 2.75);
+    EXPECT_EQ(hw->runtime.fovea.ms_per_mfrag, 0.0);
+    EXPECT_DOUBLE_EQ(hw->runtime.fovea.at(1e6, 8e3, 5e6), 3.5 + 41.0 + 1.0);
     // The middle (and whole frame) read their law, the outer its own; without one, the middle's.
     EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, false), 0.3 * std::pow(4.0, 0.25));
     EXPECT_DOUBLE_EQ(hw->runtime.bitsPerPx(4.0, true), 0.125 * 2.0);
@@ -170,6 +177,9 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\ncorun_server_slowdown = 4.5\n",
                             "[runtime]\nserver_render_power_coef_ms = -2\n",
                             "[runtime]\nfovea_tri_exponent = \"x\"\n",
+                            "[runtime]\nfovea_ms_per_mfrag = -1\n",
+                            "[runtime]\nfovea_frag_per_px = 1001\n",
+                            "[runtime]\nserver_render_frag_per_px = \"deep\"\n",
                             "[runtime]\nspeed_reference_headset_ms = -1\n",
                             "[runtime]\nspeed_reference_server_ms = \"fast\"\n",
                             "[runtime]\nspeed_reference_key = 12\n",

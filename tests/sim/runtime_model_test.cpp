@@ -612,6 +612,36 @@ TEST(RuntimeModel, LayersCostTheTrianglesTheCallerSaysTheyDraw) {
     EXPECT_NEAR(rr.summary.server_busy_ms_mean, 2.0 * (1.0 + 2.0), 1e-9);
 }
 
+TEST(RuntimeModel, TheFoveaCostsTheFragmentsTheCallerSaysItShades) {
+    // A fovea law of 1 ms per million fragments and nothing else: with a fovea_fragments count
+    // of 1e6·(frame + 1)·(eye + 1) per eye, frame k's fovea takes 3·(k + 1) ms; where the count
+    // is not known (< 0, here frame 4) its pixels at the calibration's 2.5 fragments a pixel.
+    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
+    c.fovea = {};
+    c.fovea.ms_per_mfrag = 1.0;
+    c.fovea.frag_per_px = 2.5;
+    const WorkloadTrace trace = flatTrace(10);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Ffr;
+    cfg.costs = c;
+    cfg.frames = 10;
+    cfg.fovea_fragments = [](int64_t frame, const LayerPlan& plan, int eye) {
+        EXPECT_NEAR(plan.e1_deg, 5.0, 1e-9);
+        return frame == 4 ? -1.0 : 1e6 * double(frame + 1) * double(eye + 1);
+    };
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    for (int k : {1, 3, 7})
+        EXPECT_NEAR(r.frames[size_t(k)].t_local_ms, 3.0 * (k + 1), 1e-9) << k;
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[4].gaze, 5.0);
+    const double px = double(plan.eyes[0].fovea.pixels() + plan.eyes[1].fovea.pixels());
+    EXPECT_NEAR(r.frames[4].t_local_ms, 2.5 * px * 1e-6, 1e-9);
+    // Without a count at all, every frame is charged its pixels.
+    cfg.fovea_fragments = nullptr;
+    NoisyLink link2 = fastLink();
+    EXPECT_NEAR(simulateRuntime(trace, cfg, link2).frames[7].t_local_ms, 2.5 * px * 1e-6, 1e-9);
+}
+
 TEST(RuntimeModel, SwAndQvrPayTheRingCountsEveryFrame) {
     // The runtime counts the rings for qvr and sw (LIWC's model, fed reactively for sw), the
     // draw clusters at a constant cost: with only that and a 1 ms UCA, both are charged it in

@@ -57,6 +57,10 @@ struct FrameTelemetry {
     double throughput_bps = 0.0;
     double fovea_triangles = 0.0;  // both eyes, in the e1 cone (LIWC's input)
     double warp_deg = 0.0;
+    // The fragments its fovea (or whole-frame) passes shaded, both eyes (RenderStats::
+    // fragment_invocations; 0 where the driver does not count them): the workload's overdraw,
+    // which the calibrated model charges the fovea by (docs/MODEL.md §8, "Fragments").
+    double fovea_fragments = 0.0;
 };
 
 struct DesignSummary {

@@ -16,6 +16,7 @@ struct CostSample {
     double pixels = 0.0;
     double triangles = 0.0;
     bool full_frame = false;
+    double fragments = -1.0;  // the fragments the pass shaded (< 0: not counted)
 };
 
 struct CostFitOptions {
@@ -23,6 +24,9 @@ struct CostFitOptions {
     bool use_tri = true;
     // Also fit the power law k·Mpx^p·ktri^q and keep it where its residual is smaller.
     bool allow_power = false;
+    // Charge the fragments shaded in place of the pixels (every sample must count them; else
+    // the pixels): the linear law base + per Mfrag + per ktri, no power law.
+    bool use_frag = false;
 };
 
 // Fits the law to the samples that are not whole frames. The linear law: least squares weighted
@@ -31,7 +35,9 @@ struct CostFitOptions {
 // cannot fall with size, nor be negative for a small pass). With allow_power, also the power
 // law by least squares on logs; the law with the smaller RMS relative residual over those
 // samples is kept. full_frame_scale is the median of measured / law over the whole-frame
-// samples (1 without any). No samples: a zero cost.
+// samples (1 without any). With use_frag and every sample counting its fragments, the linear
+// law charges fragments (and triangles) in place of pixels, and frag_per_px is the samples'
+// fragments over their pixels. No samples: a zero cost.
 PartCost fitPartCost(const std::vector<CostSample>& samples, const CostFitOptions& options);
 
 // RMS of (measured − predicted) / measured over the samples, in percent; whole frames are

@@ -101,14 +101,23 @@ struct PartCost {
     double px_exponent = 0.0;
     double tri_exponent = 0.0;
     double full_frame_scale = 1.0;
-    double at(double pixels, double triangles) const {
+    // > 0: the linear law also charges the fragments the pass shades (its overdraw), per million
+    // (calibration version 16, docs/MODEL.md §8 "Fragments"). A pass whose fragments are not
+    // known (< 0) is charged frag_per_px of them per pixel, the calibration samples' mean.
+    double ms_per_mfrag = 0.0;
+    double frag_per_px = 0.0;
+    double at(double pixels, double triangles, double fragments = -1.0) const {
         if (power_coef_ms > 0.0)
             return power_coef_ms * std::pow(std::max(pixels * 1e-6, 1e-6), px_exponent) *
                    std::pow(std::max(triangles * 1e-3, 0.01), tri_exponent);
-        return base_ms + ms_per_mpx * pixels * 1e-6 + ms_per_ktri * triangles * 1e-3;
+        const double frag_ms =
+            ms_per_mfrag > 0.0
+                ? ms_per_mfrag * (fragments >= 0.0 ? fragments : pixels * frag_per_px) * 1e-6
+                : 0.0;
+        return base_ms + ms_per_mpx * pixels * 1e-6 + ms_per_ktri * triangles * 1e-3 + frag_ms;
     }
-    double atFullFrame(double pixels, double triangles) const {
-        return full_frame_scale * at(pixels, triangles);
+    double atFullFrame(double pixels, double triangles, double fragments = -1.0) const {
+        return full_frame_scale * at(pixels, triangles, fragments);
     }
 };
 
@@ -232,6 +241,7 @@ struct RuntimeCosts {
             p.ms_per_mpx *= f;
             p.ms_per_ktri *= f;
             p.power_coef_ms *= f;
+            p.ms_per_mfrag *= f;
         };
         for (PartCost* p : {&c.decision, &c.fovea, &c.decode, &c.uca})
             scale(*p, headset);

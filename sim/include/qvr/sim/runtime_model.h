@@ -60,6 +60,11 @@ struct RuntimeSimConfig {
     // BVH rings of the trace (fovea: within e1 / 2; middle: within e2 / 2 / s1²; outer: all
     // / 2 / s2²), which see neither level of detail nor holes.
     std::function<double(int64_t frame, const LayerPlan& plan, int eye, int kind)> layer_triangles;
+    // The fragments one eye's fovea (or whole-frame) pass shades for frame `frame` under `plan`
+    // (RenderStats::fragment_invocations), < 0 where not known: the fovea law then charges its
+    // pixels at the calibration's fragments per pixel. Empty: none known. `qvr run` gives the
+    // counts its headset's own passes made (docs/MODEL.md §8, "Fragments").
+    std::function<double(int64_t frame, const LayerPlan& plan, int eye)> fovea_fragments;
 };
 
 // One frame, ms from the run's start, as the runtime's telemetry records it.
@@ -81,6 +86,10 @@ struct RuntimeFrame {
     bool requested = false;
     bool served = false;  // the server rendered it (not pushed out of its queue)
     bool reused = false;
+    // The server's render and encode time for its layers (before any co-run slowdown), and how
+    // many of its streams were coded as key frames: per frame, beside server_frames.csv.
+    double server_render_ms = 0.0, server_encode_ms = 0.0;
+    int key_frames = 0;
 };
 
 struct RuntimeSummary {
