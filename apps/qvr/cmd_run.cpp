@@ -1148,7 +1148,8 @@ int runRun(const RunOptions& o) {
             "the run's poses and gazes, {} ring counts computed after the run ({:.1f} s), bits "
             "per pixel from the calibration ({} of {} frames their own, coded by the calibration "
             "on the same head pose; the rest its law); layer triangles drawn (LOD, holes) counted "
-            "off the clock",
+            "off the clock; the fovea's shaded fragments as each design's own passes counted them "
+            "(a count, not a time: its overdraw, docs/MODEL.md §8 \"Fragments\")",
             o.ring_counts,
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
             bits_frames_own, predict_frames);
