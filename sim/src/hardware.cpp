@@ -135,6 +135,8 @@ Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
     powerLaw("server_render", rc.server_render);
     cost("encode_base_ms", rc.encode.base_ms);
     cost("encode_ms_per_mpx", rc.encode.ms_per_mpx);
+    rc.encode.full_frame_scale =
+        r.number("runtime.encode_full_frame_scale", rc.encode.full_frame_scale, 0.01, 100.0);
     cost("server_frame_ms", rc.server_frame_ms);
     cost("link_delay_ms", rc.link_delay_ms);
     rc.packet_payload_bytes =
@@ -235,6 +237,7 @@ std::string runtimeCostsToml(const RuntimeCosts& c) {
     putLaw("server_render", c.server_render);
     put("encode_base_ms", c.encode.base_ms);
     put("encode_ms_per_mpx", c.encode.ms_per_mpx);
+    put("encode_full_frame_scale", c.encode.full_frame_scale);
     put("server_frame_ms", c.server_frame_ms);
     put("link_delay_ms", c.link_delay_ms);
     put("packet_payload_bytes", c.packet_payload_bytes);

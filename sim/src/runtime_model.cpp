@@ -69,7 +69,7 @@ StreamCodecModel::StreamCodecModel(const RuntimeCosts& costs) : m_costs(costs) {
 
 double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes) {
     m_last_key = false;
-    m_last_canvas_share = 1.0;
+    m_last_canvas_px = 0.0;
     if (!enabled() || width < 1 || height < 1 || stream < 0 || stream >= kStreams)
         return p_bytes;
     State& st = m_streams[static_cast<size_t>(stream)];
@@ -82,7 +82,7 @@ double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes
     const double extra = double(canvas.width) * double(canvas.height) /
                              std::max(1.0, double(snug.width) * double(snug.height)) -
                          1.0;
-    m_last_canvas_share = extra + 1.0;
+    m_last_canvas_px = double(canvas.width) * double(canvas.height);
     const double p = p_bytes * std::max(0.5, 1.0 + m_costs.padding_bits_ratio * extra);
     const bool opened = st.since_key < 0 || st.canvas.changed();  // a new encoder
     const bool periodic =
@@ -398,13 +398,20 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         }
         for (LayerJob& job : jobs) {
             job.bytes = codecs.bytes(job.stream, job.width, job.height, job.bytes);
-            // The codec works on the whole canvas: its encode and decode laws were measured in
-            // snug ones.
-            const double coded_px = job.pixels * codecs.lastCanvasShare();
+            // The codec works on the whole canvas, and its encode and decode laws are per canvas
+            // pixel: the calibration times each against its encoder's canvas. (Versions 7-16 of
+            // the model charged the layer's pixels times canvas/snug, which left out the snug
+            // canvas's own headroom and alignment, 1.2-1.4x a layer's pixels: a run's layers
+            // encoded 25-40% over the prediction.) Without the canvas model, the layer.
+            const double coded_px =
+                codecs.lastCanvasPx() > 0.0 ? codecs.lastCanvasPx() : job.pixels;
             const double render = whole_frame
                                       ? c.server_render.atFullFrame(job.pixels, job.triangles)
                                       : c.server_render.at(job.pixels, job.triangles);
-            const double encode = c.encode.at(coded_px, 0.0);
+            // remote's whole frame: the encode's own scale, measured on whole frames (version
+            // 17), as the render's.
+            const double encode =
+                whole_frame ? c.encode.atFullFrame(coded_px, 0.0) : c.encode.at(coded_px, 0.0);
             fs.server_render_ms += render;
             fs.server_encode_ms += encode;
             fs.key_frames += codecs.lastWasKey() ? 1 : 0;

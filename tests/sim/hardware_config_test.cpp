@@ -74,6 +74,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     c.server_render.tri_exponent = 0.75;
     c.server_render.full_frame_scale = 1.75;
     c.fovea.full_frame_scale = 0.875;
+    c.encode.full_frame_scale = 0.625;
     c.server_render.ms_per_mfrag = 18.5;
     c.server_render.frag_per_px = 2.75;
     c.scanout_record_ms = 1.25;
@@ -132,6 +133,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
     EXPECT_EQ(hw->runtime.server_render.px_exponent, 0.5);
     EXPECT_EQ(hw->runtime.server_render.tri_exponent, 0.75);
     EXPECT_EQ(hw->runtime.server_render.full_frame_scale, 1.75);
+    EXPECT_EQ(hw->runtime.encode.full_frame_scale, 0.625);
     EXPECT_DOUBLE_EQ(hw->runtime.server_render.at(4e6, 9e3), 3.5 * 2.0 * std::pow(9.0, 0.75));
     EXPECT_DOUBLE_EQ(hw->runtime.server_render.atFullFrame(4e6, 9e3),
                      1.75 * 3.5 * 2.0 * std::pow(9.0, 0.75));
@@ -170,6 +172,7 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
                             "[runtime]\nkeyframe_periodic_bits_ratio = -1\n",
                             "[runtime]\ncanvas_shrink_after_frames = 0\n",
                             "[runtime]\nfovea_full_frame_scale = 0\n",
+                            "[runtime]\nencode_full_frame_scale = 101\n",
                             "[runtime]\nserver_render_px_exponent = 5\n",
                             "[runtime]\ncorun_slowdown = 0.9\n",
                             "[runtime]\ncorun_slowdown = 5\n",

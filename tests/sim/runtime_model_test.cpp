@@ -222,13 +222,46 @@ TEST(RuntimeModel, APaddedCanvasCostsItsPaddingAndOutgrowingItAKeyFrame) {
     const double extra = 224.0 * 112.0 / (176.0 * 96.0) - 1.0;
     EXPECT_NEAR(m.bytes(0, 150, 80, 1000.0), 1000.0 * (1.0 + 0.5 * extra), 1e-9);
     EXPECT_FALSE(m.lastWasKey());
-    EXPECT_NEAR(m.lastCanvasShare(), 1.0 + extra, 1e-12);  // the codec's work: the canvas
+    EXPECT_NEAR(m.lastCanvasPx(), 224.0 * 112.0, 1e-9);  // the codec's work: the canvas
     // The other streams have encoders of their own: their first frames are IDRs (outer: 4×).
     EXPECT_NEAR(m.bytes(1, 150, 80, 1000.0), 4000.0, 1e-9);
     // Outgrowing the canvas reopens the encoder: an IDR of the new snug canvas.
     EXPECT_NEAR(m.bytes(0, 230, 100, 1000.0), 6000.0, 1e-9);
     EXPECT_TRUE(m.lastWasKey());
     EXPECT_NEAR(m.bytes(0, 230, 100, 1000.0), 1000.0, 1e-9);
+}
+
+TEST(RuntimeModel, TheEncodeAndDecodeLawsChargeTheWholeCanvas) {
+    // ffr at 5°: each of the four streams codes into its snug canvas, the layer plus 10% a side
+    // rounded up to 16 px, and the calibration times encode and decode against that canvas. An
+    // encode law of 10 ms per Mpx and a decode law of 4 ms per Mpx then charge every frame
+    // 10 (and 4) ms per Mpx of the canvases, not of the layers.
+    RuntimeCosts c = canvasCosts();
+    c.encode = {0, 10.0, 0};
+    c.decode = {0, 4.0, 0};
+    const WorkloadTrace trace = flatTrace(20);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(Gaze{}, 5.0);
+    auto snug = [](int v) { return double((int(std::ceil(v * 1.1)) + 15) / 16 * 16); };
+    double canvas_px = 0.0, layer_px = 0.0;
+    for (const EyeLayers& e : plan.eyes)
+        for (const LayerRect* rect : {&e.middle, &e.outer}) {
+            ASSERT_FALSE(rect->empty());
+            canvas_px += snug(rect->width_px) * snug(rect->height_px);
+            layer_px += double(rect->pixels());
+        }
+    ASSERT_GT(canvas_px, 1.1 * layer_px);  // the difference is worth a test
+    const RuntimeRunResult r = run(Design::Ffr, c, 1, 20);
+    ASSERT_EQ(r.frames.size(), 20u);
+    for (const RuntimeFrame& f : r.frames)
+        EXPECT_NEAR(f.server_encode_ms, 10.0 * canvas_px / 1e6, 1e-9) << "frame " << f.index;
+    // The headset: the fovea pass (1 ms) twice, UCA (1 ms), the four decodes.
+    EXPECT_NEAR(r.summary.headset_busy_ms_mean, 3.0 + 4.0 * canvas_px / 1e6, 1e-6);
+    // remote's whole frame (320×360 an eye here) in its canvas, at the encode's whole-frame
+    // scale, as the calibration measures it on whole frames.
+    c.encode.full_frame_scale = 0.5;
+    const double whole_px = 2.0 * snug(320) * snug(360);
+    for (const RuntimeFrame& f : run(Design::Remote, c, 1, 20).frames)
+        EXPECT_NEAR(f.server_encode_ms, 0.5 * 10.0 * whole_px / 1e6, 1e-9) << "frame " << f.index;
 }
 
 TEST(RuntimeModel, ServerBoundRemoteRunsAtTheServersRate) {

@@ -296,14 +296,14 @@ HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 //             server_render_base_ms, server_render_ms_per_mpx, server_render_ms_per_ktri,
 //             server_render_power_coef_ms, server_render_px_exponent, server_render_tri_exponent
 //             (−4…4), server_render_full_frame_scale (0.01…100), encode_base_ms, encode_ms_per_mpx,
-//             server_frame_ms, link_delay_ms; packet_payload_bytes (1…65536), packet_overhead_bytes
-//             (0…65536); canvas_align_px (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio
-//             (0…1), canvas_shrink_after_frames (1…100000), keyint_frames (0…100000),
-//             keyframe_bits_ratio, keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio
-//             (0…1000), padding_bits_ratio (0…10), corun_slowdown, corun_headset_slowdown,
-//             corun_server_slowdown (1…4); bits_frame_key (arrays of integers 0…2^32−1),
-//             bits_frame_middle, bits_frame_outer (arrays of 0.05…20), as long as one another,
-//             at most 100000
+//             encode_full_frame_scale (0.01…100), server_frame_ms, link_delay_ms;
+//             packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536); canvas_align_px
+//             (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio (0…1),
+//             canvas_shrink_after_frames (1…100000), keyint_frames (0…100000), keyframe_bits_ratio,
+//             keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio (0…1000), padding_bits_ratio
+//             (0…10), corun_slowdown, corun_headset_slowdown, corun_server_slowdown (1…4);
+//             bits_frame_key (arrays of integers 0…2^32−1), bits_frame_middle, bits_frame_outer
+//             (arrays of 0.05…20), as long as one another, at most 100000
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);

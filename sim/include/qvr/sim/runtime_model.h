@@ -127,9 +127,9 @@ public:
     // takes p_bytes.
     double bytes(int stream, int width, int height, double p_bytes);
     bool lastWasKey() const { return m_last_key; }
-    // The last frame's canvas pixels over its snug canvas's (1 without the model): the codec's
-    // work, and its encode and decode time, scale with the canvas.
-    double lastCanvasShare() const { return m_last_canvas_share; }
+    // The last frame's canvas pixels (0 without the model): what the codec works on, and what
+    // the encode and decode laws are per (`qvr calibrate` times them against their canvases).
+    double lastCanvasPx() const { return m_last_canvas_px; }
 
 private:
     struct State {
@@ -139,7 +139,7 @@ private:
     RuntimeCosts m_costs;
     std::vector<State> m_streams;
     bool m_last_key = false;
-    double m_last_canvas_share = 1.0;
+    double m_last_canvas_px = 0.0;
 };
 
 // One side's busy spans, ms, in time order and disjoint.
