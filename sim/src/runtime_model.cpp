@@ -79,10 +79,9 @@ double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes
         st.canvas.snugFor(std::min(width, kMaxSidePx), std::min(height, kMaxSidePx));
     // The bits law is a P-frame's in a snug canvas: each pixel beyond it costs padding_bits_ratio
     // of a layer pixel's bits (fewer when the layer grew into its headroom).
-    const double extra = double(canvas.width) * double(canvas.height) /
-                             std::max(1.0, double(snug.width) * double(snug.height)) -
-                         1.0;
     m_last_canvas_px = double(canvas.width) * double(canvas.height);
+    const double extra =
+        m_last_canvas_px / std::max(1.0, double(snug.width) * double(snug.height)) - 1.0;
     const double p = p_bytes * std::max(0.5, 1.0 + m_costs.padding_bits_ratio * extra);
     const bool opened = st.since_key < 0 || st.canvas.changed();  // a new encoder
     const bool periodic =
@@ -402,7 +401,7 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
             // pixel: the calibration times each against its encoder's canvas. (Versions 7-16 of
             // the model charged the layer's pixels times canvas/snug, which left out the snug
             // canvas's own headroom and alignment, 1.2-1.4x a layer's pixels: a run's layers
-            // encoded 25-40% over the prediction.) Without the canvas model, the layer.
+            // encoded 25-60% over the prediction.) Without the canvas model, the layer.
             const double coded_px =
                 codecs.lastCanvasPx() > 0.0 ? codecs.lastCanvasPx() : job.pixels;
             const double render = whole_frame
