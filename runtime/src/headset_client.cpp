@@ -293,6 +293,31 @@ private:
         return d.get();
     }
 
+    // Holds the pending list to kMaxPendingFrames entries and kMaxPendingImageBytes of images,
+    // dropping the oldest. The frame the server is rendering is the oldest it still owes, so
+    // the bound must outlast a slow server's frame: the server takes the older of its two
+    // newest requests and the headset, re-warping at its own pace, asks for ~13 more frames
+    // before a 300 ms frame comes (a 661 ms one on a slow validation run, 40 frames of which
+    // showed nothing from the server while the bound was 8). The images bound the memory: a
+    // pending entry holds its fovea (4.7 MB a frame for fixed:20 at the default profile).
+    void trimPending() {
+        size_t bytes = 0;
+        for (const PendingFrame& p : m_pending)
+            bytes += imageBytes(*p.layers);
+        while (m_pending.size() > 1 &&
+               (m_pending.size() > kMaxPendingFrames || bytes > kMaxPendingImageBytes)) {
+            bytes -= imageBytes(*m_pending.front().layers);
+            m_pending.pop_front();
+        }
+    }
+    static size_t imageBytes(const LayerFrame& f) {
+        size_t n = 0;
+        for (const EyeLayerImages& e : f.eyes)
+            for (const ImageRgba8* im : {&e.fovea, &e.middle, &e.outer})
+                n += size_t(im->width()) * size_t(im->height()) * 4;
+        return n;
+    }
+
     PendingFrame* pendingFor(int64_t frame) {
         for (PendingFrame& p : m_pending)
             if (p.frame == frame)
@@ -532,8 +557,7 @@ private:
                 t->request_ns = rel(p.request_ns);
                 t->remote_requested = true;
                 m_pending.push_back(p);
-                while (m_pending.size() > kMaxPendingFrames)
-                    m_pending.pop_front();
+                trimPending();
             }
         }
 
@@ -739,7 +763,10 @@ private:
             m_pending.pop_front();
     }
 
-    static constexpr size_t kMaxPendingFrames = 8;
+    // As many as the telemetry holds at least (kMinFramesHeld): a pending entry older than
+    // that is dropped with its frame's telemetry anyway (retireOldFrames).
+    static constexpr size_t kMaxPendingFrames = 64;
+    static constexpr size_t kMaxPendingImageBytes = size_t(64) << 20;
     static constexpr size_t kMinFramesHeld = 64;
     static constexpr int kKeyMismatchBackoffMs = 2000;
 

@@ -20,6 +20,7 @@
 #include "qvr/net/auth.h"
 #include "qvr/net/protocol.h"
 #include "qvr/render/gl_renderer.h"
+#include "qvr/render/renderer.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/pacing.h"
 #include "qvr/runtime/render_server.h"
@@ -332,6 +333,52 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
     for (size_t i = 200; i < 240; ++i)
         fresh_tail += r.frames[i].reused ? 0 : 1;
     EXPECT_GT(fresh_tail, 30);
+}
+
+// A renderer that takes at least delay per layer: a server slower than the wait limit.
+class SlowRenderer final : public Renderer {
+public:
+    explicit SlowRenderer(std::chrono::milliseconds delay)
+        : m_inner(makeNullRenderer()), m_delay(delay) {}
+    std::string name() const override { return "slow-null"; }
+    Status upload(const Scene& scene) override { return m_inner->upload(scene); }
+    Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) override {
+        std::this_thread::sleep_for(m_delay);
+        return m_inner->render(view, out);
+    }
+
+private:
+    std::unique_ptr<Renderer> m_inner;
+    std::chrono::milliseconds m_delay;
+};
+
+TEST(Runtime, AServerSlowerThanTheWaitLimitStillGetsItsFramesShown) {
+    // Each remote frame takes the server 2 x 150 ms (two whole-frame layers) against a 20 ms
+    // wait limit: the headset re-warps at its own pace, ~13 frames for each of the server's.
+    // The frame the server is rendering must keep its pending entry until its layers come:
+    // they are the newest the headset will have. Before, the headset held only its newest 8
+    // requests, so every frame the server finished had already lost its entry and was
+    // discarded, and nothing from the server was ever shown (as in a validation run: room,
+    // lte, remote, the server at 661 ms a frame against the 250 ms limit, 40 frames).
+    RenderServerConfig sc = serverConfig("none", "raw");
+    sc.renderer = []() -> Expected<std::unique_ptr<Renderer>> {
+        return std::unique_ptr<Renderer>(std::make_unique<SlowRenderer>(150ms));
+    };
+    auto server = RenderServer::start(sc, world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    HeadsetConfig h = headsetConfig(RuntimeDesign::kRemote, (*server)->port(), "raw", 200);
+    h.remote_timeout_ms = 20.0;
+    const HeadsetResult r = runOn(h);
+    ASSERT_EQ(r.frames.size(), 200u);
+    std::vector<int64_t> shown;
+    for (const FrameTelemetry& t : r.frames)
+        if (t.shown_frame >= 0 && (shown.empty() || shown.back() != t.shown_frame))
+            shown.push_back(t.shown_frame);
+    // 200 frames of >= 20 ms are >= 4 s: ~13 server frames; at least 6 shown.
+    EXPECT_GE(shown.size(), 6u) << r.stats.streams_discarded << " streams discarded";
+    EXPECT_TRUE(std::is_sorted(shown.begin(), shown.end()));
+    // Each shown frame is one the server rendered while the headset moved on: all late.
+    EXPECT_GT(r.summary.frames_reused, 150);
 }
 
 TEST(Runtime, ALateFramesStreamsCountAsItsBytesAfterItWasShown) {
