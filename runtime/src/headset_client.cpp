@@ -20,6 +20,18 @@
 
 namespace qvr::runtime {
 
+size_t pendingFramesToDrop(std::span<const size_t> bytes, size_t max_frames, size_t max_bytes) {
+    size_t total = 0;
+    for (size_t b : bytes)
+        total += b;
+    size_t drop = 0;
+    while (bytes.size() - drop > 1 && (bytes.size() - drop > max_frames || total > max_bytes)) {
+        total -= bytes[drop];
+        ++drop;
+    }
+    return drop;
+}
+
 LayerPlan wholeFramePlan(const LayerPlanner& planner, const Gaze& gaze) {
     // Start from the all-local plan for its bookkeeping, then move the full frame to the
     // middle slot at scale 1: the server renders and streams it, the headset only warps it.
@@ -293,22 +305,17 @@ private:
         return d.get();
     }
 
-    // Holds the pending list to kMaxPendingFrames entries and kMaxPendingImageBytes of images,
-    // dropping the oldest. The frame the server is rendering is the oldest it still owes, so
-    // the bound must outlast a slow server's frame: the server takes the older of its two
-    // newest requests and the headset, re-warping at its own pace, asks for ~13 more frames
-    // before a 300 ms frame comes (a 661 ms one on a slow validation run, 40 frames of which
-    // showed nothing from the server while the bound was 8). The images bound the memory: a
-    // pending entry holds its fovea (4.7 MB a frame for fixed:20 at the default profile).
+    // Holds the pending list to its bounds (kMaxPendingFrames, kMaxPendingImageBytes) at each
+    // request. With 8 entries, as before, a server at 661 ms a frame (a slow validation run, 40
+    // frames) finished only frames whose entries were already gone and showed nothing.
     void trimPending() {
-        size_t bytes = 0;
+        std::vector<size_t> bytes;
+        bytes.reserve(m_pending.size());
         for (const PendingFrame& p : m_pending)
-            bytes += imageBytes(*p.layers);
-        while (m_pending.size() > 1 &&
-               (m_pending.size() > kMaxPendingFrames || bytes > kMaxPendingImageBytes)) {
-            bytes -= imageBytes(*m_pending.front().layers);
+            bytes.push_back(imageBytes(*p.layers));
+        for (size_t n = pendingFramesToDrop(bytes, kMaxPendingFrames, kMaxPendingImageBytes); n > 0;
+             --n)
             m_pending.pop_front();
-        }
     }
     static size_t imageBytes(const LayerFrame& f) {
         size_t n = 0;
@@ -763,11 +770,10 @@ private:
             m_pending.pop_front();
     }
 
-    // As many as the telemetry holds at least (kMinFramesHeld): a pending entry older than
-    // that is dropped with its frame's telemetry anyway (retireOldFrames).
-    static constexpr size_t kMaxPendingFrames = 64;
-    static constexpr size_t kMaxPendingImageBytes = size_t(64) << 20;
+    // No more pending frames than the telemetry holds: an older entry would be dropped with
+    // its frame's telemetry anyway (retireOldFrames).
     static constexpr size_t kMinFramesHeld = 64;
+    static_assert(kMaxPendingFrames <= kMinFramesHeld);
     static constexpr int kKeyMismatchBackoffMs = 2000;
 
     const HeadsetConfig& m_config;

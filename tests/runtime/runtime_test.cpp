@@ -352,6 +352,31 @@ private:
     std::chrono::milliseconds m_delay;
 };
 
+TEST(PendingFrames, TheOldestGoFirstUntilBothBoundsHoldAndTheNewestAlwaysStays) {
+    const std::vector<size_t> none;
+    EXPECT_EQ(pendingFramesToDrop(none, 4, 100), 0u);
+    const std::vector<size_t> five(5, 10);  // 50 bytes in all
+    EXPECT_EQ(pendingFramesToDrop(five, 5, 50), 0u);
+    EXPECT_EQ(pendingFramesToDrop(five, 4, 50), 1u);  // the count
+    EXPECT_EQ(pendingFramesToDrop(five, 5, 35), 2u);  // the bytes: 30 left
+    EXPECT_EQ(pendingFramesToDrop(five, 0, 0), 4u);   // the newest stays
+    // Bytes drop by the oldest frames' own sizes: a large old frame frees room at once.
+    const std::vector<size_t> mixed = {40, 1, 1, 1};
+    EXPECT_EQ(pendingFramesToDrop(mixed, 64, 10), 1u);
+    // The bounds the headset uses hold 64 frames of qvr's fovea but not of a big one.
+    const size_t fovea_5deg = size_t(2) * 224 * 224 * 4;   // ~0.4 MB
+    const size_t fovea_20deg = size_t(2) * 784 * 784 * 4;  // ~4.9 MB
+    EXPECT_EQ(pendingFramesToDrop(std::vector<size_t>(64, fovea_5deg), kMaxPendingFrames,
+                                  kMaxPendingImageBytes),
+              0u);
+    EXPECT_EQ(pendingFramesToDrop(std::vector<size_t>(65, fovea_5deg), kMaxPendingFrames,
+                                  kMaxPendingImageBytes),
+              1u);
+    EXPECT_EQ(pendingFramesToDrop(std::vector<size_t>(64, fovea_20deg), kMaxPendingFrames,
+                                  kMaxPendingImageBytes),
+              64u - kMaxPendingImageBytes / fovea_20deg);
+}
+
 TEST(Runtime, AServerSlowerThanTheWaitLimitStillGetsItsFramesShown) {
     // Each remote frame takes the server 2 x 150 ms (two whole-frame layers) against a 20 ms
     // wait limit: the headset re-warps at its own pace, ~13 frames for each of the server's.

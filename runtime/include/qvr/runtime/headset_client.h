@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -128,6 +129,17 @@ struct HeadsetResult {
 Expected<HeadsetResult> runHeadset(const HeadsetConfig& config, std::shared_ptr<const Scene> scene,
                                    std::shared_ptr<const TriangleBvh> bvh,
                                    const HeadsetTraces& traces);
+
+// The frames the headset holds pending (asked of the server, not yet shown): at most this many,
+// and at most this many bytes of their images, the oldest dropped first. The frame the server
+// is rendering is the oldest it still owes, so the bound must outlast a slow server's frame
+// (docs/RUNTIME.md step 6); the bytes bound the memory, each entry holding its fovea.
+inline constexpr size_t kMaxPendingFrames = 64;
+inline constexpr size_t kMaxPendingImageBytes = size_t(64) << 20;
+
+// How many of the oldest pending frames to drop so that at most max_frames stay and their
+// images hold at most max_bytes; the newest always stays. bytes: each one's images, oldest first.
+size_t pendingFramesToDrop(std::span<const size_t> bytes, size_t max_frames, size_t max_bytes);
 
 // The plan of whole-frame streaming: one full-resolution "middle" layer per eye, nothing local.
 LayerPlan wholeFramePlan(const LayerPlanner& planner, const Gaze& gaze);
