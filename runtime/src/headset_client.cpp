@@ -320,8 +320,7 @@ private:
     static size_t imageBytes(const LayerFrame& f) {
         size_t n = 0;
         for (const EyeLayerImages& e : f.eyes)
-            for (const ImageRgba8* im : {&e.fovea, &e.middle, &e.outer})
-                n += size_t(im->width()) * size_t(im->height()) * 4;
+            n += e.fovea.sizeBytes() + e.middle.sizeBytes() + e.outer.sizeBytes();
         return n;
     }
 
