@@ -1,6 +1,7 @@
-// `qvr validate`: the simulator's correlation sheet. Calibrates once per scene (qvr calibrate,
-// before and apart from every run), then runs `qvr run` for each condition — links × scenes ×
-// pipeline depths, every design, a few repetitions — each predicted with that calibration, and
+// `qvr validate`: the simulator's correlation sheet. Calibrates each scene (qvr calibrate, apart
+// from every run: by default anew for each repetition, before its runs), then runs `qvr run` for
+// each condition — links × scenes × pipeline depths, every design, a few repetitions — each
+// predicted with its repetition's calibration, and
 // prints one table of the signed prediction errors with their mean absolute and worst values.
 // docs/MODEL.md §8.
 #include <signal.h>
@@ -44,6 +45,7 @@ struct ValidateOptions {
     // A run taken again when its speed probes say the machine was not steady over it.
     int retakes = 1;
     std::string hardware;  // a calibration to use instead of calibrating (one scene only)
+    std::string calibrate = "per-rep";  // or "once": when each scene is calibrated
     std::string profile = "default";
     std::string out = "qvr-validate";
     bool dry_run = false;
@@ -308,14 +310,27 @@ int runValidate(const ValidateOptions& o) {
         conditions, links.size(), scenes.size(), depths.size(), o.reps, o.designs, o.frames,
         machineDescriptionLine());
 
-    // 1. One calibration per scene, before any run.
-    std::map<std::string, std::string> calibration;
-    std::vector<double> calibration_spread;  // per scene: the chosen calibration's probes
-    for (const std::string& scene : scenes) {
+    // 1. The calibrations: by default each repetition calibrates each scene anew, just before
+    // that repetition's runs of the scene, and predicts them with it — so the repetitions repeat
+    // the whole measurement (calibrate, predict, run), not the runs alone. On a host whose speed
+    // moves from one minute to the next (docs/MODEL.md §8), one calibration per scene is one
+    // sample of that speed, and every run of the scene inherits its error; with one per
+    // repetition the error of each enters its own repetition, and the spread over repetitions
+    // states it. `--calibrate once` keeps the single calibration per scene, before any run.
+    std::map<std::string, std::string> calibration;  // key: scene|rep (rep 0 for `once`)
+    std::vector<double> calibration_spread;          // per calibration: the chosen take's probes
+    nlohmann::json calibrations_json = nlohmann::json::array();
+    const bool per_rep = o.calibrate == "per-rep" && hardware.empty();
+    auto calibrationKey = [&](const std::string& scene, int rep) {
+        return fmt::format("{}|{}", scene, per_rep ? rep : 0);
+    };
+    // Calibrates `scene` for repetition `rep` (0-based); 0 on success, else the exit status.
+    auto calibrate = [&](const std::string& scene, int rep) -> int {
+        const std::string key = calibrationKey(scene, rep);
         if (!hardware.empty()) {
             fmt::print("  using the calibration {} (--hardware) on {}\n", hardware, scene);
-            calibration[scene] = hardware;
-            continue;
+            calibration[key] = hardware;
+            return 0;
         }
         // A calibration whose own three speed probes are over 10% apart was taken on an unsteady
         // machine: it is taken again like a run, the steadiest counts.
@@ -323,20 +338,22 @@ int runValidate(const ValidateOptions& o) {
         int best_take = 0;
         for (int take = 0; take <= o.retakes; ++take) {
             const std::string file =
-                (out / fmt::format("calibration-{}{}.toml", safeName(scene),
+                (out / fmt::format("calibration-{}{}{}.toml", safeName(scene),
+                                   rep == 0 ? "" : fmt::format("-r{}", rep + 1),
                                    take == 0 ? "" : fmt::format("-t{}", take + 1)))
                     .string();
             const std::string cmd =
                 fmt::format("{} calibrate --scene {} --profile {} --out {} > {} 2>&1",
                             shellQuote(*exe), shellQuote(scene), shellQuote(o.profile),
                             shellQuote(file), shellQuote(file + ".log"));
-            fmt::print("  calibrating on {}{} ...", scene,
+            fmt::print("  calibrating on {}{}{} ...", scene,
+                       per_rep ? fmt::format(" for rep {}", rep + 1) : "",
                        take == 0 ? "" : fmt::format(" (take {})", take + 1));
             std::fflush(stdout);
             if (o.dry_run) {
                 fmt::print("\n    {}\n", cmd);
-                calibration[scene] = file;
-                break;
+                calibration[key] = file;
+                return 0;
             }
             const int rc = runCommand(cmd);
             if (g_validate_stop != 0) {
@@ -354,7 +371,7 @@ int runValidate(const ValidateOptions& o) {
             }
             const double sp = calibrationSpreadPct(file + ".json");
             if (!(sp >= best_spread)) {  // NaN (no probes) counts as steady
-                calibration[scene] = file;
+                calibration[key] = file;
                 best_spread = sp;
                 best_take = take;
             }
@@ -363,9 +380,18 @@ int runValidate(const ValidateOptions& o) {
                 break;
         }
         if (best_take > 0)
-            fmt::print("  on {} the runs use {}, the steadiest\n", scene, calibration[scene]);
+            fmt::print("  on {} the runs use {}, the steadiest\n", scene, calibration[key]);
         calibration_spread.push_back(best_spread);
-    }
+        calibrations_json.push_back({{"scene", scene},
+                                     {"rep", per_rep ? rep + 1 : 0},
+                                     {"file", calibration[key]},
+                                     {"probe_spread_pct", best_spread}});
+        return 0;
+    };
+    if (!per_rep)
+        for (const std::string& scene : scenes)
+            if (const int rc = calibrate(scene, 0); rc != 0)
+                return rc;
 
     // 2. The runs. A run whose speed probes moved over 10% across it, or whose mean was over
     // 10% off the calibration's reference, was not measured on a steady machine: it is taken
@@ -417,7 +443,10 @@ int runValidate(const ValidateOptions& o) {
     };
     bool stopped = false;
     for (int rep = 0; rep < o.reps && !stopped; ++rep)
-        for (const std::string& scene : scenes)
+        for (const std::string& scene : scenes) {
+            if (per_rep)
+                if (const int rc = calibrate(scene, rep); rc != 0)
+                    return rc;
             for (const std::string& link : links)
                 for (int depth : depths) {
                     if (stopped)
@@ -434,8 +463,8 @@ int runValidate(const ValidateOptions& o) {
                             "--profile {} --hardware {} --no-video --out {} > {} 2>&1",
                             shellQuote(*exe), shellQuote(scene), shellQuote(link), depth,
                             shellQuote(o.designs), o.frames, shellQuote(o.profile),
-                            shellQuote(calibration[scene]), shellQuote(dir.string()),
-                            shellQuote((dir.string()) + ".log"));
+                            shellQuote(calibration[calibrationKey(scene, rep)]),
+                            shellQuote(dir.string()), shellQuote((dir.string()) + ".log"));
                         fmt::print("  {} | {} | depth {} | rep {}{} ...", scene, link, depth,
                                    rep + 1, take == 0 ? "" : fmt::format(" take {}", take + 1));
                         std::fflush(stdout);
@@ -498,6 +527,7 @@ int runValidate(const ValidateOptions& o) {
                         ++counted_steady;
                     }
                 }
+        }
     if (o.dry_run)
         return 0;
 
@@ -628,6 +658,8 @@ int runValidate(const ValidateOptions& o) {
         {"run_speed_spread_pct", run_speed_spread},
         {"runs_unsteady", unsteady},
         {"retakes_max", o.retakes},
+        {"calibrate", hardware.empty() ? o.calibrate : std::string("hardware")},
+        {"calibrations", calibrations_json},
         {"calibration_probe_spread_pct", calibration_spread},
         {"runs_retaken", retaken},
         {"runs_unsteady_after_retakes", still_unsteady},
@@ -673,6 +705,11 @@ static Registered registerValidate(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--hardware", o->hardware,
                     "Use this calibration instead of calibrating (one scene)");
+    cmd->add_option("--calibrate", o->calibrate,
+                    "per-rep: each repetition calibrates each scene anew before its runs; once: "
+                    "one calibration per scene before any run")
+        ->check(CLI::IsMember({"per-rep", "once"}))
+        ->capture_default_str();
     cmd->add_option("--profile", o->profile, "Display profile")->capture_default_str();
     cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
     cmd->add_flag("--dry-run", o->dry_run, "Print the commands without running them");

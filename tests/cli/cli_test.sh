@@ -261,6 +261,28 @@ if run_ok "validate --dry-run lists its commands" validate --dry-run --links wif
         fail "validate plans one calibration and 2 links x 2 depths runs" "$(head -c 600 "$tmp/out.json")"
     fi
 fi
+expect_error "validate --calibrate twice" validate --calibrate twice --dry-run --out "$tmp/val"
+# Each repetition calibrates each scene anew, before its runs, and predicts them with that
+# calibration; `--calibrate once` keeps one per scene for every repetition.
+if run_ok "validate --reps 2 --dry-run" validate --dry-run --reps 2 --links wifi --scenes builtin:room --depths 1 --out "$tmp/val"; then
+    if [ "$(grep -c ' calibrate --scene' "$tmp/out.json")" -eq 2 ] &&
+        grep -A1 'depth 1 | rep 2 \.\.\.' "$tmp/out.json" | grep -q "hardware '[^']*calibration-builtin_room-r2.toml'" &&
+        grep -A1 'depth 1 | rep 1 \.\.\.' "$tmp/out.json" | grep -q "hardware '[^']*calibration-builtin_room.toml'" &&
+        [ "$(grep -n 'calibrating on builtin:room for rep 2' "$tmp/out.json" | cut -d: -f1)" -gt \
+          "$(grep -n 'depth 1 | rep 1 \.\.\.' "$tmp/out.json" | cut -d: -f1)" ]; then
+        pass "validate calibrates anew for each repetition, before that repetition's runs"
+    else
+        fail "validate calibrates anew for each repetition" "$(head -c 900 "$tmp/out.json")"
+    fi
+fi
+if run_ok "validate --reps 2 --calibrate once --dry-run" validate --dry-run --reps 2 --calibrate once --links wifi --scenes builtin:room --depths 1 --out "$tmp/val"; then
+    if [ "$(grep -c ' calibrate --scene' "$tmp/out.json")" -eq 1 ] &&
+        [ "$(grep -c "hardware '[^']*calibration-builtin_room.toml'" "$tmp/out.json")" -eq 2 ]; then
+        pass "validate --calibrate once predicts every repetition with one calibration"
+    else
+        fail "validate --calibrate once" "$(head -c 900 "$tmp/out.json")"
+    fi
+fi
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
