@@ -357,9 +357,7 @@ int runValidate(const ValidateOptions& o) {
             }
             const int rc = runCommand(cmd);
             if (g_validate_stop != 0) {
-                std::fprintf(stderr,
-                             "\nqvr validate: stopped (signal %d) while calibrating; no "
-                             "sheet\n",
+                std::fprintf(stderr, "\nqvr validate: stopped (signal %d) while calibrating\n",
                              int(g_validate_stop));
                 return 130;
             }
@@ -444,9 +442,21 @@ int runValidate(const ValidateOptions& o) {
     bool stopped = false;
     for (int rep = 0; rep < o.reps && !stopped; ++rep)
         for (const std::string& scene : scenes) {
+            // A repetition's calibration stopped by a signal ends the sheet as a run's stop does
+            // (the runs that ended are written); one that failed leaves this scene's runs of this
+            // repetition without a prediction: counted as a failure, the sheet goes on (bad input,
+            // exit 2 from calibrate, ends it with 2).
             if (per_rep)
-                if (const int rc = calibrate(scene, rep); rc != 0)
-                    return rc;
+                if (const int rc = calibrate(scene, rep); rc != 0) {
+                    if (g_validate_stop != 0) {
+                        stopped = true;
+                        break;
+                    }
+                    if (rc == 2)  // bad input (a scene or profile calibrate refuses)
+                        return 2;
+                    ++failures;
+                    continue;
+                }
             for (const std::string& link : links)
                 for (int depth : depths) {
                     if (stopped)
