@@ -16,6 +16,7 @@
 
 #include "bench_commands.h"
 #include "cli_parse.h"
+#include "qvr/experiment/host.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/scene/scene_loader.h"
@@ -54,13 +55,6 @@ double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const size_t n = v.size();
     return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double loadAvg1() {
-    std::ifstream in("/proc/loadavg");
-    double l = 0.0;
-    in >> l;
-    return l;
 }
 
 bool openArenaInstalled() {
@@ -240,7 +234,7 @@ static Registered registerRenderBench(CLI::App& bench) {
                 "{} sample(s) per pixel; LP_NUM_THREADS {}; load average {:.2f}\n",
                 profile->name, profile->width_px, profile->height_px, plan.e1_deg, plan.s1, plan.s2,
                 (*gl)->name(), opts->msaa, lp_threads ? lp_threads : "unset (all cores)",
-                loadAvg1());
+                experiment::loadAverage1());
             fmt::print("ms: wall time from first command to glFinish, before read-back\n");
         }
         nlohmann::json results = nlohmann::json::array();
@@ -260,7 +254,7 @@ static Registered registerRenderBench(CLI::App& bench) {
             j["renderer"] = (*gl)->name();
             j["frames"] = opts->frames;
             j["msaa_samples"] = opts->msaa;
-            j["load_average"] = loadAvg1();
+            j["load_average"] = experiment::loadAverage1();
             j["scenes"] = results;
             std::printf("%s\n", j.dump(2).c_str());
         }

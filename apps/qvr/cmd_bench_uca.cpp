@@ -14,6 +14,7 @@
 #include "bench_commands.h"
 #include "qvr/compose/opencv_two_pass.h"
 #include "qvr/compose/uca_benchmark.h"
+#include "qvr/experiment/host.h"
 
 namespace qvr::cli {
 
@@ -31,27 +32,6 @@ struct UcaBenchCli {
     bool no_quality = false;
     bool json = false;
 };
-
-std::string cpuModel() {
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line)) {
-        if (line.rfind("model name", 0) == 0) {
-            const auto colon = line.find(':');
-            if (colon != std::string::npos)
-                return line.substr(colon + 2);
-        }
-    }
-    return "unknown";
-}
-
-// Other processes on the cores inflate medians; the 1-minute load average says how much.
-double loadAverage() {
-    std::ifstream in("/proc/loadavg");
-    double load = -1.0;
-    in >> load;
-    return load;
-}
 
 nlohmann::json regionJson(const RegionQuality& q) {
     return {{"psnr_db", std::isfinite(q.psnr_db) ? q.psnr_db : 999.0},
@@ -154,9 +134,9 @@ static Registered registerUcaBench(CLI::App& bench) {
                            {"iterations", o.iterations},
                            {"simd_target", b.simd_target},
                            {"opencv_built", openCvAnchorBuilt()},
-                           {"cpu", cpuModel()},
+                           {"cpu", experiment::cpuModel()},
                            {"hardware_threads", std::thread::hardware_concurrency()},
-                           {"load_average", loadAverage()}};
+                           {"load_average", experiment::loadAverage1()}};
             std::printf("%s\n", j.dump(2).c_str());
             return 0;
         }
@@ -166,7 +146,7 @@ static Registered registerUcaBench(CLI::App& bench) {
             o.profile.width_px, o.profile.height_px, o.e1_deg, b.pose_change_deg, b.threads,
             b.simd_target);
         fmt::print("  tiles: {} empty, {} single-layer, {} border; load average {:.2f}\n",
-                   b.tiles.empty, b.tiles.single, b.tiles.border, loadAverage());
+                   b.tiles.empty, b.tiles.single, b.tiles.border, experiment::loadAverage1());
         fmt::print("  ms per frame        median      min   ({} frames each)\n", o.iterations);
         fmt::print("  UCA                {:8.2f} {:8.2f}\n", b.uca_ms, b.uca_min_ms);
         fmt::print("  UCA scalar twin    {:8.2f}\n", b.uca_scalar_ms);

@@ -27,7 +27,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "calibration.h"
+#include "qvr/experiment/calibration.h"
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/mp4_writer.h"
@@ -35,6 +35,7 @@
 #include "qvr/compose/quality.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/compose/warp.h"
+#include "qvr/experiment/host.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/net/link_emulator.h"
@@ -55,9 +56,11 @@
 #include "qvr/sim/runtime_model.h"
 #include "qvr/sim/simulator.h"
 #include "qvr/workload/trace_io.h"
-#include "scanout_recorder.h"
+#include "qvr/experiment/scanout_recorder.h"
 
 namespace qvr::cli {
+
+using namespace qvr::experiment;  // the experiment part this command drives
 
 namespace {
 
@@ -227,24 +230,6 @@ Expected<DesignQuality> measureDesignQuality(const std::vector<QualitySampler::S
         }
     q.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return q;
-}
-
-std::string machineDescription() {
-    std::string model;
-    std::ifstream cpu("/proc/cpuinfo");
-    for (std::string line; std::getline(cpu, line);)
-        if (line.rfind("model name", 0) == 0) {
-            model = line.substr(line.find(':') + 2);
-            break;
-        }
-    return fmt::format("{} × {}", onlineCores(), model.empty() ? "unknown CPU" : model);
-}
-
-std::string utcNow() {
-    const std::time_t t = std::time(nullptr);
-    char buf[64];
-    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M UTC", std::gmtime(&t));
-    return buf;
 }
 
 nlohmann::json summaryJson(const DesignSummary& s, const HeadsetStats& st) {
@@ -1257,8 +1242,8 @@ int runRun(const RunOptions& o) {
     // summary.json
     nlohmann::json j;
     j["command"] = o.command_line;
-    j["date"] = utcNow();
-    j["machine"] = machineDescription();
+    j["date"] = experiment::utcNow();
+    j["machine"] = experiment::machineDescription();
     j["scene"] = scene->name;
     j["profile"] = {{"name", profile->name},
                     {"width_px", profile->width_px},
@@ -1558,8 +1543,8 @@ int runRun(const RunOptions& o) {
     auto num = [](double v, int prec = 1) { return fmt::format("{:.{}f}", v, prec); };
     report::HtmlReport page("qvr run");
     page.heading(1, "qvr run");
-    page.html("<p>" + report::htmlEscape(o.command_line) + "<br>" + report::htmlEscape(utcNow()) +
-              ", " + report::htmlEscape(machineDescription()) + "</p>\n");
+    page.html("<p>" + report::htmlEscape(o.command_line) + "<br>" + report::htmlEscape(experiment::utcNow()) +
+              ", " + report::htmlEscape(experiment::machineDescription()) + "</p>\n");
     page.html(fmt::format(
         "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
         "the "

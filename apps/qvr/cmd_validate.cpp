@@ -24,12 +24,15 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "calibration.h"
+#include "qvr/experiment/calibration.h"
 #include "commands.h"
+#include "qvr/experiment/host.h"
 #include "qvr/runtime/server_process.h"
 #include "qvr/sim/hardware.h"
 
 namespace qvr::cli {
+
+using namespace qvr::experiment;  // the experiment part this command drives
 
 namespace {
 
@@ -308,7 +311,7 @@ int runValidate(const ValidateOptions& o) {
         "qvr validate: {} conditions ({} links × {} scenes × {} depths) × {} repetition(s), "
         "designs {}, {} frames each; {}\n",
         conditions, links.size(), scenes.size(), depths.size(), o.reps, o.designs, o.frames,
-        machineDescriptionLine());
+        experiment::machineDescription());
 
     // 1. The calibrations: by default each repetition calibrates each scene anew, just before
     // that repetition's runs of the scene, and predicts them with it — so the repetitions repeat
@@ -650,7 +653,7 @@ int runValidate(const ValidateOptions& o) {
     fmt::print("\n{}", md);
     std::ofstream(out / "validation.md") << md;
     const nlohmann::json summary = {
-        {"machine", machineDescriptionLine()},
+        {"machine", experiment::machineDescription()},
         {"seconds", seconds},
         {"reps", o.reps},
         {"frames", o.frames},

@@ -18,7 +18,7 @@
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/runtime/headset_client.h"
 
-namespace qvr::cli {
+namespace qvr::experiment {
 
 // Keeps what the headset scanned out, both eyes side by side at a quarter of the resolution
 // on each axis, in memory; encoded after the run. The recording runs inside the headset's loop
@@ -154,4 +154,4 @@ private:
     int m_recorded = 0;
 };
 
-}  // namespace qvr::cli
+}  // namespace qvr::experiment

@@ -14,7 +14,7 @@
 #include "qvr/core/expected.h"
 #include "qvr/sim/hardware.h"
 
-namespace qvr::cli {
+namespace qvr::experiment {
 
 struct CalibrateOptions {
     std::string scene = "builtin:room";
@@ -78,6 +78,10 @@ struct Calibration {
 
 Expected<Calibration> runCalibration(const CalibrateOptions& options);
 
+// The co-running load's child process (`qvr corun-load --mix MIX`): one side's frame mix,
+// looped until it is killed, beside the other side's measured frames. Returns an exit code.
+int runCoRunLoad(const CalibrateOptions& options, const std::string& mix);
+
 // The machine's speed at one moment: a fixed headset frame and a fixed server frame (the
 // co-running measurement's frames at e1 = 10°: both eyes' fovea, four decodes and UCA; four
 // periphery layers rendered and encoded), each timed over the same frames every time on this
@@ -109,7 +113,6 @@ std::string calibrationCachePath(const CalibrateOptions& options);
 // scale.
 std::string costLawText(const PartCost& cost);
 
-std::string machineDescriptionLine();
 // "h/s, h/s … ms headset/server" of speed probes.
 std::string speedProbesText(const std::vector<SpeedSample>& probes);
 // Each side's spread of speed probes (headset, server): largest over smallest, minus 1, in
@@ -119,4 +122,4 @@ std::array<double, 2> speedProbesSpreadPct(const std::vector<SpeedSample>& probe
 // machine was unsteady (calibrate, run, validate).
 inline constexpr double kUnsteadySpeedPct = 10.0;
 
-}  // namespace qvr::cli
+}  // namespace qvr::experiment
