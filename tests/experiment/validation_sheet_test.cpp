@@ -72,11 +72,12 @@ TEST(ValidationRows, AMissingFieldReadsAsNaN) {
 
 TEST(ValidationStats, MeanAbsoluteAndWorstOverTheCellsMeans) {
     ValidationResult result;
-    // Cell qvr: +10 then −4 (mean +3); cell ffr: −8 twice.
-    result.rows.add(summaryOf({{"qvr", design(10.0)}, {"ffr", design(-8.0)}}), "s", "l", 1);
-    result.rows.add(summaryOf({{"qvr", design(-4.0)}, {"ffr", design(-8.0)}}), "s", "l", 1);
+    // Cell ffr (read first): −2 twice; cell qvr: +20 then −4 (mean +8).
+    result.rows.add(summaryOf({{"qvr", design(20.0)}, {"ffr", design(-2.0)}}), "s", "l", 1);
+    result.rows.add(summaryOf({{"qvr", design(-4.0)}, {"ffr", design(-2.0)}}), "s", "l", 1);
+    ASSERT_EQ(result.rows.rows()[0].design, "ffr");
     const ValidationStats s = summariseValidation(result);
-    EXPECT_DOUBLE_EQ(s.fps.mean, 5.5);
+    EXPECT_DOUBLE_EQ(s.fps.mean, 5.0);
     EXPECT_DOUBLE_EQ(s.fps.worst, 8.0);
     EXPECT_EQ(s.fps.cells, 2u);
     EXPECT_DOUBLE_EQ(s.bytes.mean, 3.0);
