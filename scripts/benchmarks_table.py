@@ -140,6 +140,17 @@ def eval_command(eval_dir):
     return html.unescape(m.group(1)) if m else "qvr eval"
 
 
+def host_line(run):
+    """Whether the host held its calibration's speed over the run (docs/MODEL.md §11)."""
+    ref = run.get("calibration", {}).get("speed_reference", {})
+    spread = ref.get("run_spread_pct") or {}
+    if not isinstance(ref.get("unsteady"), bool) or not spread:
+        return ""
+    moved = ", ".join(f"{side} {num(v, '.0f')}%" for side, v in spread.items())
+    word = "unsteady" if ref["unsteady"] else "steady"
+    return f"Host {word} over the run (speed probes moved {moved})."
+
+
 def block(run_dir, eval_dir, note):
     run = read_json(Path(run_dir) / "summary.json")
     date = run.get("date") or datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -156,6 +167,9 @@ def block(run_dir, eval_dir, note):
         "",
     ]
     lines += run_table(run)
+    host = host_line(run)
+    if host:
+        lines += ["", host]
     ratios = run.get("ratios", {})
     if "qvr_fps_over_local" in ratios or "qvr_bytes_saved_vs_remote" in ratios:
         parts = []
