@@ -54,6 +54,14 @@ def cpu_model():
     return "unknown CPU"
 
 
+def machine_text(run):
+    """`lscpu`'s model name, with the run's own description where it names another machine."""
+    model, machine = cpu_model(), run.get("machine", "")
+    if not machine or model in machine:
+        return machine or model
+    return f"{model} (`lscpu` here; the run's summary.json says {machine})"
+
+
 def design_order(name):
     """local, remote, ffr, fixed:E by E, sw, qvr; anything else after them by name."""
     rank = {"local": 0, "remote": 1, "ffr": 2, "sw": 4, "qvr": 5}
@@ -157,7 +165,7 @@ def block(run_dir, eval_dir, note):
     if note:
         lines += [f"**{note}**", ""]
     lines += [
-        f"Measured {date} on {cpu_model()} ({run.get('machine', '?')}); "
+        f"Measured {date} on {machine_text(run)}; "
         f"scene {run.get('scene', '?')}, link {run.get('net', '?')}, "
         f"{run.get('frames_per_design', '?')} frames a design.",
         "",
