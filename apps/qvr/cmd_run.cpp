@@ -2,7 +2,7 @@
 // every design of the runtime over the same frames through net's link emulator (paper Fig. 4,
 // §6.1 measured for real), then write summary.json, per-frame telemetry, report.html with
 // gnuplot figures, the video the headset displayed for `qvr`, and `qvr sim`'s prediction for the
-// workload recorded during the run. The experiment is the experiment part's (run_report.h
+// workload recorded during the run. The experiment is the experiment part's (run_experiment.h
 // runExperiment); this file parses and checks the options.
 #include <cstdio>
 #include <memory>
@@ -13,8 +13,8 @@
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/video_codec.h"
+#include "qvr/experiment/run_experiment.h"
 #include "qvr/experiment/run_plan.h"
-#include "qvr/experiment/run_report.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/cpu_share.h"
 #include "qvr/runtime/runtime_design.h"

@@ -144,12 +144,16 @@ DesignMetrics metricsOf(const RuntimeSummary& s) {
             s.e1_deg_mean, s.headset_busy_ms_mean, s.server_busy_ms_mean};
 }
 
-// One pass of the calibrated runtime model with `costs` on the run's link.
-RuntimeRunResult runModel(const WorkloadTrace& trace, Design design, double fixed_e1_deg,
-                          RuntimeCosts costs, const ModelSettings& settings,
-                          const DesignModelInputs& inputs) {
+// One pass of the calibrated runtime model with `costs` on the run's link (none: the model
+// cannot make that link).
+std::optional<RuntimeRunResult> runModel(const WorkloadTrace& trace, Design design,
+                                         double fixed_e1_deg, RuntimeCosts costs,
+                                         const ModelSettings& settings,
+                                         const DesignModelInputs& inputs) {
     double delay_ms = 0.0;
     auto link = makeRuntimeLink(settings.net, &delay_ms);
+    if (!link)
+        return std::nullopt;
     RuntimeSimConfig rc;
     rc.design = design;
     rc.fixed_e1_deg = fixed_e1_deg;
@@ -178,20 +182,17 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     if (!simDesignOf(inputs.design, sd, fixed_e1))
         return p;
     p.speed = inputs.speed;
-    double delay_ms = 0.0;
-    if (makeRuntimeLink(settings.net, &delay_ms)) {
-        const RuntimeRunResult r = runModel(trace, sd, fixed_e1, calibrated, settings, inputs);
-        p.calibrated = RuntimePrediction{metricsOf(r.summary), r.summary.t_remote_ms_mean,
-                                         r.summary.frames_reused};
+    if (auto r = runModel(trace, sd, fixed_e1, calibrated, settings, inputs)) {
+        p.calibrated = RuntimePrediction{metricsOf(r->summary), r->summary.t_remote_ms_mean,
+                                         r->summary.frames_reused};
         if (frames)
-            *frames = r.frames;
+            *frames = std::move(r->frames);
         // With probes: the same model with the costs at the probes' speed, beside it.
         if (inputs.speed)
-            p.at_probe_speed =
-                metricsOf(runModel(trace, sd, fixed_e1,
+            if (auto at = runModel(trace, sd, fixed_e1,
                                    calibrated.atSpeed(inputs.speed->headset, inputs.speed->server),
-                                   settings, inputs)
-                              .summary);
+                                   settings, inputs))
+                p.at_probe_speed = metricsOf(at->summary);
     }
     if (paper_net) {
         auto sim_link = makeLink(*paper_net, settings.seed);
@@ -400,10 +401,7 @@ RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
         std::vector<RuntimeFrame> frames;
         DesignPrediction p = predictDesign(*w.trace, di, calibrated, settings, paper_net, &frames);
         writePredictedFrames(predicted_csv, di.design, frames);
-        Design sd;
-        double e1;
-        if (simDesignOf(di.design, sd, e1))
-            rp.by_design[di.design] = std::move(p);
+        rp.by_design[di.design] = std::move(p);
     }
     return rp;
 }

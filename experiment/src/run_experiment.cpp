@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "qvr/experiment/run_report.h"
+#include "qvr/experiment/run_experiment.h"
 
 namespace qvr::experiment {
 

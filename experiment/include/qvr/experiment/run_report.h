@@ -1,7 +1,7 @@
 // What `qvr run` found, as one typed result — per design what its run measured, what the models
 // predicted, their errors, its image quality and its transport counters; the run's setting,
 // calibration, machine speed, server, timeline and video — and everything written from it:
-// summary.json, report.html with its figures, the console's summary and the exit status.
+// summary.json and report.html with its figures.
 #pragma once
 
 #include <cstddef>
@@ -113,15 +113,5 @@ std::string validationHtml(const RunOutcome& outcome);
 
 // Writes summary.json, the figures (gnuplot, with their CSVs) and report.html into `out`.
 void writeRunReport(const RunOutcome& outcome, const std::filesystem::path& out);
-
-// The console's closing lines; then the exit status: 130 interrupted, 1 when a design never
-// showed the server's layers, else 0 (with a message on stderr for either).
-void printRunSummary(const RunOutcome& outcome, const std::string& out);
-int runExitStatus(const RunOutcome& outcome, const std::string& out);
-
-// `qvr run` once its options are checked: the calibration, the designs run, predicted and
-// reported into plan.out. Returns the exit status (2 for bad input found on the way).
-int runExperiment(const RunOptions& plan, const std::vector<runtime::DesignSpec>& designs,
-                  const HmdProfile& profile);
 
 }  // namespace qvr::experiment
