@@ -1,0 +1,135 @@
+// A run's designs predicted by the simulators: the runtime pipeline model with this machine's
+// calibration (sim/runtime_model.h), again with each design's costs at the machine's speed around
+// it, and the paper's model on its modelled hardware; and each prediction's error against what
+// was measured.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "qvr/experiment/design_runs.h"
+#include "qvr/sim/design.h"
+#include "qvr/sim/hardware.h"
+#include "qvr/sim/runtime_model.h"
+#include "qvr/workload/workload.h"
+
+namespace qvr::experiment {
+
+// The metrics a prediction is compared on, in the order summary.json and the report list them.
+enum class Metric { kFps, kMtpMean, kMtpP99, kBytes, kE1, kHeadsetBusy, kServerBusy };
+inline constexpr std::array<Metric, 7> kComparedMetrics = {
+    Metric::kFps, Metric::kMtpMean,     Metric::kMtpP99,    Metric::kBytes,
+    Metric::kE1,  Metric::kHeadsetBusy, Metric::kServerBusy};
+// Its key in summary.json ("fps_mean", …).
+const char* metricKey(Metric metric);
+
+// One design's headline metrics, measured or predicted. The two sides' own costs (the headset's
+// busy time per frame after the start-up, the server's render and encode per served frame) tell
+// which side an error is on; the paper's model predicts neither.
+struct DesignMetrics {
+    double fps_mean = 0.0;
+    double mtp_ms_mean = 0.0;
+    double mtp_ms_p99 = 0.0;
+    double bytes_per_frame_mean = 0.0;
+    double e1_deg_mean = 0.0;
+    std::optional<double> headset_busy_ms_mean;
+    std::optional<double> server_busy_ms_mean;
+    std::optional<double> value(Metric metric) const;
+};
+
+// What a design's run measured, as a prediction is compared on it; server_busy: the server's
+// busy time per served frame (none where it served none).
+DesignMetrics measuredMetrics(const runtime::DesignSummary& summary,
+                              std::optional<double> server_busy_ms_mean);
+
+// The calibrated runtime model's prediction: the metrics and what the model says besides.
+struct RuntimePrediction {
+    DesignMetrics metrics;
+    double t_remote_ms_mean = 0.0;
+    int frames_reused = 0;
+};
+
+// Signed error of a prediction, percent of the measurement, per compared metric (none where the
+// measurement is 0 or either side has no value), and e1's in degrees.
+struct PredictionError {
+    std::array<std::optional<double>, kComparedMetrics.size()> pct{};
+    double e1_deg_abs = 0.0;
+    std::optional<double> pctOf(Metric metric) const;
+};
+PredictionError predictionError(const DesignMetrics& predicted, const DesignMetrics& measured);
+
+// The machine's speed around a design (the mean of its probes before and after) over the
+// calibration's speed reference, per side; none without probes or a reference.
+struct SpeedFactors {
+    double headset = 1.0;
+    double server = 1.0;
+};
+std::optional<SpeedFactors> speedFactors(const DesignRun& run, const RuntimeCosts& calibrated);
+
+// The runtime designs on the simulator's: fixed:E is FFR at E degrees. False for a name the
+// simulator has no design for.
+bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg);
+
+// The triangles one layer draws and the fragments one eye's fovea pass shades
+// (RuntimeSimConfig::layer_triangles, fovea_fragments).
+using LayerTrianglesFn =
+    std::function<double(int64_t frame, const LayerPlan& plan, int eye, int kind)>;
+using FoveaFragmentsFn = std::function<double(int64_t frame, const LayerPlan& plan, int eye)>;
+
+// The run's knobs the models replay.
+struct ModelSettings {
+    std::string net;  // the run's --net spec
+    uint64_t seed = 1;
+    int pipeline_depth = 2;
+    double remote_timeout_ms = 250.0;
+    int warmup_frames = 0;
+    bool record_scanout = false;
+};
+ModelSettings modelSettings(const RunOptions& plan);
+
+// One design's predictions on a workload whose frame k is the run's frame k.
+struct DesignPrediction {
+    std::optional<RuntimePrediction> calibrated;
+    std::optional<SpeedFactors> speed;            // set where the probes give one
+    std::optional<DesignMetrics> at_probe_speed;  // the calibrated model at `speed`
+    std::optional<DesignMetrics> paper_hardware;  // the paper's model
+};
+
+// What a design's model run needs beyond the workload and the costs.
+struct DesignModelInputs {
+    std::string design;  // the run's label ("qvr", "fixed:10")
+    std::optional<SpeedFactors> speed;
+    LayerTrianglesFn layer_triangles;  // empty: the trace's BVH rings
+    FoveaFragmentsFn fovea_fragments;  // empty: none known
+};
+
+// Predicts one design: the calibrated model (and at the probes' speed when `speed` is set) on
+// the link `settings.net` makes for it, and the paper's model on `paper_net` (none: no
+// paper-hardware prediction). `frames`, when given, receives the calibrated model's frames.
+// Nothing where simDesignOf knows no design of that name.
+DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInputs& inputs,
+                               const RuntimeCosts& calibrated, const ModelSettings& settings,
+                               const std::optional<NetworkSpec>& paper_net,
+                               std::vector<RuntimeFrame>* frames = nullptr);
+
+// Every design of a run predicted, by design label.
+struct RunPrediction {
+    std::map<std::string, DesignPrediction> by_design;
+    std::string workload_source;  // where the replayed workload came from
+    size_t bits_frames_own = 0;   // frames charged the calibration's own bits for them
+    std::string sim_note;         // why a prediction is missing or differs (empty: none)
+};
+
+// The workload the predictions replay, computed after the run off the clock (every frame's
+// rings for the run's poses and gazes), the layers' triangles and the fovea's fragments, and
+// every design's predictions; the calibrated model's frames go to out/predicted_frames.csv.
+RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
+                         const runtime::HeadsetInputs& inputs, const RuntimeCosts& calibrated,
+                         const RunMeasurement& measurement);
+
+}  // namespace qvr::experiment

@@ -1,0 +1,409 @@
+#include "qvr/experiment/prediction.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <tuple>
+
+#include <fmt/format.h>
+
+#include "qvr/render/camera.h"
+#include "qvr/render/draw_list.h"
+#include "qvr/render/renderer.h"
+#include "qvr/runtime/workload_probe.h"
+#include "qvr/sim/network.h"
+#include "qvr/sim/simulator.h"
+#include "qvr/workload/trace_io.h"
+
+namespace qvr::experiment {
+
+namespace fs = std::filesystem;
+using runtime::DesignSummary;
+using runtime::FrameTelemetry;
+
+const char* metricKey(Metric metric) {
+    switch (metric) {
+        case Metric::kFps:
+            return "fps_mean";
+        case Metric::kMtpMean:
+            return "mtp_ms_mean";
+        case Metric::kMtpP99:
+            return "mtp_ms_p99";
+        case Metric::kBytes:
+            return "bytes_per_frame_mean";
+        case Metric::kE1:
+            return "e1_deg_mean";
+        case Metric::kHeadsetBusy:
+            return "headset_busy_ms_mean";
+        case Metric::kServerBusy:
+            return "server_busy_ms_mean";
+    }
+    return "";
+}
+
+std::optional<double> DesignMetrics::value(Metric metric) const {
+    switch (metric) {
+        case Metric::kFps:
+            return fps_mean;
+        case Metric::kMtpMean:
+            return mtp_ms_mean;
+        case Metric::kMtpP99:
+            return mtp_ms_p99;
+        case Metric::kBytes:
+            return bytes_per_frame_mean;
+        case Metric::kE1:
+            return e1_deg_mean;
+        case Metric::kHeadsetBusy:
+            return headset_busy_ms_mean;
+        case Metric::kServerBusy:
+            return server_busy_ms_mean;
+    }
+    return std::nullopt;
+}
+
+DesignMetrics measuredMetrics(const DesignSummary& s, std::optional<double> server_busy_ms_mean) {
+    DesignMetrics m{s.fps_mean,    s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
+                    s.e1_deg_mean, std::nullopt,  std::nullopt};
+    if (s.headset_busy_frames > 0)
+        m.headset_busy_ms_mean = s.headset_busy_ms_mean;
+    m.server_busy_ms_mean = server_busy_ms_mean;
+    return m;
+}
+
+std::optional<double> PredictionError::pctOf(Metric metric) const {
+    for (size_t i = 0; i < kComparedMetrics.size(); ++i)
+        if (kComparedMetrics[i] == metric)
+            return pct[i];
+    return std::nullopt;
+}
+
+PredictionError predictionError(const DesignMetrics& predicted, const DesignMetrics& measured) {
+    PredictionError e;
+    for (size_t i = 0; i < kComparedMetrics.size(); ++i) {
+        const double m = measured.value(kComparedMetrics[i]).value_or(0.0);
+        const std::optional<double> p = predicted.value(kComparedMetrics[i]);
+        if (m != 0.0 && p)
+            e.pct[i] = 100.0 * (*p - m) / std::fabs(m);
+    }
+    e.e1_deg_abs = predicted.e1_deg_mean - measured.e1_deg_mean;
+    return e;
+}
+
+std::optional<SpeedFactors> speedFactors(const DesignRun& run, const RuntimeCosts& calibrated) {
+    double h = 0.0, sv = 0.0;
+    int n = 0;
+    for (const std::optional<SpeedSample>& p : {run.speed_before, run.speed_after})
+        if (p) {
+            h += p->headset_ms;
+            sv += p->server_ms;
+            ++n;
+        }
+    if (n == 0 || calibrated.speed_reference_headset_ms <= 0.0 ||
+        calibrated.speed_reference_server_ms <= 0.0)
+        return std::nullopt;
+    return SpeedFactors{h / n / calibrated.speed_reference_headset_ms,
+                        sv / n / calibrated.speed_reference_server_ms};
+}
+
+bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg) {
+    if (name.rfind("fixed:", 0) == 0) {
+        char* end = nullptr;
+        const double e = std::strtod(name.c_str() + 6, &end);
+        if (end == name.c_str() + 6 || *end != '\0' || !(e > 0))
+            return false;
+        design = Design::Ffr;
+        fixed_e1_deg = e;
+        return true;
+    }
+    auto d = qvr::runtimeDesignByName(name);
+    if (!d)
+        return false;
+    design = *d;
+    return true;
+}
+
+ModelSettings modelSettings(const RunOptions& plan) {
+    ModelSettings s;
+    s.net = plan.net;
+    s.seed = plan.seed;
+    s.pipeline_depth = plan.pipeline_depth;
+    s.remote_timeout_ms = plan.remote_timeout_ms;
+    s.warmup_frames = plan.warmup_frames;  // the same frames left out as measured
+    s.record_scanout = plan.video;         // every design's headset copies its scan-out
+    return s;
+}
+
+namespace {
+
+DesignMetrics metricsOf(const RuntimeSummary& s) {
+    return {s.fps_mean,    s.mtp_ms_mean,          s.mtp_ms_p99,         s.bytes_per_frame_mean,
+            s.e1_deg_mean, s.headset_busy_ms_mean, s.server_busy_ms_mean};
+}
+
+// One pass of the calibrated runtime model with `costs` on the run's link (none: the model
+// cannot make that link).
+std::optional<RuntimeRunResult> runModel(const WorkloadTrace& trace, Design design,
+                                         double fixed_e1_deg, RuntimeCosts costs,
+                                         const ModelSettings& settings,
+                                         const DesignModelInputs& inputs) {
+    double delay_ms = 0.0;
+    auto link = makeRuntimeLink(settings.net, &delay_ms);
+    if (!link)
+        return std::nullopt;
+    RuntimeSimConfig rc;
+    rc.design = design;
+    rc.fixed_e1_deg = fixed_e1_deg;
+    rc.costs = std::move(costs);
+    rc.costs.link_delay_ms += delay_ms;
+    rc.pipeline_depth = settings.pipeline_depth;
+    rc.wait_limit_ms = settings.remote_timeout_ms;
+    rc.frames = static_cast<int>(trace.frames.size());
+    rc.warmup_frames = settings.warmup_frames;
+    rc.record_scanout = settings.record_scanout;
+    // The trace's frame k is the run's frame k (same poses).
+    rc.layer_triangles = inputs.layer_triangles;
+    rc.fovea_fragments = inputs.fovea_fragments;
+    return simulateRuntime(trace, rc, **link);
+}
+
+}  // namespace
+
+DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInputs& inputs,
+                               const RuntimeCosts& calibrated, const ModelSettings& settings,
+                               const std::optional<NetworkSpec>& paper_net,
+                               std::vector<RuntimeFrame>* frames) {
+    DesignPrediction p;
+    Design sd = Design::Qvr;
+    double fixed_e1 = 5.0;
+    if (!simDesignOf(inputs.design, sd, fixed_e1))
+        return p;
+    p.speed = inputs.speed;
+    if (auto r = runModel(trace, sd, fixed_e1, calibrated, settings, inputs)) {
+        p.calibrated = RuntimePrediction{metricsOf(r->summary), r->summary.t_remote_ms_mean,
+                                         r->summary.frames_reused};
+        if (frames)
+            *frames = std::move(r->frames);
+        // With probes: the same model with the costs at the probes' speed, beside it.
+        if (inputs.speed)
+            if (auto at = runModel(trace, sd, fixed_e1,
+                                   calibrated.atSpeed(inputs.speed->headset, inputs.speed->server),
+                                   settings, inputs))
+                p.at_probe_speed = metricsOf(at->summary);
+    }
+    if (paper_net) {
+        auto sim_link = makeLink(*paper_net, settings.seed);
+        if (!sim_link)
+            return p;
+        SimConfig cfg;
+        cfg.bench = "qvr-run";
+        cfg.design = sd;
+        cfg.frames = static_cast<int>(trace.frames.size());
+        const RunSummary s = simulate(trace, cfg, **sim_link).summary;
+        p.paper_hardware =
+            DesignMetrics{s.fps_mean,    s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
+                          s.e1_deg_mean, std::nullopt,  std::nullopt};
+    }
+    return p;
+}
+
+namespace {
+
+// The layers' triangles as the renderer draws them (level of detail, the periphery's holes) for
+// the run's poses and the plan the model chose, counted off the clock.
+LayerTrianglesFn makeLayerTriangles(const RunOptions& plan, const HmdProfile& profile,
+                                    const runtime::HeadsetInputs& inputs,
+                                    std::shared_ptr<const DrawList> draw_list) {
+    // By (frame, e1 in 1/1000°, eye, kind): LIWC revisits the same candidates.
+    auto cache = std::make_shared<std::map<std::tuple<int64_t, int64_t, int, int>, double>>();
+    const LayerHoles server_holes{.enabled = !plan.no_holes};
+    const float lod_px = plan.lod_px;
+    const PoseTrace* motion = &inputs.traces.motion;
+    return [=](int64_t frame, const LayerPlan& layer_plan, int eye, int kind) {
+        const auto key = std::make_tuple(
+            frame, static_cast<int64_t>(std::llround(layer_plan.e1_deg * 1000.0)), eye, kind);
+        if (auto it = cache->find(key); it != cache->end())
+            return it->second;
+        const double content_ms = contentTimeMs(frame, profile.refresh_hz);
+        const LayerKind lk = kind == 0   ? LayerKind::kFovea
+                             : kind == 1 ? LayerKind::kMiddle
+                                         : LayerKind::kOuter;
+        const double tris = double(layerTriangles(
+            *draw_list, profile, layer_plan, poseAt(*motion, content_ms), static_cast<Eye>(eye), lk,
+            lod_px, CameraOptions{}, lk == LayerKind::kFovea ? LayerHoles{} : server_holes));
+        cache->emplace(key, tris);
+        return tris;
+    };
+}
+
+// The fragments a design's fovea pass shaded at frame k, as its own run's headset counted them
+// (FrameTelemetry::fovea_fragments, both eyes): the overdraw the fovea law charges (docs/
+// MODEL.md §8, "Fragments"). A count of the content at that pose and e1, as the triangles are,
+// not a time. Where the model's e1 differs from the run's (LIWC's choices), the run's fragments
+// per fovea pixel times the model's pixels; none counted: −1, the law's mean.
+FoveaFragmentsFn foveaFragmentsOf(const DesignRun& run, const HmdProfile& profile,
+                                  const runtime::HeadsetTraces& traces) {
+    std::vector<std::pair<double, double>> by_frame;  // e1, fragments per eye
+    for (const FrameTelemetry& t : run.result.frames) {
+        if (t.frame < 0 || t.frame > 1000000)
+            continue;
+        if (by_frame.size() <= size_t(t.frame))
+            by_frame.resize(size_t(t.frame) + 1, {0.0, -1.0});
+        by_frame[size_t(t.frame)] = {t.e1_deg,
+                                     t.fovea_fragments > 0.0 ? t.fovea_fragments / 2.0 : -1.0};
+    }
+    auto planner = std::make_shared<const LayerPlanner>(profile);
+    const GazeTrace* gaze = &traces.gaze;
+    const double refresh_hz = profile.refresh_hz;
+    return [=](int64_t frame, const LayerPlan& plan, int eye) -> double {
+        if (frame < 0 || size_t(frame) >= by_frame.size() || by_frame[size_t(frame)].second < 0)
+            return -1.0;
+        const auto [e1, frags] = by_frame[size_t(frame)];
+        const LayerRect& model = plan.eyes[size_t(eye)].fovea;
+        if (std::fabs(plan.e1_deg - e1) < 1e-3 || model.empty())
+            return frags;
+        const double content_ms = contentTimeMs(frame, refresh_hz);
+        const LayerPlan run_plan = planner->plan(gazeAt(*gaze, content_ms), e1);
+        const double run_px = double(run_plan.eyes[size_t(eye)].fovea.pixels());
+        return run_px > 0.0 ? frags * double(model.pixels()) / run_px : -1.0;
+    };
+}
+
+struct PredictionWorkload {
+    Expected<WorkloadTrace> trace = makeError("no workload");
+    std::string source;
+    size_t bits_frames_own = 0;
+};
+
+// The workload the predictions replay: every frame's triangles and pixels per ring as the
+// headset's LIWC counts them (the draw clusters at the fovea's level of detail, or the BVH with
+// --ring-counts bvh; all rings), computed after the runs, off the clock, for the same poses and
+// gazes; bits per pixel from the calibration's codec law. So every design set gets a prediction
+// and nothing in it is measured on the run. Without a bits law in the calibration, the qvr
+// design's recorded workload (its bits per pixel as the headset estimated them).
+PredictionWorkload predictionWorkload(const RunOptions& plan, const HmdProfile& profile,
+                                      const runtime::HeadsetInputs& inputs,
+                                      const RuntimeCosts& costs, const RunMeasurement& m,
+                                      std::shared_ptr<const DrawList> draw_list) {
+    PredictionWorkload w;
+    if (costs.bits_per_px_at_1 <= 0.0) {
+        if (m.recorded_workload) {
+            w.trace = loadWorkloadTrace((fs::path(plan.out) / "workload.jsonl").string());
+            w.source = "workload.jsonl recorded by the qvr design";
+        }
+        return w;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    runtime::WorkloadProbe probe(profile, inputs.bvh);
+    if (plan.ring_counts == "clusters")
+        probe.useClusters(draw_list, plan.lod_px);
+    probe.setName("qvr-run-prediction", "qvr run: the run's poses and gazes, LIWC's rings");
+    WorkloadTrace t;
+    t.header = probe.header();
+    // An interrupted run predicts the frames its designs got through, not the ones asked for.
+    size_t predict_frames = static_cast<size_t>(plan.frames);
+    if (m.interrupted) {
+        predict_frames = 0;
+        for (const DesignRun& r : m.runs)
+            predict_frames = std::max(predict_frames, r.result.frames.size());
+    }
+    for (size_t i = 0; i < predict_frames; ++i) {
+        const double content_ms = contentTimeMs(static_cast<int64_t>(i), profile.refresh_hz);
+        WorkloadFrame wf = probe.frame(static_cast<int64_t>(i), content_ms,
+                                       poseAt(inputs.traces.motion, content_ms),
+                                       gazeAt(inputs.traces.gaze, content_ms), 180.0);
+        for (size_t k = 0; k < wf.bits_per_pixel.size(); ++k)
+            wf.bits_per_pixel[k] =
+                costs.bits_per_px_at_1 * std::pow(t.header.scales[k], costs.bits_scale_exponent);
+        // The calibration coded this very head pose as its frame i: the frame's own bits.
+        if (costs.bitsFrameMeasured(i, frameContentKey(wf.head)))
+            ++w.bits_frames_own;
+        t.frames.push_back(std::move(wf));
+    }
+    w.trace = std::move(t);
+    w.source = fmt::format(
+        "the run's poses and gazes, {} ring counts computed after the run ({:.1f} s), bits "
+        "per pixel from the calibration ({} of {} frames their own, coded by the calibration "
+        "on the same head pose; the rest its law); layer triangles drawn (LOD, holes) counted "
+        "off the clock; the fovea's shaded fragments as each design's own passes counted them "
+        "(a count, not a time: its overdraw, docs/MODEL.md §8 \"Fragments\")",
+        plan.ring_counts,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+        w.bits_frames_own, predict_frames);
+    return w;
+}
+
+// The model's frames beside telemetry.csv's, to chase an error to its stage.
+constexpr const char* kPredictedFramesHeader =
+    "design,frame,e1_deg,pose_ms,t_local_ms,t_remote_ms,headset_busy_ms,decision_ms,"
+    "remote_done_ms,uca_end_ms,display_ms,mtp_ms,uca_ms,bytes,reused,served,server_render_ms,"
+    "server_encode_ms,key_frames\n";
+
+void writePredictedFrames(std::ostream& csv, const std::string& name,
+                          const std::vector<RuntimeFrame>& frames) {
+    for (const RuntimeFrame& f : frames)
+        csv << fmt::format(
+            "{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},"
+            "{:.0f},{:d},{:d},{:.3f},{:.3f},{:d}\n",
+            name, f.index, f.e1_deg, f.pose_ms, f.t_local_ms, f.t_remote_ms, f.headset_busy_ms,
+            f.decision_ms, f.remote_done_ms, f.uca_end_ms, f.display_ms, f.mtp_ms,
+            f.uca_end_ms - f.uca_start_ms, f.bytes, int(f.reused), int(f.served),
+            f.server_render_ms, f.server_encode_ms, f.key_frames);
+}
+
+// The paper model's network for the run's link, and what the report says about both links.
+std::optional<NetworkSpec> paperNetwork(const std::string& net, std::string& sim_note) {
+    const std::string net_name = net.substr(0, net.find(','));
+    auto spec = networkSpecByName(net_name);
+    if (!spec) {
+        sim_note = fmt::format(
+            "--net '{}' has no paper-model profile; the paper-hardware column uses wifi", net_name);
+        spec = networkSpecByName("wifi");
+    }
+    double delay_ms = 0.0;
+    if (auto link = makeRuntimeLink(net, &delay_ms); !link)
+        sim_note += (sim_note.empty() ? "" : "; ") + ("no calibrated prediction: " + link.error());
+    return spec ? std::optional<NetworkSpec>(*spec) : std::nullopt;
+}
+
+}  // namespace
+
+RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
+                         const runtime::HeadsetInputs& inputs, const RuntimeCosts& calibrated,
+                         const RunMeasurement& measurement) {
+    RunPrediction rp;
+    auto draw_list = std::make_shared<DrawList>(buildDrawList(*inputs.scene));
+    if (plan.lod_px > 0.0f)
+        buildLods(*draw_list, *inputs.scene);
+    PredictionWorkload w =
+        predictionWorkload(plan, profile, inputs, calibrated, measurement, draw_list);
+    rp.workload_source = w.source;
+    rp.bits_frames_own = w.bits_frames_own;
+    if (!w.trace) {
+        rp.sim_note =
+            "no prediction: the workload is recorded during the qvr design's run, and "
+            "--designs has no qvr";
+        return rp;
+    }
+    const std::optional<NetworkSpec> paper_net = paperNetwork(plan.net, rp.sim_note);
+    std::ofstream predicted_csv(fs::path(plan.out) / "predicted_frames.csv");
+    predicted_csv << kPredictedFramesHeader;
+    if (w.trace->frames.empty())
+        return rp;
+    const ModelSettings settings = modelSettings(plan);
+    const LayerTrianglesFn layer_triangles = makeLayerTriangles(plan, profile, inputs, draw_list);
+    for (const DesignRun& r : measurement.runs) {
+        const DesignModelInputs di{r.label(), speedFactors(r, calibrated), layer_triangles,
+                                   foveaFragmentsOf(r, profile, inputs.traces)};
+        std::vector<RuntimeFrame> frames;
+        DesignPrediction p = predictDesign(*w.trace, di, calibrated, settings, paper_net, &frames);
+        writePredictedFrames(predicted_csv, di.design, frames);
+        rp.by_design[di.design] = std::move(p);
+    }
+    return rp;
+}
+
+}  // namespace qvr::experiment
