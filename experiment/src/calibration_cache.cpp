@@ -11,7 +11,7 @@
 namespace qvr::experiment {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
-    // What the calibration measures and how; a cached calibration of another version is not reused.
+    // Raised whenever what the calibration measures, or how, changes: an older cache is not reused.
     constexpr int kCalibrationVersion = 17;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescription(), o.profile,
