@@ -27,13 +27,6 @@ namespace {
 // The layers' pass skips its first frames, as a run's warm-up does; so does the whole frame's.
 constexpr int kCodecWarmup = 10;
 
-double meanOf(const std::vector<double>& v) {  // 0 for none
-    double sum = 0.0;
-    for (double x : v)
-        sum += x;
-    return v.empty() ? 0.0 : sum / double(v.size());
-}
-
 double canvasPx(const VideoEncoder& e) {
     return double(e.canvasWidth()) * double(e.canvasHeight());
 }

@@ -18,6 +18,13 @@ double upperMedian(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+double meanOf(const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v)
+        sum += x;
+    return v.empty() ? 0.0 : sum / double(v.size());
+}
+
 CalibratedPart summarisePart(const std::string& name, const std::string& what,
                              const std::vector<CostSample>& samples, const PartCost& cost) {
     CalibratedPart p;
@@ -86,13 +93,6 @@ void fitBitsByFrame(const std::array<std::vector<BitsSample>, 2>& bits,
 }
 
 namespace {
-
-double meanOf(const std::vector<double>& v) {  // 0 for none
-    double sum = 0.0;
-    for (double x : v)
-        sum += x;
-    return v.empty() ? 0.0 : sum / double(v.size());
-}
 
 // Bits per pixel: b·s^γ for the middle and the outer layer apart, γ from the logs, b from the
 // mean (sim/cost_fit.h fitBitsLaw).

@@ -26,6 +26,11 @@ TEST(CalibrationFit, UpperMedian) {
     EXPECT_EQ(upperMedian({5.0, 1.0, 3.0}), 3.0);
 }
 
+TEST(CalibrationFit, MeanOf) {
+    EXPECT_EQ(meanOf({}), 0.0);
+    EXPECT_EQ(meanOf({1.0, 2.0, 6.0}), 3.0);
+}
+
 TEST(CalibrationFit, SummarisePartSpreadsAndKeepsEverySample) {
     std::vector<CostSample> s = {{3.0, 1e5, 1e3}, {1.0, 2e5, 2e3, true, 5e5}, {2.0, 3e5, 3e3}};
     const PartCost cost{2.0, 0.0, 0.0};

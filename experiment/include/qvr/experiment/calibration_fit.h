@@ -41,6 +41,8 @@ struct CalibrationSamples {
 
 // The middle value of v (the upper of the two middle ones for an even count); 0 for none.
 double upperMedian(std::vector<double> v);
+// The mean of v; 0 for none.
+double meanOf(const std::vector<double>& v);
 
 // A part's summary: its samples' spread, the fit's residual and every sample (for the JSON).
 CalibratedPart summarisePart(const std::string& name, const std::string& what,
