@@ -39,40 +39,7 @@ int runCalibrate(CalibrateCmdOptions& o) {
         return 2;
     }
     cal->command = o.command_line;
-    fmt::print("  {:14} {:>7} {:>9} {:>9} {:>9} {:>8}  {}\n", "part", "samples", "median", "min",
-               "max", "fit RMS", "law (ms)");
-    for (const CalibratedPart& p : cal->parts)
-        fmt::print("  {:14} {:>7} {:>9.2f} {:>9.2f} {:>9.2f} {:>7.0f}%  {}\n", p.name, p.samples,
-                   p.median_ms, p.min_ms, p.max_ms, p.residual_rms_pct, costLawText(p.cost));
-    fmt::print(
-        "  frame overhead (plan) {:.3f} ms; display video copy {:.3f} ms; packets {} + {} bytes; "
-        "took {:.0f} s, load average {:.2f} before\n",
-        cal->costs.frame_overhead_ms, cal->costs.scanout_record_ms, cal->costs.packet_payload_bytes,
-        cal->costs.packet_overhead_bytes, cal->seconds, cal->load_avg_before);
-    fmt::print(
-        "  codec: P-frame bits per layer pixel middle {:.4f}·s^{:.3f}, outer {:.4f}·s^{:.3f} (the "
-        "mean: {:.3f}x / {:.3f}x the geometric mean); key frame {:.2f}x / {:.2f}x a P-frame (new "
-        "encoder), {:.2f}x (periodic); padding {:.3f} of a layer pixel's bits ({} pairs)\n",
-        cal->costs.bits_per_px_at_1, cal->costs.bits_scale_exponent,
-        cal->costs.bits_outer_per_px_at_1, cal->costs.bits_outer_scale_exponent,
-        cal->bits_mean_over_geometric[0], cal->bits_mean_over_geometric[1],
-        cal->costs.keyframe_bits_ratio, cal->costs.keyframe_outer_bits_ratio,
-        cal->costs.keyframe_periodic_bits_ratio, cal->costs.padding_bits_ratio,
-        cal->padding_samples);
-    fmt::print("  codec: P-frame bits per whole-frame pixel (remote) {:.4f} ({} P-frames)\n",
-               cal->costs.bits_full_frame_per_px, cal->bits_full_frame_samples);
-    fmt::print("  codec: bits frame by frame on the calibration's motion: {}\n",
-               bitsByFrameText(cal->costs));
-    fmt::print("  co-running, headset: {}\n", cal->corun_headset.note);
-    fmt::print("  co-running, server: {}\n", cal->corun_server.note);
-    fmt::print(
-        "  speed reference: {}\n",
-        cal->speed_note.empty()
-            ? fmt::format("headset frame {:.2f} ms, server frame {:.2f} ms, the mean of "
-                          "{}",
-                          cal->costs.speed_reference_headset_ms,
-                          cal->costs.speed_reference_server_ms, speedProbesText(cal->speed_probes))
-            : cal->speed_note);
+    fmt::print("{}", calibrationSummaryText(*cal));
     {
         std::ofstream f(o.out);
         f << cal->toToml();

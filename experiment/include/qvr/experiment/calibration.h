@@ -39,6 +39,10 @@ struct CalibratedPart {
     std::vector<double> samples_fragments;  // its shaded fragments (−1: not counted)
 };
 
+// The e1 of the frames the co-running measurement and the speed probe time: where qvr and sw
+// settle on the reference scenes.
+inline constexpr double kCoRunE1Deg = 10.0;
+
 // One speed probe (SpeedProbe below).
 struct SpeedSample {
     double headset_ms = 0.0;  // median of kFrames headset frames
@@ -60,8 +64,8 @@ struct Calibration {
     int bits_full_frame_samples = 0;  // whole-frame P-frames (remote's layer) measured
     nlohmann::json codec_by_e1;       // per calibration e1: median P-frame bits, key-frame ratios
     nlohmann::json links;             // the emulator's profiles
-    // The co-running measurements behind costs.corun_headset_slowdown and corun_server_slowdown
-    // (calibration version 12): one side's frames timed alone and beside the other side's mix.
+    // The co-running measurements behind costs.corun_headset_slowdown and corun_server_slowdown:
+    // one side's frames timed alone and beside the other side's mix.
     struct CoRun {
         double alone_ms = 0.0, shared_ms = 0.0;  // a frame's median, alone and beside the load
         int samples = 0;                         // paired frames
@@ -83,7 +87,7 @@ Expected<Calibration> runCalibration(const CalibrateOptions& options);
 int runCoRunLoad(const CalibrateOptions& options, const std::string& mix);
 
 // The machine's speed at one moment: a fixed headset frame and a fixed server frame (the
-// co-running measurement's frames at e1 = 10°: both eyes' fovea, four decodes and UCA; four
+// co-running measurement's frames at kCoRunE1Deg: both eyes' fovea, four decodes and UCA; four
 // periphery layers rendered and encoded), each timed over the same frames every time on this
 // thread's core, their medians. `qvr calibrate` takes it three times over its measurement and
 // keeps the mean as the hardware file's speed reference; `qvr run` takes it before and after
@@ -109,6 +113,10 @@ private:
 // cached calibration of `qvr run` is stored under it.
 std::string calibrationCacheKey(const CalibrateOptions& options);
 std::string calibrationCachePath(const CalibrateOptions& options);
+// What `qvr calibrate` prints once it has measured: a line per part (samples, spread, fit
+// residual, law), then the frame's overhead, the codec's laws, the co-running and the speed
+// reference.
+std::string calibrationSummaryText(const Calibration& cal);
 // A part's fitted law as text: "a + b·Mpx + c·ktri" or "k·Mpx^p·ktri^q", with its whole-frame
 // scale.
 std::string costLawText(const PartCost& cost);
@@ -118,6 +126,8 @@ std::string bitsByFrameText(const RuntimeCosts& costs);
 
 // "h/s, h/s … ms headset/server" of speed probes.
 std::string speedProbesText(const std::vector<SpeedSample>& probes);
+// Each side's mean over the probes; zero for none.
+SpeedSample meanSpeed(const std::vector<SpeedSample>& probes);
 // Each side's spread of speed probes (headset, server): largest over smallest, minus 1, in
 // percent; {0, 0} with fewer than two probes.
 std::array<double, 2> speedProbesSpreadPct(const std::vector<SpeedSample>& probes);
