@@ -9,6 +9,7 @@
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/experiment/calibration.h"
+#include "qvr/experiment/host.h"
 
 namespace qvr::cli {
 

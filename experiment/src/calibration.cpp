@@ -206,10 +206,6 @@ nlohmann::json Calibration::toJson() const {
                }()}}}};
 }
 
-namespace {
-
-// The frame-by-frame bits in a line: how many frames, and the middle's and outer's mean over
-// the law in the motion's first second (frames up to 30) and after it, with their range.
 std::string bitsByFrameText(const RuntimeCosts& c) {
     std::array<std::array<double, 3>, 4> acc{};  // {sum, min, max} middle/outer × early/late
     std::array<int, 2> n{};
@@ -242,8 +238,6 @@ std::string bitsByFrameText(const RuntimeCosts& c) {
     std::string early = part(0, "frames < 30,"), later = part(1, "frames >= 30,");
     return early + (early.empty() || later.empty() ? "" : "; ") + later + " of the law";
 }
-
-}  // namespace
 
 std::string Calibration::toToml() const {
     std::string s = fmt::format(

@@ -112,6 +112,9 @@ std::string calibrationCachePath(const CalibrateOptions& options);
 // A part's fitted law as text: "a + b·Mpx + c·ktri" or "k·Mpx^p·ktri^q", with its whole-frame
 // scale.
 std::string costLawText(const PartCost& cost);
+// The codec's frame-by-frame bits in a line: how many frames, and the middle's and outer's mean
+// over the law in the motion's first second (frames up to 30) and after it, with their range.
+std::string bitsByFrameText(const RuntimeCosts& costs);
 
 // "h/s, h/s … ms headset/server" of speed probes.
 std::string speedProbesText(const std::vector<SpeedSample>& probes);
