@@ -94,7 +94,7 @@ CLI::Validator unsignedInteger() {
                 return fmt::format("must be a whole number from 0 up, got '{}'", text);
             return {};
         },
-        "UINT", "UINT");
+        "", "UINT");
 }
 
 CLI::Validator readableFile() {
@@ -181,8 +181,8 @@ CLI::Option* addProfileOption(CLI::App* cmd, std::string& profile, ProfileNames 
         ->check(CLI::Validator(
             [with_runtime](std::string& name) -> std::string {
 #ifdef QVR_HAVE_RUNTIME
-                auto p = with_runtime ? runtime::runtimeProfileByName(name)
-                                      : hmdProfileByName(name);
+                auto p =
+                    with_runtime ? runtime::runtimeProfileByName(name) : hmdProfileByName(name);
 #else
                 (void)with_runtime;
                 auto p = hmdProfileByName(name);
