@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "options.h"
 #include "qvr/foveation/eye_geometry.h"
 
 namespace qvr::cli {
@@ -27,17 +28,6 @@ inline bool parseGazeDeg(const std::string& text, Gaze& gaze) {
         return false;
     gaze = {x, y};
     return true;
-}
-
-// --lod-px (render/draw_list.h): each view draws every scene cluster at the coarsest level of
-// detail whose vertices move at most this many of the view's own pixels; 0 draws full detail.
-inline CLI::Option* addLodOption(CLI::App* cmd, float& lod_px) {
-    return cmd
-        ->add_option("--lod-px", lod_px,
-                     "Level of detail: largest vertex move in each view's own pixels (0: full "
-                     "detail)")
-        ->check(CLI::Range(0.0, 16.0))
-        ->capture_default_str();
 }
 
 // "HOST:PORT" or "[IPV6]:PORT": PORT all digits in 1..65535; HOST an IPv4 or IPv6 address, or
@@ -96,11 +86,6 @@ inline bool isIpAddress(const std::string& text) {
     unsigned char addr[16];
     return inet_pton(AF_INET, text.c_str(), addr) == 1 ||
            inet_pton(AF_INET6, text.c_str(), addr) == 1;
-}
-
-// Seconds of a run: finite, in [0, one year].
-inline bool validDurationS(double s) {
-    return std::isfinite(s) && s >= 0.0 && s <= 365.0 * 24 * 3600;
 }
 
 // Checks, before any work, that `path` can be written (creates or truncates it), so that a run

@@ -181,30 +181,20 @@ static Registered registerRenderBench(CLI::App& bench) {
     cmd->add_option("--scene", opts->scenes,
                     "Scene(s) to render (default: builtin:room, and openarena:oa_dm5 when "
                     "installed)");
-    cmd->add_option("--profile", opts->profile, "HMD profile: default, low or a TOML file")
-        ->capture_default_str();
+    addProfileOption(cmd, opts->profile);
     cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees")
-        ->check(CLI::Range(0.0, 90.0))
+        ->check(finiteRange(0.0, 90.0))
         ->capture_default_str();
-    cmd->add_option("--gaze", opts->gaze, "Gaze X,Y degrees right/up of the optical axis")
-        ->capture_default_str();
-    cmd->add_option("--frames", opts->frames, "Timed frames per scene (median reported)")
-        ->check(CLI::Range(1, 10000))
-        ->capture_default_str();
+    addGazePointOption(cmd, opts->gaze);
+    addFramesOption(cmd, opts->frames, 1, 10000, "Timed frames per scene (median reported)");
     addLodOption(cmd, opts->lod_px);
     cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
         ->check(CLI::Range(1, 32))
         ->capture_default_str();
     cmd->add_flag("--json", opts->json, "Print machine-readable JSON");
     Action action = [opts]() -> int {
-        double gx = 0, gy = 0;
-        char tail = 0;
-        if (std::sscanf(opts->gaze.c_str(), "%lf,%lf%c", &gx, &gy, &tail) != 2 ||
-            !std::isfinite(gx) || !std::isfinite(gy) || std::fabs(gx) > 80 || std::fabs(gy) > 80) {
-            std::fprintf(stderr, "%s: --gaze must be X,Y in degrees within ±80, got '%s'\n", kCmd,
-                         opts->gaze.c_str());
-            return 2;
-        }
+        Gaze gaze;
+        parseGazeDeg(opts->gaze, gaze);  // checked when parsed
         auto profile = hmdProfileByName(opts->profile);
         if (!profile) {
             std::fprintf(stderr, "%s: %s\n", kCmd, profile.error().c_str());
@@ -226,7 +216,7 @@ static Registered registerRenderBench(CLI::App& bench) {
             std::fprintf(stderr, "%s: %s\n", kCmd, gl.error().c_str());
             return 1;
         }
-        const LayerPlan plan = LayerPlanner(*profile).plan({gx, gy}, opts->e1_deg);
+        const LayerPlan plan = LayerPlanner(*profile).plan(gaze, opts->e1_deg);
         const char* lp_threads = std::getenv("LP_NUM_THREADS");
         if (!opts->json) {
             fmt::print(

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_commands.h"
+#include "options.h"
 #include "qvr/compose/opencv_two_pass.h"
 #include "qvr/compose/uca_benchmark.h"
 #include "qvr/experiment/host.h"
@@ -51,19 +52,18 @@ static Registered registerUcaBench(CLI::App& bench) {
     auto opts = std::make_shared<UcaBenchCli>();
     CLI::App* cmd = bench.add_subcommand(
         "uca", "UCA vs two-pass vs OpenCV anchor, bandwidth floor, PSNR/SSIM (paper §4.2)");
-    cmd->add_option("--profile", opts->profile, "HMD profile: default, low or a TOML file")
-        ->capture_default_str();
+    addProfileOption(cmd, opts->profile);
     cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees")
-        ->check(CLI::Range(0.0, 90.0))
+        ->check(finiteRange(0.0, 90.0))
         ->capture_default_str();
     cmd->add_option("--yaw", opts->yaw_deg, "Display pose yaw relative to render pose, degrees")
-        ->check(CLI::Range(-30.0, 30.0))
+        ->check(finiteRange(-30.0, 30.0))
         ->capture_default_str();
     cmd->add_option("--pitch", opts->pitch_deg, "Display pose pitch, degrees")
-        ->check(CLI::Range(-30.0, 30.0))
+        ->check(finiteRange(-30.0, 30.0))
         ->capture_default_str();
     cmd->add_option("--roll", opts->roll_deg, "Display pose roll, degrees")
-        ->check(CLI::Range(-30.0, 30.0))
+        ->check(finiteRange(-30.0, 30.0))
         ->capture_default_str();
     cmd->add_option("--threads", opts->threads, "Worker threads (0: all cores)")
         ->check(CLI::Range(0, 256))

@@ -25,10 +25,6 @@ struct CalibrateCmdOptions {
 };
 
 int runCalibrate(CalibrateCmdOptions& o) {
-    if (o.out.empty()) {
-        std::fprintf(stderr, "qvr calibrate: --out FILE is required\n");
-        return 2;
-    }
     o.cal.verbose = true;
     fmt::print("qvr calibrate: {} on {}, profile {}, codec {}, LOD {} px, core {}{}\n",
                experiment::machineDescription(), o.cal.scene, o.cal.profile, o.cal.codec,
@@ -69,15 +65,16 @@ static Registered registerCalibrate(CLI::App& app) {
         "calibrate",
         "Measure this machine's runtime costs (render, encode, decode, UCA, ring counts) and "
         "write a hardware file for the runtime pipeline model");
-    cmd->add_option("--out", o->out, "Hardware file to write (TOML)")->required();
-    cmd->add_option("--json", o->json, "JSON copy (default: OUT.json)");
+    cmd->add_option("--out", o->out, "Hardware file to write (TOML)")
+        ->required()
+        ->check(writableFile());
+    cmd->add_option("--json", o->json, "JSON copy (default: OUT.json)")->check(writableFile());
     cmd->add_option("--scene", o->cal.scene, "Scene the render costs are measured on")
         ->capture_default_str();
-    cmd->add_option("--profile", o->cal.profile, "Display profile (as qvr run's)")
-        ->capture_default_str();
-    cmd->add_option("--codec", o->cal.codec, "Codec backend: x264 or raw")
-        ->check(CLI::IsMember({"x264", "raw"}))
-        ->capture_default_str();
+    addProfileOption(cmd, o->cal.profile, ProfileNames::kRuntime);
+    addCodecOption(cmd, o->cal.codec);
+    // Any core number, also one this machine lacks: the calibration then measures without its
+    // speed probe and says why (tests/cli/run_outputs_test.sh).
     cmd->add_option("--core", o->cal.core, "Core to pin to (-1: none)")
         ->check(CLI::Range(-1, 4096))
         ->capture_default_str();
@@ -101,10 +98,10 @@ static Registered registerCoRunLoad(CLI::App& app) {
         "qvr calibrate's second-core load (internal: one side's frames while told to)");
     cmd->group("");  // not listed: qvr calibrate starts it
     cmd->add_option("--scene", o->scene)->required();
-    cmd->add_option("--profile", o->profile)->required();
-    cmd->add_option("--lod-px", o->lod_px)->check(CLI::Range(0.0, 16.0));
+    addProfileOption(cmd, o->profile, ProfileNames::kRuntime)->required();
+    addLodOption(cmd, o->lod_px);
     cmd->add_option("--core", o->core)->required()->check(CLI::Range(0, 4095));
-    cmd->add_option("--codec", o->codec)->check(CLI::IsMember({"x264", "raw"}));
+    addCodecOption(cmd, o->codec);
     auto mix = std::make_shared<std::string>("server");
     cmd->add_option("--mix", *mix)->check(CLI::IsMember({"server", "headset", "probe"}));
     return {cmd, [o, mix] { return runCoRunLoad(*o, *mix); }};

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/compose/png_io.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/compose/uca.h"
@@ -81,41 +82,44 @@ static Registered registerCompose(CLI::App& app) {
     auto opts = std::make_shared<ComposeCli>();
     CLI::App* cmd = app.add_subcommand(
         "compose", "Compose one frame's layers for a display pose with UCA and write a PNG");
-    cmd->add_option("--profile", opts->profile, "HMD profile: default, low or a TOML file")
-        ->capture_default_str();
+    addProfileOption(cmd, opts->profile);
     cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees (the layer plan)")
-        ->check(CLI::Range(0.0, 180.0))
+        ->check(finiteRange(0.0, 180.0))
         ->capture_default_str();
-    cmd->add_option("--gaze", opts->gaze, "Gaze point X,Y in degrees (the layer plan)")
-        ->capture_default_str();
+    addGazePointOption(cmd, opts->gaze);
+    const CLI::Validator pose(
+        [](std::string& text) -> std::string {
+            double v[3];
+            return parseNumbers(text, v, 3, 180.0)
+                       ? std::string()
+                       : "must be yaw,pitch,roll in degrees within ±180, got '" + text + "'";
+        },
+        "YAW,PITCH,ROLL", "POSE");
     cmd->add_option("--render-pose", opts->render_pose,
                     "Yaw,pitch,roll in degrees the layers were rendered for")
+        ->check(pose)
         ->capture_default_str();
     cmd->add_option("--display-pose", opts->display_pose,
                     "Yaw,pitch,roll in degrees of the newer display pose")
+        ->check(pose)
         ->capture_default_str();
     cmd->add_option("--layers", opts->layers_dir,
                     "Read {left,right}_{fovea,middle,outer}.png from this directory instead of "
                     "rendering the test pattern; sizes must match the plan (see qvr plan)");
     cmd->add_option("--write-layers", opts->write_layers_dir,
-                    "Also write the layer images used, in the --layers naming");
+                    "Also write the layer images used, in the --layers naming")
+        ->check(outputFolder());
     cmd->add_option("--out", opts->out, "Output PNG: left and right eye side by side")
+        ->check(writableFileMakingFolder())
         ->capture_default_str();
     cmd->add_flag("--two-pass", opts->two_pass, "Use the two-pass reference instead of UCA");
     cmd->add_flag("--scalar", opts->scalar, "Use the scalar twin of the UCA kernel");
     Action action = [opts]() -> int {
+        // Each checked when parsed.
         double gaze[2], render[3], display[3];
-        if (!parseNumbers(opts->gaze, gaze, 2, 80.0)) {
-            std::fprintf(stderr, "qvr compose: --gaze must be X,Y degrees within ±80, got '%s'\n",
-                         opts->gaze.c_str());
-            return 2;
-        }
-        if (!parseNumbers(opts->render_pose, render, 3, 180.0) ||
-            !parseNumbers(opts->display_pose, display, 3, 180.0)) {
-            std::fprintf(stderr,
-                         "qvr compose: poses must be yaw,pitch,roll in degrees within ±180\n");
-            return 2;
-        }
+        parseNumbers(opts->gaze, gaze, 2, 80.0);
+        parseNumbers(opts->render_pose, render, 3, 180.0);
+        parseNumbers(opts->display_pose, display, 3, 180.0);
         auto profile = hmdProfileByName(opts->profile);
         if (!profile) {
             std::fprintf(stderr, "qvr compose: %s\n", profile.error().c_str());

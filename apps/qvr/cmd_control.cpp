@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/controller/control_run.h"
 #include "qvr/workload/synthetic.h"
 #include "qvr/workload/trace_io.h"
@@ -68,10 +69,6 @@ nlohmann::json summaryJson(const ControlSummary& s) {
 
 int runControl(const ControlOptions& o) {
     WorkloadTrace trace;
-    if (!o.trace.empty() && !o.bench.empty()) {
-        std::fprintf(stderr, "qvr control: give either --trace or --bench, not both\n");
-        return 2;
-    }
     if (!o.trace.empty()) {
         auto loaded = loadWorkloadTrace(o.trace);
         if (!loaded) {
@@ -101,15 +98,8 @@ int runControl(const ControlOptions& o) {
         trace = generateSyntheticWorkload(spec);
     }
     double mbps = o.throughput_mbps;
-    if (mbps <= 0.0) {
-        const double nominal = nominalMbps(o.net);
-        if (nominal <= 0.0) {
-            std::fprintf(stderr, "qvr control: unknown --net '%s' (choose wifi, lte or 5g)\n",
-                         o.net.c_str());
-            return 2;
-        }
-        mbps = nominal * kLinkEfficiency;
-    }
+    if (mbps <= 0.0)
+        mbps = nominalMbps(o.net) * kLinkEfficiency;
     GpuModel gpu;
     gpu.freq_mhz = o.gpu_mhz;
     const CostModel truth(trace.header, gpu, mbps * 1e6);
@@ -220,24 +210,25 @@ static Registered registerControl(CLI::App& app) {
                     "(e1 = 5 deg, the paper's FFR) or oracle (knows each frame's true cost)")
         ->check(CLI::IsMember({"liwc", "sw", "fixed", "oracle"}))
         ->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Frames to run")
-        ->check(CLI::Range(1, 1000000))
-        ->capture_default_str();
-    cmd->add_option("--trace", o->trace,
-                    "Workload trace file (JSON lines, docs/WORKLOAD_FORMAT.md)");
+    addFramesOption(cmd, o->frames, 1, 1000000, "Frames to run");
+    auto* trace = cmd->add_option("--trace", o->trace,
+                                  "Workload trace file (JSON lines, docs/WORKLOAD_FORMAT.md)")
+                      ->check(readableFile());
     cmd->add_option("--bench", o->bench,
                     "A workload of the synthetic suite (synthetic-doom3-h, synthetic-grid, ...); "
-                    "default: synthetic-default");
+                    "default: synthetic-default")
+        ->excludes(trace);
     cmd->add_option("--net", o->net, "Network profile: wifi (200 Mbit/s), lte (100), 5g (500)")
+        ->check(CLI::IsMember({"wifi", "lte", "5g"}))
         ->capture_default_str();
     cmd->add_option("--throughput-mbps", o->throughput_mbps,
                     "Effective link throughput in Mbit/s (overrides --net)")
-        ->check(CLI::Range(0.01, 1e6));
+        ->check(finiteRange(0.01, 1e6));
     cmd->add_option("--gpu-mhz", o->gpu_mhz, "Mobile GPU clock; rates scale linearly")
-        ->check(CLI::Range(50.0, 5000.0))
+        ->check(finiteRange(50.0, 5000.0))
         ->capture_default_str();
     cmd->add_option("--e1", o->fixed_e1_deg, "e1 of the fixed policy, degrees")
-        ->check(CLI::Range(0.0, 90.0))
+        ->check(finiteRange(0.0, 90.0))
         ->capture_default_str();
     cmd->add_flag("--compare", o->compare, "Also run every other policy and compare");
     cmd->add_flag("--json", o->json, "Print machine-readable JSON");

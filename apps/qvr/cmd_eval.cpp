@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/sim/benches.h"
 #include "qvr/sim/evaluation.h"
 #include "qvr/sim/network.h"
@@ -181,10 +182,10 @@ static Registered registerEval(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "eval",
         "Run the paper's experiments (Fig. 12-15, Table 4) on the recorded (or synthetic) suite");
-    cmd->add_option("--frames", o->frames,
-                    "Frames per run (30..100000); Fig. 14 always gets at least 300")
-        ->capture_default_str();
+    addFramesOption(cmd, o->frames, 30, 100000,
+                    "Frames per run (30..100000); Fig. 14 always gets at least 300");
     cmd->add_option("--jobs", o->jobs, "Runs simulated in parallel (threads)")
+        ->check(CLI::Range(1, 256))
         ->capture_default_str();
     cmd->add_option("--bench", o->benches,
                     "Run only these suite workloads (repeatable); default: all of the suite");
@@ -201,13 +202,16 @@ static Registered registerEval(CLI::App& app) {
                     "report shows the other beside it")
         ->capture_default_str();
     cmd->add_option("--hardware", o->hardware,
-                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)");
+                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)")
+        ->check(readableFile());
     cmd->add_option("--mahimahi", o->mahimahi,
                     "Mahimahi capacity traces (e.g. ../shared/data/network/*.down) to replay, "
-                    "rescaled to 100 Mbps, for ffr, dfr and qvr");
+                    "rescaled to 100 Mbps, for ffr, dfr and qvr")
+        ->check(readableFile());
     cmd->add_option("--out", o->out,
                     "Output folder: CSV + PNG per experiment, summary.json, report.html")
-        ->required();
+        ->required()
+        ->check(outputFolder());
     return {cmd, [o]() { return runEval(*o); }};
 }
 

@@ -62,22 +62,14 @@ static Registered registerPlan(CLI::App& app) {
     auto opts = std::make_shared<PlanOptions>();
     CLI::App* cmd = app.add_subcommand("plan", "Print the layer plan (Eq. 1) for a fovea radius");
     cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees of eccentricity")
-        ->check(CLI::Range(0.0, 180.0))
+        ->check(finiteRange(0.0, 180.0))
         ->capture_default_str();
-    cmd->add_option("--gaze", opts->gaze,
-                    "Gaze point as X,Y degrees right/up of the optical axis (within ±80)")
-        ->capture_default_str();
-    cmd->add_option("--profile", opts->profile,
-                    "HMD profile: default (1920x2160), low (1280x1600) or a TOML file")
-        ->capture_default_str();
+    addGazePointOption(cmd, opts->gaze);
+    addProfileOption(cmd, opts->profile);
     cmd->add_flag("--json", opts->json, "Print machine-readable JSON");
     Action action = [opts]() -> int {
         Gaze gaze;
-        if (!parseGazeDeg(opts->gaze, gaze)) {
-            std::fprintf(stderr, "qvr plan: --gaze must be X,Y in degrees within ±80, got '%s'\n",
-                         opts->gaze.c_str());
-            return 2;
-        }
+        parseGazeDeg(opts->gaze, gaze);  // checked when parsed
         auto profile = hmdProfileByName(opts->profile);
         if (!profile) {
             std::fprintf(stderr, "qvr plan: %s\n", profile.error().c_str());

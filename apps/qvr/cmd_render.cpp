@@ -54,19 +54,12 @@ bool parsePose(const std::string& text, Pose& pose) {
 
 int run(const RenderOptions& o) {
     constexpr const char* kCmd = "qvr render";
+    // Gaze and pose are checked when parsed.
     Gaze gaze;
-    if (!parseGazeDeg(o.gaze, gaze)) {
-        std::fprintf(stderr, "%s: --gaze must be X,Y in degrees within ±80, got '%s'\n", kCmd,
-                     o.gaze.c_str());
-        return 2;
-    }
+    parseGazeDeg(o.gaze, gaze);
     Pose head;
-    if (!o.pose.empty() && !parsePose(o.pose, head)) {
-        std::fprintf(stderr,
-                     "%s: --pose must be yaw,pitch,roll,x,y,z (degrees, then metres), got '%s'\n",
-                     kCmd, o.pose.c_str());
-        return 2;
-    }
+    if (!o.pose.empty())
+        parsePose(o.pose, head);
     auto profile = hmdProfileByName(o.profile);
     if (!profile) {
         std::fprintf(stderr, "%s: %s\n", kCmd, profile.error().c_str());
@@ -215,31 +208,38 @@ static Registered registerRender(CLI::App& app) {
         ->required();
     auto* pose = cmd->add_option("--pose", opts->pose,
                                  "Head pose yaw,pitch,roll,x,y,z (degrees, metres; y up, -z "
-                                 "forward)");
+                                 "forward)")
+                     ->check(CLI::Validator(
+                         [](std::string& text) -> std::string {
+                             Pose p;
+                             return parsePose(text, p) ? std::string()
+                                                       : "must be yaw,pitch,roll,x,y,z (degrees, "
+                                                         "then metres), got '" +
+                                                             text + "'";
+                         },
+                         "YAW,PITCH,ROLL,X,Y,Z", "POSE"));
     cmd->add_option("--spawn", opts->spawn, "Stand at this spawn point (default: the first)")
         ->check(CLI::Range(0, 100000))
         ->excludes(pose);
-    cmd->add_option("--gaze", opts->gaze, "Gaze X,Y degrees right/up of the optical axis")
-        ->capture_default_str();
+    addGazePointOption(cmd, opts->gaze);
     cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees of eccentricity")
-        ->check(CLI::Range(0.0, 180.0))
+        ->check(finiteRange(0.0, 180.0))
         ->capture_default_str();
-    cmd->add_option("--profile", opts->profile,
-                    "HMD profile: default (1920x2160), low (1280x1600) or a TOML file")
-        ->capture_default_str();
+    addProfileOption(cmd, opts->profile);
     cmd->add_option("--ipd-mm", opts->ipd_mm, "Interpupillary distance in millimetres")
-        ->check(CLI::Range(0.0, 100.0))
+        ->check(finiteRange(0.0, 100.0))
         ->capture_default_str();
     cmd->add_option("--lightmap-gain", opts->lightmap_gain,
                     "Extra lightmap brightening on top of the loader's overbright shift")
-        ->check(CLI::Range(0.0, 16.0))
+        ->check(finiteRange(0.0, 16.0))
         ->capture_default_str();
     addLodOption(cmd, opts->lod_px);
     cmd->add_option("--msaa", opts->msaa, "Samples per pixel (1: no multisampling)")
         ->check(CLI::Range(1, 32))
         ->capture_default_str();
     cmd->add_option("--out", opts->out_dir, "Directory for the PNGs ({eye}_{layer}.png)")
-        ->required();
+        ->required()
+        ->check(outputFolder());
     cmd->add_flag("--json", opts->json, "Print machine-readable JSON");
     Action action = [opts]() -> int { return run(*opts); };
     return {cmd, action};

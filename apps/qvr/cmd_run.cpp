@@ -34,32 +34,15 @@ int runRun(const RunOptions& o) {
         std::fprintf(stderr, "qvr run: --designs: %s\n", designs.error().c_str());
         return 2;
     }
-    if (o.frames < 2 || o.frames > 100000) {
-        std::fprintf(stderr, "qvr run: --frames must be within 2..100000, got %d\n", o.frames);
-        return 2;
-    }
     if (o.warmup_frames < 0 || o.warmup_frames > o.frames - 2) {
         std::fprintf(stderr, "qvr run: --warmup-frames must be within 0..frames-2 (%d), got %d\n",
                      o.frames - 2, o.warmup_frames);
-        return 2;
-    }
-    auto link = net::parseLinkSpec(o.net);
-    if (!link) {
-        std::fprintf(stderr, "qvr run: --net: %s\n", link.error().c_str());
         return 2;
     }
     auto profile = runtimeProfileByName(o.profile);
     if (!profile) {
         std::fprintf(stderr, "qvr run: --profile: %s\n", profile.error().c_str());
         return 2;
-    }
-    {
-        CodecConfig codec;
-        codec.backend = o.codec;
-        if (auto st = validateCodecConfig(codec); !st) {
-            std::fprintf(stderr, "qvr run: --codec: %s\n", st.error().c_str());
-            return 2;
-        }
     }
     if (std::string why; !makeOutputDir(o.out, why)) {
         std::fprintf(stderr, "qvr run: --out: %s\n", why.c_str());
@@ -79,26 +62,26 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_option("--motion", o->motion,
                     "Head motion: default (CMU BVH), a .bvh, a pose CSV, still")
         ->capture_default_str();
-    cmd->add_option("--gaze", o->gaze, "Gaze: model (seeded), center, or a gaze CSV")
-        ->capture_default_str();
-    cmd->add_option("--net", o->net,
-                    "Link spec for net's emulator (wifi, lte, 5g, rate:MBPS, trace:...)")
-        ->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Frames per design")->capture_default_str();
+    addGazeSourceOption(cmd, o->gaze);
+    addLinkOption(cmd, o->net);
+    addFramesOption(cmd, o->frames, 2, 100000, "Frames per design");
     cmd->add_option("--designs", o->designs,
                     "Comma-separated: local, remote, ffr (= fixed:5), fixed:E for any e1 E in "
                     "degrees, sw, qvr")
+        ->check(CLI::Validator(
+            [](std::string& list) -> std::string {
+                auto designs = parseDesignList(list);
+                return designs ? std::string() : designs.error();
+            },
+            "DESIGNS", "DESIGNS"))
         ->capture_default_str();
-    cmd->add_option(
-           "--profile", o->profile,
-           "Display profile: run (480x540), small (320x360), default (1920x2160), low, TOML")
-        ->capture_default_str();
-    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
-    cmd->add_option("--codec", o->codec, "Codec backend: x264 or raw")->capture_default_str();
-    cmd->add_option("--seed", o->seed, "Gaze model and simulator seed")->capture_default_str();
+    addProfileOption(cmd, o->profile, ProfileNames::kRuntime);
+    cmd->add_option("--out", o->out, "Output folder")->check(outputFolder())->capture_default_str();
+    addCodecOption(cmd, o->codec);
+    addSeedOption(cmd, o->seed, "Gaze model and simulator seed");
     cmd->add_option("--remote-timeout-ms", o->remote_timeout_ms,
                     "Remote layers later than this after the local render are late (frame reuse)")
-        ->check(CLI::Range(1.0, 10000.0))
+        ->check(finiteRange(1.0, 10000.0))
         ->capture_default_str();
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Server renders middle and outer in one geometry pass per eye (pays when "
@@ -109,7 +92,7 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_option("--headset-share", o->headset_share,
                     "Fraction of its core the headset process may use (CFS quota per 10 ms, "
                     "cgroups; needs root): the analogue of Table 4's slower headset GPUs")
-        ->check(CLI::Range(CpuShareGroup::kMinShare + 1e-9, 1.0))
+        ->check(finiteRange(CpuShareGroup::kMinShare + 1e-9, 1.0))
         ->capture_default_str();
     cmd->add_option("--ring-counts", o->ring_counts,
                     "LIWC's triangle rings: clusters (what the fovea draws, cheap) or bvh "
@@ -131,7 +114,8 @@ static Registered registerRun(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--hardware", o->hardware,
                     "Calibration for the prediction (qvr calibrate --out FILE); without it the "
-                    "cached calibration of this machine, or a fresh one measured first");
+                    "cached calibration of this machine, or a fresh one measured first")
+        ->check(readableFile());
     cmd->add_flag("--recalibrate", o->recalibrate,
                   "Measure the calibration again even when a cached one exists");
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");

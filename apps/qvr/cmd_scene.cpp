@@ -145,12 +145,7 @@ int runInfo(const SceneOptions& o) {
 
 int runCount(const SceneOptions& o) {
     Gaze gaze;
-    if (!parseGazeDeg(o.gaze, gaze)) {
-        std::fprintf(stderr,
-                     "qvr scene count: --gaze must be X,Y in degrees within ±80, got '%s'\n",
-                     o.gaze.c_str());
-        return 2;
-    }
+    parseGazeDeg(o.gaze, gaze);  // checked when parsed
     if (!(o.near_m > 0.0 && o.far_m > o.near_m)) {
         std::fprintf(stderr, "qvr scene count: need 0 < --near-m < --far-m\n");
         return 2;
@@ -291,23 +286,25 @@ static Registered registerScene(CLI::App& app) {
     common(count);
     count->add_option("--spawn", opts->spawn, "Spawn point index")->capture_default_str();
     count->add_option("--yaw", opts->yaw_deg, "Degrees added to the spawn's yaw")
-        ->check(CLI::Range(-360.0, 360.0));
+        ->check(finiteRange(-360.0, 360.0));
     count->add_option("--pitch", opts->pitch_deg, "Head pitch in degrees (up positive)")
-        ->check(CLI::Range(-89.0, 89.0));
-    count->add_option("--gaze", opts->gaze, "Gaze X,Y degrees right/up of the optical axis")
-        ->capture_default_str();
-    count->add_option("--profile", opts->profile, "HMD profile: default, low or a TOML file")
-        ->capture_default_str();
+        ->check(finiteRange(-89.0, 89.0));
+    addGazePointOption(count, opts->gaze);
+    addProfileOption(count, opts->profile);
     count->add_option("--ring-deg", opts->ring_deg, "Ring width in degrees")
-        ->check(CLI::Range(0.1, 90.0))
+        ->check(finiteRange(0.1, 90.0))
         ->capture_default_str();
     count->add_option("--rings", opts->rings, "Rings (0: enough to cover the image)")
         ->check(CLI::Range(0, 1800));
     count->add_option("--e1", opts->e1_deg, "Fovea cone radius in degrees")
-        ->check(CLI::Range(0.01, 89.9))
+        ->check(finiteRange(0.01, 89.9))
         ->capture_default_str();
-    count->add_option("--near-m", opts->near_m, "Near plane (metres)")->capture_default_str();
-    count->add_option("--far-m", opts->far_m, "Far plane (metres)")->capture_default_str();
+    count->add_option("--near-m", opts->near_m, "Near plane (metres)")
+        ->check(finiteNumber())
+        ->capture_default_str();
+    count->add_option("--far-m", opts->far_m, "Far plane (metres)")
+        ->check(finiteNumber())
+        ->capture_default_str();
     count->add_flag("--brute-force", opts->brute_force,
                     "Also count by testing every triangle, and compare");
     Action action = [opts, info, count]() -> int {

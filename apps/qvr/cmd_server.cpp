@@ -53,56 +53,41 @@ struct ServerCmdOptions {
     float lod_px = 1.0f;
 };
 
-int runServer(const ServerCmdOptions& o) {
-    // Pin the whole process: threads made from here on (asio, the render thread, llvmpipe's
-    // rasterizers, x264) inherit the mask.
-    if (o.core >= 0) {
-        if (auto st = pinCurrentThread(o.core); !st)
-            std::fprintf(stderr, "qvr server: %s (running unpinned)\n", st.error().c_str());
-    }
-    auto key = keyFromOptions(o.key, o.key_file);
-    if (!key) {
-        std::fprintf(stderr, "qvr server: %s\n", key.error().c_str());
-        return 2;
-    }
-    if (!isIpAddress(o.bind)) {
-        std::fprintf(stderr, "qvr server: --bind: '%s' is not an IPv4 or IPv6 address\n",
-                     o.bind.c_str());
-        return 2;
-    }
-    if (!validDurationS(o.duration_s)) {
-        std::fprintf(stderr,
-                     "qvr server: --duration-s must be finite and in [0, 31536000], got %g\n",
-                     o.duration_s);
-        return 2;
-    }
-    {
-        CodecConfig codec;
-        codec.backend = o.codec;
-        if (auto st = validateCodecConfig(codec); !st) {
-            std::fprintf(stderr, "qvr server: --codec: %s\n", st.error().c_str());
-            return 2;
+using StampsFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
+
+// Per-frame stamps for timelines (qvr run's trace.json): one line per layer sent, on this
+// process's steady clock; bounded so a long-running server cannot fill the disk.
+Status attachStampsCsv(const std::string& path, RenderServerConfig& cfg, StampsFile& stamps) {
+    stamps.reset(std::fopen(path.c_str(), "w"));
+    if (!stamps)
+        return makeError("--stamps-csv: cannot write '" + path + "'");
+    std::fputs(kServerStampsHeader, stamps.get());
+    cfg.on_frame = [f = stamps.get(), lines = int64_t{0}](const ServerFrameStamps& st) mutable {
+        for (const ServerFrameStamps::Layer& l : st.layers) {
+            if (++lines > kMaxServerStampLines)
+                return;
+            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", st.client, st.frame_id,
+                       st.client_send_ns, st.queued_ns, st.start_ns, st.end_ns, l.stream_id,
+                       l.render_start_ns, l.render_end_ns, l.encode_end_ns, l.sent_ns);
         }
-    }
-    if (std::string why; !checkWritableFile(o.stats_json, why)) {
-        std::fprintf(stderr, "qvr server: --stats-json: %s\n", why.c_str());
-        return 2;
-    }
+        // Whole frames on disk: a client on this machine reads the file while we run.
+        std::fflush(f);
+    };
+    return {};
+}
+
+// The server's settings from the options (each checked when parsed); an error when the key,
+// the scene or the stamps file cannot be had.
+Expected<RenderServerConfig> serverConfig(const ServerCmdOptions& o, StampsFile& stamps) {
+    auto key = keyFromOptions(o.key, o.key_file);
+    if (!key)
+        return makeError(key.error());
     auto profile = runtimeProfileByName(o.profile);
-    if (!profile) {
-        std::fprintf(stderr, "qvr server: --profile: %s\n", profile.error().c_str());
-        return 2;
-    }
+    if (!profile)
+        return makeError("--profile: " + profile.error());
     auto link = net::parseLinkSpec(o.net);
-    if (!link) {
-        std::fprintf(stderr, "qvr server: --net: %s\n", link.error().c_str());
-        return 2;
-    }
-    auto scene = loadScene(o.scene);
-    if (!scene) {
-        std::fprintf(stderr, "qvr server: %s\n", scene.error().c_str());
-        return 2;
-    }
+    if (!link)
+        return makeError("--net: " + link.error());
     RenderServerConfig cfg;
     cfg.net.bind_address = o.bind;
     cfg.net.port = o.port;
@@ -121,133 +106,103 @@ int runServer(const ServerCmdOptions& o) {
     GlRendererOptions gl;
     gl.lod_error_px = o.lod_px;
     cfg.renderer = glRendererFactory(gl);
-    // Per-frame stamps for timelines (qvr run's trace.json): one line per layer sent, on this
-    // process's steady clock; bounded so a long-running server cannot fill the disk.
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> stamps(nullptr, std::fclose);
-    if (!o.stamps_csv.empty()) {
-        stamps.reset(std::fopen(o.stamps_csv.c_str(), "w"));
-        if (!stamps) {
-            std::fprintf(stderr, "qvr server: --stamps-csv: cannot write '%s'\n",
-                         o.stamps_csv.c_str());
-            return 2;
-        }
-        std::fputs(kServerStampsHeader, stamps.get());
-        cfg.on_frame = [f = stamps.get(), lines = int64_t{0}](const ServerFrameStamps& st) mutable {
-            for (const ServerFrameStamps::Layer& l : st.layers) {
-                if (++lines > kMaxServerStampLines)
-                    return;
-                fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", st.client, st.frame_id,
-                           st.client_send_ns, st.queued_ns, st.start_ns, st.end_ns, l.stream_id,
-                           l.render_start_ns, l.render_end_ns, l.encode_end_ns, l.sent_ns);
-            }
-            // Whole frames on disk: a client on this machine reads the file while we run.
-            std::fflush(f);
-        };
-    }
-    auto server = RenderServer::start(cfg, std::make_shared<const Scene>(std::move(*scene)));
-    if (!server) {
-        std::fprintf(stderr, "qvr server: %s\n", server.error().c_str());
-        return 1;
-    }
-    fmt::print("qvr server: listening on {}:{} ({}x{} per eye, link {}); Ctrl-C stops\n", o.bind,
-               (*server)->port(), profile->width_px, profile->height_px, o.net);
-    std::fflush(stdout);
+    if (!o.stamps_csv.empty())
+        if (Status st = attachStampsCsv(o.stamps_csv, cfg, stamps); !st)
+            return makeError(st.error());
+    return cfg;
+}
+
+// Serves until SIGINT/SIGTERM, or until `duration_s` seconds have passed when it is above 0.
+void serveUntilStopped(double duration_s) {
     std::signal(SIGINT, onServerSignal);
     std::signal(SIGTERM, onServerSignal);
     const auto t0 = std::chrono::steady_clock::now();
     while (!g_server_stop) {
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        if (o.duration_s > 0 &&
+        if (duration_s > 0 &&
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >
-                o.duration_s)
+                duration_s)
             break;
     }
-    // Stop first (the frame in flight finishes, the render thread is joined), then read: the
-    // stats and the frames CSV then describe the same frames, however the server was ended.
-    (*server)->stop();
-    const RenderServerStats s = (*server)->stats();
-    const std::vector<ServerFrameRecord> frame_records = (*server)->frameRecords();
-    if (stamps && std::fflush(stamps.get()) != 0)
-        std::fprintf(stderr, "qvr server: error writing '%s'\n", o.stamps_csv.c_str());
-    if (!o.stats_json.empty()) {
-        const nlohmann::json j = {{"requests", s.requests},
-                                  {"requests_dropped", s.requests_dropped},
-                                  {"requests_invalid", s.requests_invalid},
-                                  {"frames_rendered", s.frames_rendered},
-                                  {"layers_rendered", s.layers_rendered},
-                                  {"periphery_passes", s.periphery_passes},
-                                  {"streams_sent", s.streams_sent},
-                                  {"stream_send_failures", s.stream_send_failures},
-                                  {"render_failures", s.render_failures},
-                                  {"encode_failures", s.encode_failures},
-                                  {"key_frame_requests", s.key_frame_requests},
-                                  {"render_ms_total", s.render_ms_total},
-                                  {"encode_ms_total", s.encode_ms_total},
-                                  {"readback_ms_total", s.readback_ms_total},
-                                  {"send_ms_total", s.send_ms_total},
-                                  {"connections", s.net.connections},
-                                  {"clients_accepted", s.net.clients_accepted},
-                                  {"auth_failures", s.net.auth_failures},
-                                  {"handshake_timeouts", s.net.handshake_timeouts},
-                                  {"refused_full", s.net.refused_full},
-                                  {"pending_evicted", s.net.pending_evicted},
-                                  {"idle_timeouts", s.net.idle_timeouts},
-                                  {"keepalives", s.net.keepalives},
-                                  {"protocol_errors", s.net.protocol_errors},
-                                  {"version_mismatches", s.net.version_mismatches},
-                                  {"settings_refusals", s.net.settings_refusals},
-                                  {"route_failures", s.net.route_failures},
-                                  {"control_forged", s.net.control_forged},
-                                  {"control_replayed", s.net.control_replayed},
-                                  {"nacks", s.net.nacks},
-                                  {"packets_retransmitted", s.net.packets_retransmitted},
-                                  {"bytes_retransmitted", s.net.bytes_retransmitted},
-                                  {"retransmissions_refused", s.net.retransmissions_refused},
-                                  {"fec_frames", s.net.fec_frames},
-                                  {"fec_parity_packets", s.net.fec_parity_packets},
-                                  {"fec_parity_bytes", s.net.fec_parity_bytes},
-                                  {"client_loss_ppm", s.net.client_loss_ppm},
-                                  {"control_drops", s.net.control_drops.total()},
-                                  {"link",
-                                   {{"packets_in", s.net.link.packets_in},
-                                    {"packets_delivered", s.net.link.packets_delivered},
-                                    {"dropped_loss", s.net.link.dropped_loss},
-                                    {"dropped_queue", s.net.link.dropped_queue},
-                                    {"dropped_burst", s.net.link.dropped_burst},
-                                    {"reordered", s.net.link.reordered},
-                                    {"duplicated", s.net.link.duplicated},
-                                    {"spiked", s.net.link.spiked}}},
-                                  {"core", o.core}};
-        std::ofstream f(o.stats_json);
-        f << j.dump(2) << "\n";
-        if (!f) {
-            std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
-            return 1;
-        }
-    }
-    if (!o.frames_csv.empty()) {
-        std::ofstream f(o.frames_csv);
-        f << "client,frame,e1_deg,received_ns,start_ns,done_ns";
-        for (int sid = 0; sid < 4; ++sid)
-            f << fmt::format(
-                ",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
-                "send_ms{0},bytes{0}",
-                sid);
+}
+
+nlohmann::json serverStatsJson(const RenderServerStats& s, int core) {
+    return {{"requests", s.requests},
+            {"requests_dropped", s.requests_dropped},
+            {"requests_invalid", s.requests_invalid},
+            {"frames_rendered", s.frames_rendered},
+            {"layers_rendered", s.layers_rendered},
+            {"periphery_passes", s.periphery_passes},
+            {"streams_sent", s.streams_sent},
+            {"stream_send_failures", s.stream_send_failures},
+            {"render_failures", s.render_failures},
+            {"encode_failures", s.encode_failures},
+            {"key_frame_requests", s.key_frame_requests},
+            {"render_ms_total", s.render_ms_total},
+            {"encode_ms_total", s.encode_ms_total},
+            {"readback_ms_total", s.readback_ms_total},
+            {"send_ms_total", s.send_ms_total},
+            {"connections", s.net.connections},
+            {"clients_accepted", s.net.clients_accepted},
+            {"auth_failures", s.net.auth_failures},
+            {"handshake_timeouts", s.net.handshake_timeouts},
+            {"refused_full", s.net.refused_full},
+            {"pending_evicted", s.net.pending_evicted},
+            {"idle_timeouts", s.net.idle_timeouts},
+            {"keepalives", s.net.keepalives},
+            {"protocol_errors", s.net.protocol_errors},
+            {"version_mismatches", s.net.version_mismatches},
+            {"settings_refusals", s.net.settings_refusals},
+            {"route_failures", s.net.route_failures},
+            {"control_forged", s.net.control_forged},
+            {"control_replayed", s.net.control_replayed},
+            {"nacks", s.net.nacks},
+            {"packets_retransmitted", s.net.packets_retransmitted},
+            {"bytes_retransmitted", s.net.bytes_retransmitted},
+            {"retransmissions_refused", s.net.retransmissions_refused},
+            {"fec_frames", s.net.fec_frames},
+            {"fec_parity_packets", s.net.fec_parity_packets},
+            {"fec_parity_bytes", s.net.fec_parity_bytes},
+            {"client_loss_ppm", s.net.client_loss_ppm},
+            {"control_drops", s.net.control_drops.total()},
+            {"link",
+             {{"packets_in", s.net.link.packets_in},
+              {"packets_delivered", s.net.link.packets_delivered},
+              {"dropped_loss", s.net.link.dropped_loss},
+              {"dropped_queue", s.net.link.dropped_queue},
+              {"dropped_burst", s.net.link.dropped_burst},
+              {"reordered", s.net.link.reordered},
+              {"duplicated", s.net.link.duplicated},
+              {"spiked", s.net.link.spiked}}},
+            {"core", core}};
+}
+
+// One row per served frame: per-layer pixels, triangles, render, read-back, encode and send.
+Status writeServerFramesCsv(const std::string& path,
+                            const std::vector<ServerFrameRecord>& records) {
+    std::ofstream f(path);
+    f << "client,frame,e1_deg,received_ns,start_ns,done_ns";
+    for (int sid = 0; sid < 4; ++sid)
+        f << fmt::format(
+            ",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
+            "send_ms{0},bytes{0}",
+            sid);
+    f << "\n";
+    for (const ServerFrameRecord& r : records) {
+        f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg, r.received_ns,
+                         r.start_ns, r.done_ns);
+        for (size_t sid = 0; sid < 4; ++sid)
+            f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{}", r.pixels[sid],
+                             r.triangles[sid], r.render_ms[sid], r.readback_ms[sid],
+                             r.encode_ms[sid], r.send_ms[sid], r.bytes[sid]);
         f << "\n";
-        for (const ServerFrameRecord& r : frame_records) {
-            f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg, r.received_ns,
-                             r.start_ns, r.done_ns);
-            for (size_t sid = 0; sid < 4; ++sid)
-                f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{}", r.pixels[sid],
-                                 r.triangles[sid], r.render_ms[sid], r.readback_ms[sid],
-                                 r.encode_ms[sid], r.send_ms[sid], r.bytes[sid]);
-            f << "\n";
-        }
-        if (!f) {
-            std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.frames_csv.c_str());
-            return 1;
-        }
     }
+    if (!f)
+        return makeError("cannot write '" + path + "'");
+    return {};
+}
+
+void printServerStats(const RenderServerStats& s) {
     fmt::print(
         "qvr server: {} requests ({} dropped, {} invalid), {} frames, {} streams sent, {} auth "
         "failures, {} malformed control messages\n",
@@ -262,6 +217,67 @@ int runServer(const ServerCmdOptions& o) {
         s.net.pending_evicted, s.net.refused_full, s.net.protocol_errors, s.net.version_mismatches,
         s.net.settings_refusals, s.net.route_failures, s.net.control_forged, s.net.control_replayed,
         s.net.nacks, s.net.packets_retransmitted);
+}
+
+// Writes --stats-json and --frames-csv once the server has stopped.
+int writeServerOutputs(const ServerCmdOptions& o, const RenderServerStats& s,
+                       const std::vector<ServerFrameRecord>& frame_records) {
+    if (!o.stats_json.empty()) {
+        std::ofstream f(o.stats_json);
+        f << serverStatsJson(s, o.core).dump(2) << "\n";
+        if (!f) {
+            std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
+            return 1;
+        }
+    }
+    if (!o.frames_csv.empty()) {
+        if (Status st = writeServerFramesCsv(o.frames_csv, frame_records); !st) {
+            std::fprintf(stderr, "qvr server: %s\n", st.error().c_str());
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int runServer(const ServerCmdOptions& o) {
+    // Pin the whole process before any work: threads made from here on (asio, the render
+    // thread, llvmpipe's rasterizers, x264) inherit the mask.
+    if (o.core >= 0) {
+        if (auto st = pinCurrentThread(o.core); !st) {
+            std::fprintf(stderr, "qvr server: --core: %s\n", st.error().c_str());
+            return 2;
+        }
+    }
+    StampsFile stamps(nullptr, std::fclose);
+    auto cfg = serverConfig(o, stamps);
+    if (!cfg) {
+        std::fprintf(stderr, "qvr server: %s\n", cfg.error().c_str());
+        return 2;
+    }
+    auto scene = loadScene(o.scene);
+    if (!scene) {
+        std::fprintf(stderr, "qvr server: %s\n", scene.error().c_str());
+        return 2;
+    }
+    auto server = RenderServer::start(*cfg, std::make_shared<const Scene>(std::move(*scene)));
+    if (!server) {
+        std::fprintf(stderr, "qvr server: %s\n", server.error().c_str());
+        return 1;
+    }
+    fmt::print("qvr server: listening on {}:{} ({}x{} per eye, link {}); Ctrl-C stops\n", o.bind,
+               (*server)->port(), cfg->profile.width_px, cfg->profile.height_px, o.net);
+    std::fflush(stdout);
+    serveUntilStopped(o.duration_s);
+    // Stop first (the frame in flight finishes, the render thread is joined), then read: the
+    // stats and the frames CSV then describe the same frames, however the server was ended.
+    (*server)->stop();
+    const RenderServerStats s = (*server)->stats();
+    const std::vector<ServerFrameRecord> frame_records = (*server)->frameRecords();
+    if (stamps && std::fflush(stamps.get()) != 0)
+        std::fprintf(stderr, "qvr server: error writing '%s'\n", o.stamps_csv.c_str());
+    if (const int rc = writeServerOutputs(o, s, frame_records); rc != 0)
+        return rc;
+    printServerStats(s);
     return 0;
 }
 
@@ -271,31 +287,37 @@ static Registered registerServer(CLI::App& app) {
     auto o = std::make_shared<ServerCmdOptions>();
     CLI::App* cmd = app.add_subcommand("server", "The render server: streams periphery layers");
     cmd->add_option("--bind", o->bind, "Address to listen on (loopback unless changed)")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                return isIpAddress(text) ? std::string()
+                                         : "'" + text + "' is not an IPv4 or IPv6 address";
+            },
+            "IP", "IP_ADDRESS"))
         ->capture_default_str();
     cmd->add_option("--port", o->port, "TCP port (0: any)")->capture_default_str();
-    cmd->add_option("--key", o->key, "Pre-shared key: 64 hex digits, or pass:TEXT");
-    cmd->add_option("--key-file", o->key_file, "File holding the pre-shared key");
+    addKeyOptions(cmd, o->key, o->key_file);
     cmd->add_option("--scene", o->scene, "Scene")->capture_default_str();
-    cmd->add_option("--profile", o->profile, "Display profile (must match the headset's)")
-        ->capture_default_str();
-    cmd->add_option("--net", o->net, "Link emulator spec on the media egress")
-        ->capture_default_str();
-    cmd->add_option("--codec", o->codec, "x264 or raw")->capture_default_str();
-    cmd->add_option("--core", o->core, "Pin the render thread to this core (-1: no)")
-        ->capture_default_str();
+    addProfileOption(cmd, o->profile, ProfileNames::kRuntime);
+    addLinkOption(cmd, o->net);
+    addCodecOption(cmd, o->codec);
+    addCoreOption(cmd, o->core, "Pin the server (all its threads) to this core (-1: no)");
     addLodOption(cmd, o->lod_px);
-    cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit");
+    cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit")
+        ->check(writableFile());
     cmd->add_option("--stamps-csv", o->stamps_csv,
-                    "Write per-layer render/encode/send stamps (steady clock ns) here");
+                    "Write per-layer render/encode/send stamps (steady clock ns) here")
+        ->check(writableFile());
     cmd->add_option("--frames-csv", o->frames_csv,
                     "Write one row per served frame (per-layer render, read-back, encode, send) "
-                    "here on exit");
+                    "here on exit")
+        ->check(writableFile());
     cmd->add_flag("--no-holes", o->no_holes,
                   "Draw every periphery layer whole, also where the compositor takes a finer "
                   "layer");
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
     cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")
+        ->check(finiteRange(0.0, kMaxDurationS))
         ->capture_default_str();
     return {cmd, [o] { return runServer(*o); }};
 }

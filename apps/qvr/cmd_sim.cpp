@@ -1,6 +1,5 @@
 // `qvr sim`: one design over one workload on one GPU clock and network, through the pipeline
 // simulator (paper §5); per-frame records in frames.csv and the run in summary.json.
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/sim/benches.h"
 #include "qvr/sim/evaluation.h"
 #include "qvr/sim/runtime_model.h"
@@ -117,14 +117,6 @@ int runSim(const SimOptions& o) {
         std::fprintf(stderr, "qvr sim: give exactly one of --bench NAME or --trace FILE\n");
         return 2;
     }
-    if (!std::isfinite(o.gpu_mhz) || o.gpu_mhz < 50.0 || o.gpu_mhz > 3000.0) {
-        std::fprintf(stderr, "qvr sim: --gpu-mhz must be within 50..3000, got %g\n", o.gpu_mhz);
-        return 2;
-    }
-    if (o.frames < 1 || o.frames > 1'000'000) {
-        std::fprintf(stderr, "qvr sim: --frames must be within 1..1000000, got %d\n", o.frames);
-        return 2;
-    }
     auto design = designByName(o.design);
     if (!design) {
         std::fprintf(stderr, "qvr sim: %s\n", design.error().c_str());
@@ -139,11 +131,6 @@ int runSim(const SimOptions& o) {
     auto link = makeLink(*net, o.seed);
     if (!link) {
         std::fprintf(stderr, "qvr sim: %s\n", link.error().c_str());
-        return 2;
-    }
-    if (o.codec_model != "auto" && !parseCodecModel(o.codec_model)) {
-        std::fprintf(stderr, "qvr sim: --codec-model: %s\n",
-                     parseCodecModel(o.codec_model).error().c_str());
         return 2;
     }
     Expected<WorkloadTrace> trace =
@@ -227,7 +214,8 @@ static Registered registerSim(CLI::App& app) {
     cmd->add_option("--bench", o->bench,
                     "Synthetic suite workload: " + suiteBenchNamesList() +
                         " (the 'synthetic-' prefix may be left out)");
-    cmd->add_option("--trace", o->trace, "Workload trace file (JSON lines) instead of --bench");
+    cmd->add_option("--trace", o->trace, "Workload trace file (JSON lines) instead of --bench")
+        ->check(readableFile());
     cmd->add_option("--design", o->design,
                     "System design: " + designNamesList() +
                         " (local baseline, remote-only, static collaborative, fixed 5-deg fovea, "
@@ -235,15 +223,16 @@ static Registered registerSim(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--gpu-mhz", o->gpu_mhz,
                     "Mobile GPU clock in MHz; the paper uses 500 (default), 400 and 300")
+        ->check(finiteRange(50.0, 3000.0))
         ->capture_default_str();
     cmd->add_option("--net", o->net,
                     "Network: wifi (200 Mbps), lte (100), 5g (500), each with 20 dB SNR noise, or "
                     "trace:FILE[@MBPS] for a Mahimahi trace rescaled to MBPS (default 100)")
         ->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Frames to simulate (1..1000000)")
-        ->capture_default_str();
+    addFramesOption(cmd, o->frames, 1, 1'000'000, "Frames to simulate (1..1000000)");
     cmd->add_option("--hardware", o->hardware,
-                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)");
+                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)")
+        ->check(readableFile());
     cmd->add_option("--pipeline", o->pipeline,
                     "Pipeline model: paper (Fig. 4, the default) or runtime (qvr run's, with the "
                     "hardware file's calibrated costs; the default when that file says so)")
@@ -253,14 +242,24 @@ static Registered registerSim(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--wait-limit-ms", o->wait_limit_ms,
                     "Runtime pipeline: remote layers later than this are late (frame reuse)")
-        ->check(CLI::Range(1.0, 10000.0))
+        ->check(finiteRange(1.0, 10000.0))
         ->capture_default_str();
     cmd->add_option("--codec-model", o->codec_model,
                     "Periphery bytes from the trace's lossless (the paper's, §2.3) or stream "
                     "(CRF 23) measurements; auto: lossless when recorded")
+        ->check(CLI::Validator(
+            [](std::string& name) -> std::string {
+                if (name == "auto")
+                    return {};
+                auto model = parseCodecModel(name);
+                return model ? std::string() : model.error();
+            },
+            "auto|lossless|stream", "CODEC_MODEL"))
         ->capture_default_str();
-    cmd->add_option("--seed", o->seed, "Seed of the network noise")->capture_default_str();
-    cmd->add_option("--out", o->out, "Output folder for frames.csv and summary.json")->required();
+    addSeedOption(cmd, o->seed, "Seed of the network noise");
+    cmd->add_option("--out", o->out, "Output folder for frames.csv and summary.json")
+        ->required()
+        ->check(outputFolder());
     return {cmd, [o]() { return runSim(*o); }};
 }
 

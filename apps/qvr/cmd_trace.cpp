@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/trace/gaze_model.h"
 #include "qvr/trace/head_motion.h"
 
@@ -66,29 +67,37 @@ Registered registerTraceMotion(CLI::App& parent) {
     auto o = std::make_shared<MotionOptions>();
     CLI::App* cmd = parent.add_subcommand(
         "motion", "Head-pose trace (CSV) from a BVH motion-capture file, at the display rate");
-    auto* bvh = cmd->add_option("--bvh", o->bvh, "BVH file (HIERARCHY/MOTION text)");
+    auto* bvh =
+        cmd->add_option("--bvh", o->bvh, "BVH file (HIERARCHY/MOTION text)")->check(readableFile());
     auto* def = cmd->add_flag("--default", o->use_default,
                               "Use " + defaultBvhPath() + " (Debian assimp-testmodels)");
     bvh->excludes(def);
     def->excludes(bvh);
     cmd->add_option("--rate", o->rate_hz, "Display rate to resample to, Hz")
-        ->check(CLI::Range(1.0, 1000.0))
+        ->check(finiteRange(1.0, 1000.0))
         ->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Poses to write (0: the whole recording)")
-        ->check(CLI::Range(0, 100'000'000))
-        ->capture_default_str();
-    cmd->add_option("--out", o->out, "Output CSV (t_ms,qw,qx,qy,qz,x,y,z)")->required();
+    addFramesOption(cmd, o->frames, 0, 100'000'000, "Poses to write (0: the whole recording)");
+    cmd->add_option("--out", o->out, "Output CSV (t_ms,qw,qx,qy,qz,x,y,z)")
+        ->required()
+        ->check(writableFile());
     cmd->add_option("--unit", o->unit, "BVH length unit: auto, m, cm, inch or cmu (1/0.45 in)")
         ->capture_default_str();
     cmd->add_option("--joint", o->joint,
                     "Head joint name (default: Head/head, else the top joint)");
     cmd->add_option("--origin", o->origin, "Start point X,Y,Z in metres; Y is the floor height")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                glm::vec3 v;
+                return parseTriple(text, v) ? std::string()
+                                            : "must be X,Y,Z in metres, got '" + text + "'";
+            },
+            "X,Y,Z", "POINT"))
         ->capture_default_str();
     cmd->add_option("--yaw", o->yaw_deg, "Initial heading in degrees about +y (0 looks down -z)")
-        ->check(CLI::Range(-360.0, 360.0))
+        ->check(finiteRange(-360.0, 360.0))
         ->capture_default_str();
     cmd->add_option("--smooth-ms", o->smooth_ms, "Gaussian smoothing sigma in ms (0: off)")
-        ->check(CLI::Range(0.0, 1000.0))
+        ->check(finiteRange(0.0, 1000.0))
         ->capture_default_str();
     cmd->add_flag("--keep-first-frame", o->keep_first,
                   "Keep a first frame that looks like a reference pose (CMU files start with one)");
@@ -106,11 +115,7 @@ Registered registerTraceMotion(CLI::App& parent) {
         }
         h.unit = *unit;
         h.head_joint = o->joint;
-        if (!parseTriple(o->origin, h.origin_m)) {
-            std::fprintf(stderr, "qvr trace motion: --origin must be X,Y,Z in metres, got '%s'\n",
-                         o->origin.c_str());
-            return 2;
-        }
+        parseTriple(o->origin, h.origin_m);  // checked when parsed
         h.yaw_deg = o->yaw_deg;
         h.rate_hz = o->rate_hz;
         h.frames = o->frames;
@@ -167,27 +172,26 @@ Registered registerTraceGaze(CLI::App& parent) {
     auto o = std::make_shared<GazeOptions>();
     CLI::App* cmd = parent.add_subcommand(
         "gaze", "Seeded gaze trace (CSV): fixations, main-sequence saccades, 120 Hz samples");
-    cmd->add_option("--seed", o->seed, "Random seed; the same seed gives the same trace")
-        ->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Eye-tracker samples to write")
-        ->check(CLI::Range(1, 100'000'000))
-        ->capture_default_str();
-    cmd->add_option("--out", o->out, "Output CSV (t_ms,x_deg,y_deg)")->required();
+    addSeedOption(cmd, o->seed, "Random seed; the same seed gives the same trace");
+    addFramesOption(cmd, o->frames, 1, 100'000'000, "Eye-tracker samples to write");
+    cmd->add_option("--out", o->out, "Output CSV (t_ms,x_deg,y_deg)")
+        ->required()
+        ->check(writableFile());
     cmd->add_option("--rate", o->model.sample_rate_hz, "Eye-tracker sample rate, Hz")
-        ->check(CLI::Range(1.0, 2000.0))
+        ->check(finiteRange(1.0, 2000.0))
         ->capture_default_str();
     cmd->add_option("--pursuit", o->model.pursuit_probability,
                     "Probability that smooth pursuit replaces a fixation")
-        ->check(CLI::Range(0.0, 1.0))
+        ->check(finiteRange(0.0, 1.0))
         ->capture_default_str();
     cmd->add_option("--noise", o->model.tracker_noise_deg, "Tracker noise sigma in degrees")
-        ->check(CLI::Range(0.0, 5.0))
+        ->check(finiteRange(0.0, 5.0))
         ->capture_default_str();
     cmd->add_option("--bound-x", o->model.bound_x_deg, "Horizontal gaze half-range, degrees")
-        ->check(CLI::Range(1.0, 80.0))
+        ->check(finiteRange(1.0, 80.0))
         ->capture_default_str();
     cmd->add_option("--bound-y", o->model.bound_y_deg, "Vertical gaze half-range, degrees")
-        ->check(CLI::Range(1.0, 80.0))
+        ->check(finiteRange(1.0, 80.0))
         ->capture_default_str();
     Action action = [o]() -> int {
         auto trace = generateGaze(o->model, o->seed, o->frames);

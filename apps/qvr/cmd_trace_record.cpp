@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/trace/recorder.h"
 
@@ -51,16 +52,13 @@ Registered registerTraceRecord(CLI::App& parent) {
                     "Head motion: pose CSV, BVH file, or 'default' (CMU 01_01 from "
                     "assimp-testmodels)")
         ->capture_default_str();
-    auto* gaze = cmd->add_option("--gaze", o->record.gaze_csv, "Gaze CSV (t_ms,x_deg,y_deg)");
-    auto* seed = cmd->add_option("--gaze-seed", o->record.gaze_seed, "Seed of the gaze model")
-                     ->capture_default_str();
+    auto* gaze = cmd->add_option("--gaze", o->record.gaze_csv, "Gaze CSV (t_ms,x_deg,y_deg)")
+                     ->check(readableFile());
+    auto* seed = addSeedOption(cmd, o->record.gaze_seed, "Seed of the gaze model", "--gaze-seed");
     gaze->excludes(seed);
     seed->excludes(gaze);
-    cmd->add_option("--profile", o->profile, "HMD profile: default, low or a TOML file")
-        ->capture_default_str();
-    cmd->add_option("--frames", o->record.frames, "Frames to record at the display rate")
-        ->check(CLI::Range(1, 1'000'000))
-        ->capture_default_str();
+    addProfileOption(cmd, o->profile);
+    addFramesOption(cmd, o->record.frames, 1, 1'000'000, "Frames to record at the display rate");
     cmd->add_option("--spawn", o->record.spawn, "Spawn point to start from")
         ->check(CLI::Range(0, 1'000'000))
         ->capture_default_str();
@@ -73,7 +71,9 @@ Registered registerTraceRecord(CLI::App& parent) {
                     "Nearest visible objects that form the static design's foreground")
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
-    cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")->required();
+    cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")
+        ->required()
+        ->check(writableFile());
     cmd->add_flag("--quiet", o->quiet, "No progress line");
     Action action = [o]() -> int {
         auto profile = hmdProfileByName(o->profile);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "options.h"
 #include "qvr/experiment/validation.h"
 #include "qvr/runtime/server_process.h"
 #include "qvr/sim/hardware.h"
@@ -58,10 +59,6 @@ int runValidate(const ValidateOptions& o) {
         return 1;
     }
     ProcessRunner runner;  // from here SIGINT and SIGTERM stop the sheet
-    if (o.frames < 5 || o.frames > 100000) {
-        std::fprintf(stderr, "qvr validate: --frames must be within 5..100000\n");
-        return 2;
-    }
     std::vector<std::string> links = splitList(o.links);
     if (o.links.empty()) {
         links = {"wifi", "lte", "5g"};
@@ -141,7 +138,7 @@ static Registered registerValidate(CLI::App& app) {
                     "Mahimahi trace of shared/data/network)");
     cmd->add_option("--scenes", o->scenes, "Comma-separated scenes")->capture_default_str();
     cmd->add_option("--depths", o->depths, "Frames in flight: 1, 2 or 1,2")->capture_default_str();
-    cmd->add_option("--frames", o->frames, "Frames per design per run")->capture_default_str();
+    addFramesOption(cmd, o->frames, 5, 100000, "Frames per design per run");
     cmd->add_option("--reps", o->reps, "Repetitions of every condition")
         ->check(CLI::Range(1, 20))
         ->capture_default_str();
@@ -151,14 +148,15 @@ static Registered registerValidate(CLI::App& app) {
         ->check(CLI::Range(0, 5))
         ->capture_default_str();
     cmd->add_option("--hardware", o->hardware,
-                    "Use this calibration instead of calibrating (one scene)");
+                    "Use this calibration instead of calibrating (one scene)")
+        ->check(readableFile());
     cmd->add_option("--calibrate", o->calibrate,
                     "per-rep: each repetition calibrates each scene anew before its runs; once: "
                     "one calibration per scene before any run")
         ->check(CLI::IsMember({"per-rep", "once"}))
         ->capture_default_str();
-    cmd->add_option("--profile", o->profile, "Display profile")->capture_default_str();
-    cmd->add_option("--out", o->out, "Output folder")->capture_default_str();
+    addProfileOption(cmd, o->profile, ProfileNames::kRuntime);
+    cmd->add_option("--out", o->out, "Output folder")->check(outputFolder())->capture_default_str();
     cmd->add_flag("--dry-run", o->dry_run, "Print the commands without running them");
     return {cmd, [o] { return runValidate(*o); }};
 }

@@ -75,6 +75,20 @@ Expected<HmdProfile> loadHmdProfile(const std::string& path) {
     auto text = readTextFile(path);
     if (!text)
         return makeError(text.error());
+    // A file that sets no field would silently be the default profile: a wrong or truncated
+    // file more likely than a wish (`default` names that profile).
+    auto table = parseTomlText(*text, path);
+    if (!table)
+        return makeError(table.error());
+    const bool sets_a_field = std::any_of(table->begin(), table->end(), [](const auto& kv) {
+        const toml::table* section = kv.second.as_table();
+        return kv.first.str() != "name" && (section == nullptr || !section->empty());
+    });
+    if (!sets_a_field)
+        return makeError(fmt::format(
+            "{}: the profile file sets no field ([display], [fov], [lens] or [acuity]); use "
+            "'default' for the default profile",
+            path));
     return parseHmdProfile(*text, path);
 }
 

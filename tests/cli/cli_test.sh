@@ -201,6 +201,31 @@ expect_error "plan --profile /nonexistent.toml" plan --profile /nonexistent.toml
 expect_error "plan --profile <malformed toml>" plan --profile "$tmp/malformed.toml"
 expect_error "plan --profile <width 0>" plan --profile "$tmp/zero_width.toml"
 expect_error "plan --profile <a directory>" plan --profile "$tmp"
+# Every floating-point option refuses NaN and infinities when parsed; an empty profile file is
+# not the default profile.
+: >"$tmp/empty.toml"
+expect_error "plan --profile <empty file>" plan --profile "$tmp/empty.toml"
+expect_error "plan --e1 nan" plan --e1 nan
+expect_error "plan --gaze nan,0" plan --gaze nan,0
+expect_error "control --gpu-mhz nan" control --gpu-mhz nan --frames 5
+expect_error "control --throughput-mbps inf" control --throughput-mbps inf --frames 5
+expect_error "control --e1 nan" control --policy fixed --e1 nan --frames 5
+expect_error "sim --gpu-mhz nan" sim --bench grid --gpu-mhz nan --out "$tmp/x"
+expect_error "sim --wait-limit-ms nan" sim --bench grid --pipeline runtime --wait-limit-ms nan --out "$tmp/x"
+expect_error "sim --seed -1" sim --bench grid --seed -1 --out "$tmp/x"
+expect_error "trace gaze --rate inf" trace gaze --rate inf --out "$tmp/g.csv"
+expect_error "trace gaze --pursuit nan" trace gaze --pursuit nan --out "$tmp/g.csv"
+expect_error "trace gaze --out into a missing folder" trace gaze --out "$tmp/missing/g.csv"
+expect_error "trace motion --smooth-ms nan" trace motion --default --smooth-ms nan --out "$tmp/m.csv"
+expect_error "scene count --far-m inf" scene count builtin:room --far-m inf
+expect_error "render --ipd-mm nan" render builtin:room --ipd-mm nan --out "$tmp/render"
+expect_error "bench uca --yaw nan" bench uca --yaw nan
+expect_error "compose --e1 nan" compose --e1 nan --out "$tmp/c.png"
+if [ -e "$tmp/x" ] || [ -e "$tmp/g.csv" ] || [ -e "$tmp/render" ] || [ -e "$tmp/c.png" ]; then
+    fail "refused options leave no output" "$(ls "$tmp")"
+else
+    pass "refused options leave no output"
+fi
 expect_error "control --policy bogus" control --policy bogus
 expect_error "control --frames 0" control --frames 0
 expect_error "control --frames -5" control --frames -5

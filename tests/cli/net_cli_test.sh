@@ -84,6 +84,51 @@ expect_exit2 "run --net rate:1e-300" run --net rate:1e-300 --frames 12 --warmup-
 expect_exit2 "run --net wifi,dup=1" run --net wifi,dup=1 --frames 12 --warmup-frames 0 --out "$tmp/r"
 expect_exit2 "run --out under a file" run --frames 12 --warmup-frames 0 --out "$tmp/a_file/sub"
 
+# --- bad input refused when parsed, before any work -------------------------------------------
+# expect_exit2_no_work NAME OUTPUT ARGS...: as expect_exit2, and OUTPUT (what the work would make)
+# does not exist afterwards, nor did a server say it was listening.
+expect_exit2_no_work() {
+    local name=$1 output=$2
+    shift 2
+    expect_exit2 "$name" "$@"
+    if [ -e "$output" ]; then
+        fail "$name: before any work" "$output exists"
+    elif grep -q "listening on" "$tmp/out.txt"; then
+        fail "$name: before any work" "the server started: $(head -c 200 "$tmp/out.txt")"
+    else
+        pass "$name: before any work"
+    fi
+}
+R=(--frames 12 --warmup-frames 0)
+expect_exit2_no_work "run --remote-timeout-ms nan" "$tmp/r_nan" run "${R[@]}" --remote-timeout-ms nan --out "$tmp/r_nan"
+expect_exit2_no_work "run --remote-timeout-ms inf" "$tmp/r_nan" run "${R[@]}" --remote-timeout-ms inf --out "$tmp/r_nan"
+expect_exit2_no_work "run --headset-share nan" "$tmp/r_nan" run "${R[@]}" --headset-share nan --out "$tmp/r_nan"
+expect_exit2_no_work "run --lod-px nan" "$tmp/r_nan" run "${R[@]}" --lod-px nan --out "$tmp/r_nan"
+expect_exit2_no_work "run --lod-px -inf" "$tmp/r_nan" run "${R[@]}" --lod-px -inf --out "$tmp/r_nan"
+expect_exit2_no_work "run --seed -1" "$tmp/r_nan" run "${R[@]}" --seed -1 --out "$tmp/r_nan"
+: >"$tmp/empty.toml"
+printf '# a comment, no field\nname = "nothing"\n' >"$tmp/fieldless.toml"
+expect_exit2_no_work "run --profile <empty file>" "$tmp/r_nan" run "${R[@]}" --profile "$tmp/empty.toml" --out "$tmp/r_nan"
+expect_exit2_no_work "server --profile <file with no field>" "$tmp/none" server "${K[@]}" --port 0 --duration-s 1 --profile "$tmp/fieldless.toml"
+expect_exit2_no_work "client --profile <empty file>" "$tmp/c_bad" client "${K[@]}" --frames 3 --profile "$tmp/empty.toml" --out "$tmp/c_bad"
+expect_exit2_no_work "server --core 99999" "$tmp/none" server "${K[@]}" --port 0 --duration-s 1 --core 99999
+expect_exit2_no_work "server --core -2" "$tmp/none" server "${K[@]}" --port 0 --duration-s 1 --core -2
+expect_exit2_no_work "client --core 99999" "$tmp/c_bad" client "${K[@]}" --frames 3 --core 99999 --out "$tmp/c_bad"
+expect_exit2_no_work "client --seed -1" "$tmp/c_bad" client "${K[@]}" --frames 3 --seed -1 --out "$tmp/c_bad"
+expect_exit2_no_work "client --lod-px nan" "$tmp/c_bad" client "${K[@]}" --frames 3 --lod-px nan --out "$tmp/c_bad"
+mkfifo "$tmp/key_fifo"
+expect_exit2_no_work "server --key-file <a FIFO>" "$tmp/none" server --key-file "$tmp/key_fifo" --port 0 --duration-s 1
+expect_exit2_no_work "client --key-file <a FIFO>" "$tmp/c_bad" client --key-file "$tmp/key_fifo" --frames 3 --out "$tmp/c_bad"
+expect_exit2_no_work "server --key-file <a directory>" "$tmp/none" server --key-file "$tmp" --port 0 --duration-s 1
+expect_exit2_no_work "client --server-stamps <a directory>" "$tmp/c_bad" client "${K[@]}" --frames 3 --server-stamps "$tmp" --out "$tmp/c_bad"
+printf 'not,a,stamps,header\n' >"$tmp/bad_stamps.csv"
+expect_exit2_no_work "client --server-stamps <not a stamps file>" "$tmp/c_bad" client "${K[@]}" --frames 3 --server-stamps "$tmp/bad_stamps.csv" --out "$tmp/c_bad"
+expect_exit2_no_work "server --frames-csv into a missing folder" "$tmp/missing" server "${K[@]}" --port 0 --duration-s 1 --frames-csv "$tmp/missing/frames.csv"
+expect_exit2_no_work "server --frames-csv a folder" "$tmp/none" server "${K[@]}" --port 0 --duration-s 1 --frames-csv "$tmp"
+expect_exit2_no_work "calibrate --out into a missing folder" "$tmp/missing" calibrate --quick --out "$tmp/missing/cal.toml"
+expect_exit2_no_work "calibrate --json into a missing folder" "$tmp/cal.toml" calibrate --quick --out "$tmp/cal.toml" --json "$tmp/missing/cal.json"
+expect_exit2_no_work "calibrate --core 99999" "$tmp/cal.toml" calibrate --quick --core 99999 --out "$tmp/cal.toml"
+
 # --- settings negotiated in the handshake -----------------------------------------------------
 "$QVR" server "${K[@]}" --port 0 --profile small --codec x264 --duration-s 120 \
     --stats-json "$tmp/server_stats.json" --stamps-csv "$tmp/stamps.csv" \

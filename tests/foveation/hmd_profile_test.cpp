@@ -205,6 +205,34 @@ TEST(HmdProfileByName, LoadsFileWhenGivenPath) {
     std::filesystem::remove_all(dir);
 }
 
+// A profile file that sets nothing would be the default profile in disguise: refused, while the
+// same file with one field loads.
+TEST(LoadHmdProfile, RefusesAFileThatSetsNoField) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("qvr_foveation_empty_profile_test_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const auto path = dir / "empty.toml";
+    for (const char* text : {"", "# nothing\n", "name = \"only a name\"\n", "[display]\n[fov]\n"}) {
+        {
+            std::ofstream out(path);
+            out << text;
+        }
+        auto p = loadHmdProfile(path.string());
+        ASSERT_FALSE(p.ok()) << "accepted: " << text;
+        EXPECT_THAT(p.error(), HasSubstr("empty.toml"));
+        EXPECT_THAT(p.error(), HasSubstr("sets no field"));
+        EXPECT_FALSE(hmdProfileByName(path.string()).ok());
+    }
+    {
+        std::ofstream out(path);
+        out << "[display]\nrefresh_hz = 72\n";
+    }
+    auto p = loadHmdProfile(path.string());
+    ASSERT_TRUE(p.ok()) << p.error();
+    EXPECT_DOUBLE_EQ(p->refresh_hz, 72.0);
+    std::filesystem::remove_all(dir);
+}
+
 TEST(HmdProfileByName, FailsWithPathWhenFileIsMissing) {
     auto p = hmdProfileByName("/nonexistent/dir/hmd.toml");
     ASSERT_FALSE(p.ok());
