@@ -84,7 +84,7 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: --out: %s\n", why.c_str());
         return 2;
     }
-    auto design = designSpecByName(o.design);
+    auto design = parseDesign(o.design, DesignScope::Runtime);
     if (!design) {
         std::fprintf(stderr, "qvr client: --design: %s\n", design.error().c_str());
         return 2;

@@ -27,7 +27,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "qvr/experiment/calibration.h"
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/mp4_writer.h"
@@ -35,7 +34,9 @@
 #include "qvr/compose/quality.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/compose/warp.h"
+#include "qvr/experiment/calibration.h"
 #include "qvr/experiment/host.h"
+#include "qvr/experiment/scanout_recorder.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/net/link_emulator.h"
@@ -56,7 +57,6 @@
 #include "qvr/sim/runtime_model.h"
 #include "qvr/sim/simulator.h"
 #include "qvr/workload/trace_io.h"
-#include "qvr/experiment/scanout_recorder.h"
 
 namespace qvr::cli {
 
@@ -269,7 +269,7 @@ struct DesignRun {
     HeadsetResult result;
     // The machine's speed just before and just after the design ran (calibration.h SpeedProbe).
     std::optional<SpeedSample> speed_before, speed_after;
-    RuntimeDesign design() const { return spec.design; }
+    Design design() const { return spec.design; }
     std::string label() const { return spec.label(); }
 };
 
@@ -467,7 +467,7 @@ bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg) 
         fixed_e1_deg = e;
         return true;
     }
-    auto d = qvr::runtimeDesignByName(name);
+    auto d = qvr::designByName(name);
     if (!d)
         return false;
     design = *d;
@@ -591,7 +591,7 @@ void onRunSignal(int) {
 }
 
 int runRun(const RunOptions& o) {
-    auto designs = parseDesignList(o.designs);
+    auto designs = parseDesignList(o.designs, DesignScope::Runtime);
     if (!designs) {
         std::fprintf(stderr, "qvr run: --designs: %s\n", designs.error().c_str());
         return 2;
@@ -605,7 +605,7 @@ int runRun(const RunOptions& o) {
                      o.frames - 2, o.warmup_frames);
         return 2;
     }
-    auto link = net::parseLinkSpec(o.net);
+    auto link = qvr::loadLinkSpec(o.net);
     if (!link) {
         std::fprintf(stderr, "qvr run: --net: %s\n", link.error().c_str());
         return 2;
@@ -807,7 +807,7 @@ int runRun(const RunOptions& o) {
     for (const DesignSpec& spec : *designs) {
         if (g_run_stop.load())
             break;
-        const RuntimeDesign d = spec.design;
+        const Design d = spec.design;
         const std::string label = spec.label();
         HeadsetConfig hc;
         hc.design = d;
@@ -829,7 +829,7 @@ int runRun(const RunOptions& o) {
         hc.renderer = glRendererFactory(gl);
         std::ofstream workload_out;
         std::unique_ptr<WorkloadTraceWriter> writer;
-        if (d == RuntimeDesign::kQvr) {
+        if (d == Design::Qvr) {
             if (o.video) {
                 recorder.reserve(o.frames);
                 hc.display = &recorder;
@@ -1324,18 +1324,18 @@ int runRun(const RunOptions& o) {
             }
             dj[name]["speed"] = sp;
         }
-        if (r.design() == RuntimeDesign::kLocal)
+        if (r.design() == Design::Local)
             local = &r.result.summary;
-        if (r.design() == RuntimeDesign::kRemote)
+        if (r.design() == Design::Remote)
             remote = &r.result.summary;
-        if (r.design() == RuntimeDesign::kQvr)
+        if (r.design() == Design::Qvr)
             qvr = &r.result.summary;
     }
     j["designs"] = dj;
     // The fixed designs run (ffr is fixed:5): the best in hindsight, by displayed FPS.
     const DesignRun* best_fixed = nullptr;
     for (const DesignRun& r : runs)
-        if ((r.design() == RuntimeDesign::kFixed || r.design() == RuntimeDesign::kFfr) &&
+        if ((r.design() == Design::Fixed || r.design() == Design::Ffr) &&
             (!best_fixed || r.result.summary.fps_mean > best_fixed->result.summary.fps_mean))
             best_fixed = &r;
     if (best_fixed) {
@@ -1344,7 +1344,7 @@ int runRun(const RunOptions& o) {
                              {"fps_mean", best_fixed->result.summary.fps_mean},
                              {"mtp_ms_p99", best_fixed->result.summary.mtp_ms_p99}};
         for (const DesignRun& r : runs)
-            if (r.design() == RuntimeDesign::kQvr || r.design() == RuntimeDesign::kSw)
+            if (r.design() == Design::Qvr || r.design() == Design::Sw)
                 bf[std::string(r.label()) + "_fps_over_best_fixed"] =
                     r.result.summary.fps_mean / std::max(1e-9, best_fixed->result.summary.fps_mean);
         j["best_fixed"] = bf;
@@ -1497,10 +1497,8 @@ int runRun(const RunOptions& o) {
         std::ofstream sweep(out / "fps_vs_e1.csv");
         sweep << "design,kind,e1_deg,fps,mtp_ms_p99\n";
         for (const DesignRun& r : runs) {
-            const bool fixed =
-                r.design() == RuntimeDesign::kFixed || r.design() == RuntimeDesign::kFfr;
-            const bool adaptive =
-                r.design() == RuntimeDesign::kQvr || r.design() == RuntimeDesign::kSw;
+            const bool fixed = r.design() == Design::Fixed || r.design() == Design::Ffr;
+            const bool adaptive = r.design() == Design::Qvr || r.design() == Design::Sw;
             if (!fixed && !adaptive)
                 continue;
             fixed_points += fixed ? 1 : 0;
@@ -1543,8 +1541,9 @@ int runRun(const RunOptions& o) {
     auto num = [](double v, int prec = 1) { return fmt::format("{:.{}f}", v, prec); };
     report::HtmlReport page("qvr run");
     page.heading(1, "qvr run");
-    page.html("<p>" + report::htmlEscape(o.command_line) + "<br>" + report::htmlEscape(experiment::utcNow()) +
-              ", " + report::htmlEscape(experiment::machineDescription()) + "</p>\n");
+    page.html("<p>" + report::htmlEscape(o.command_line) + "<br>" +
+              report::htmlEscape(experiment::utcNow()) + ", " +
+              report::htmlEscape(experiment::machineDescription()) + "</p>\n");
     page.html(fmt::format(
         "<p>Scene {}, {}×{} per eye at {} Hz, link <code>{}</code> (net's userspace emulator on "
         "the "

@@ -93,7 +93,7 @@ int runServer(const ServerCmdOptions& o) {
         std::fprintf(stderr, "qvr server: --profile: %s\n", profile.error().c_str());
         return 2;
     }
-    auto link = net::parseLinkSpec(o.net);
+    auto link = qvr::loadLinkSpec(o.net);
     if (!link) {
         std::fprintf(stderr, "qvr server: --net: %s\n", link.error().c_str());
         return 2;

@@ -690,10 +690,26 @@ TEST(RuntimeModel, SwAndQvrPayTheRingCountsEveryFrame) {
 }
 
 TEST(RuntimeModel, DesignNames) {
-    EXPECT_EQ(*runtimeDesignByName("qvr"), Design::Qvr);
-    EXPECT_EQ(*runtimeDesignByName("local"), Design::Local);
-    EXPECT_FALSE(runtimeDesignByName("dfr").ok());
-    EXPECT_FALSE(runtimeDesignByName("").ok());
+    EXPECT_EQ(parseDesign("qvr", DesignScope::Runtime)->design, Design::Qvr);
+    EXPECT_EQ(parseDesign("local", DesignScope::Runtime)->design, Design::Local);
+    EXPECT_FALSE(parseDesign("dfr", DesignScope::Runtime).ok());
+    EXPECT_FALSE(parseDesign("", DesignScope::Runtime).ok());
+}
+
+TEST(RuntimeModel, FixedEIsAFixedFoveaAtItsE1) {
+    // fixed:E runs as the runtime runs it: FFR's pipeline at e1 = E.
+    auto spec = parseDesign("fixed:12", DesignScope::Runtime);
+    ASSERT_TRUE(spec.ok()) << spec.error();
+    RuntimeSimConfig cfg;
+    cfg.design = spec->design;
+    cfg.fixed_e1_deg = spec->fixed_e1_deg;
+    cfg.costs = flatCosts(1.0, 1.0, 1.0);
+    cfg.frames = 10;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(flatTrace(10), cfg, link);
+    ASSERT_EQ(r.frames.size(), 10u);
+    for (const RuntimeFrame& f : r.frames)
+        EXPECT_DOUBLE_EQ(f.e1_deg, 12.0);
 }
 
 TEST(RuntimeModel, ASlowServerIsNotASilentOne) {
