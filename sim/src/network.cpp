@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "qvr/core/link_spec.h"
+
 namespace qvr {
 
 const std::vector<Table1Row>& table1Rows() {

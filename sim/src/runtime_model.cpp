@@ -17,6 +17,7 @@
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
 #include "qvr/core/canvas_policy.h"
+#include "qvr/core/link_spec.h"
 #include "qvr/core/silence.h"
 #include "qvr/foveation/layer_plan.h"
 

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "qvr/core/expected.h"
-#include "qvr/core/link_spec.h"
 #include "qvr/core/mahimahi.h"
 
 namespace qvr {
