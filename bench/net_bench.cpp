@@ -116,7 +116,7 @@ void BM_ControlSealOpenFrameRequest(benchmark::State& state) {
 BENCHMARK(BM_ControlSealOpenFrameRequest);
 
 void BM_LinkEmulatorPerPacket(benchmark::State& state) {
-    LinkConfig c = parseLinkSpec("wifi,delay_ms=5,jitter_ms=1,loss=0.01").value();
+    LinkSpec c = parseLinkSpec("wifi,delay_ms=5,jitter_ms=1,loss=0.01").value();
     LinkEmulator link(c);
     std::vector<std::vector<uint8_t>> out;
     int64_t now_ns = 0;

@@ -65,7 +65,7 @@ Expected<HeadsetConfig> headsetConfig(const ClientCmdOptions& o) {
     uint16_t port = 0;
     if (!parseHostPort(o.connect, host, port, why))
         return makeError("--connect: " + why);
-    auto design = designSpecByName(o.design);
+    auto design = parseDesign(o.design, DesignScope::Runtime);
     if (!design)
         return makeError("--design: " + design.error());
     auto profile = runtimeProfileByName(o.profile);
@@ -284,7 +284,7 @@ static Registered registerClient(CLI::App& app) {
     cmd->add_option("--design", o->design, "local, remote, ffr, fixed:E, sw or qvr")
         ->check(CLI::Validator(
             [](std::string& name) -> std::string {
-                auto d = designSpecByName(name);
+                auto d = parseDesign(name, DesignScope::Runtime);
                 return d ? std::string() : d.error();
             },
             "DESIGN", "DESIGN"))

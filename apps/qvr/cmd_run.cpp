@@ -17,7 +17,7 @@
 #include "qvr/experiment/run_plan.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/cpu_share.h"
-#include "qvr/runtime/runtime_design.h"
+#include "qvr/core/design.h"
 #include "qvr/runtime/session.h"
 
 namespace qvr::cli {
@@ -29,7 +29,7 @@ namespace {
 using namespace qvr::runtime;
 
 int runRun(const RunOptions& o) {
-    auto designs = parseDesignList(o.designs);
+    auto designs = parseDesignList(o.designs, DesignScope::Runtime);
     if (!designs) {
         std::fprintf(stderr, "qvr run: --designs: %s\n", designs.error().c_str());
         return 2;
@@ -70,7 +70,7 @@ static Registered registerRun(CLI::App& app) {
                     "degrees, sw, qvr")
         ->check(CLI::Validator(
             [](std::string& list) -> std::string {
-                auto designs = parseDesignList(list);
+                auto designs = parseDesignList(list, DesignScope::Runtime);
                 return designs ? std::string() : designs.error();
             },
             "DESIGNS", "DESIGNS"))

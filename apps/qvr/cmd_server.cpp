@@ -85,7 +85,7 @@ Expected<RenderServerConfig> serverConfig(const ServerCmdOptions& o, StampsFile&
     auto profile = runtimeProfileByName(o.profile);
     if (!profile)
         return makeError("--profile: " + profile.error());
-    auto link = net::parseLinkSpec(o.net);
+    auto link = qvr::loadLinkSpec(o.net);
     if (!link)
         return makeError("--net: " + link.error());
     RenderServerConfig cfg;

@@ -290,10 +290,10 @@ CLI::Option* addLinkOption(CLI::App* cmd, std::string& net) {
     return cmd
         ->add_option("--net", net,
                      "Link spec for net's emulator: none, wifi, lte, 5g, rate:MBPS, trace:FILE, "
-                     "with impairments after commas (net/link_emulator.h)")
+                     "with impairments after commas (core/link_spec.h)")
         ->check(CLI::Validator(
             [](std::string& spec) -> std::string {
-                auto link = net::parseLinkSpec(spec);
+                auto link = qvr::loadLinkSpec(spec);
                 return link ? std::string() : link.error();
             },
             "LINK", "LINK"))

@@ -197,8 +197,8 @@ void describeLinks(Calibration& cal) {
     cal.costs.packet_payload_bytes = double(net::kMediaChunkBytes);
     cal.costs.packet_overhead_bytes = double(net::kMediaHeaderBytes);
     cal.links = nlohmann::json::object();
-    for (const std::string& name : net::linkProfileNames()) {
-        auto lc = net::parseLinkSpec(name);
+    for (const std::string& name : qvr::linkProfileNames()) {
+        auto lc = qvr::parseLinkSpec(name);
         if (lc)
             cal.links[name] = {{"rate_bps", lc->rate_bps}, {"delay_ms", lc->delay_ms}};
     }

@@ -337,7 +337,7 @@ Expected<bool> DesignRunner::runDesign(const DesignSpec& spec, size_t designs_re
     HeadsetConfig hc = headsetConfig(spec);
     std::ofstream workload_out;
     std::unique_ptr<WorkloadTraceWriter> writer;
-    if (spec.design == RuntimeDesign::kQvr) {
+    if (spec.design == Design::Qvr) {
         if (m_plan.video) {
             m_m.recorder->reserve(m_plan.frames);
             hc.display = m_m.recorder.get();

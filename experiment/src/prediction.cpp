@@ -119,7 +119,7 @@ bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg) 
         fixed_e1_deg = e;
         return true;
     }
-    auto d = qvr::runtimeDesignByName(name);
+    auto d = qvr::designByName(name);
     if (!d)
         return false;
     design = *d;

@@ -131,7 +131,7 @@ RunOutcome runOutcome(const RunOptions& plan, const HmdProfile& profile,
 std::optional<BestFixed> bestFixed(const std::vector<DesignResult>& designs) {
     const DesignResult* best = nullptr;
     for (const DesignResult& d : designs)
-        if ((d.spec.design == RuntimeDesign::kFixed || d.spec.design == RuntimeDesign::kFfr) &&
+        if ((d.spec.design == Design::Fixed || d.spec.design == Design::Ffr) &&
             (!best || d.summary.fps_mean > best->summary.fps_mean))
             best = &d;
     if (!best)
@@ -139,7 +139,7 @@ std::optional<BestFixed> bestFixed(const std::vector<DesignResult>& designs) {
     BestFixed bf{
         best->name, best->spec.fixed_e1_deg, best->summary.fps_mean, best->summary.mtp_ms_p99, {}};
     for (const DesignResult& d : designs)
-        if (d.spec.design == RuntimeDesign::kQvr || d.spec.design == RuntimeDesign::kSw)
+        if (d.spec.design == Design::Qvr || d.spec.design == Design::Sw)
             bf.fps_over_best.emplace_back(d.name, d.summary.fps_mean / std::max(1e-9, bf.fps_mean));
     return bf;
 }
@@ -150,11 +150,11 @@ HeadlineRatios headlineRatios(const std::vector<DesignResult>& designs) {
     const DesignSummary* qvr = nullptr;
     std::map<std::string, DesignMetrics> paper;  // the paper-hardware model, by design
     for (const DesignResult& d : designs) {
-        if (d.spec.design == RuntimeDesign::kLocal)
+        if (d.spec.design == Design::Local)
             local = &d.summary;
-        if (d.spec.design == RuntimeDesign::kRemote)
+        if (d.spec.design == Design::Remote)
             remote = &d.summary;
-        if (d.spec.design == RuntimeDesign::kQvr)
+        if (d.spec.design == Design::Qvr)
             qvr = &d.summary;
         if (d.prediction.paper_hardware)
             paper[d.name] = *d.prediction.paper_hardware;

@@ -218,9 +218,9 @@ int sweepFigure(report::Plotter& plotter, const RunOutcome& o, const fs::path& o
     std::ofstream sweep(out / "fps_vs_e1.csv");
     sweep << "design,kind,e1_deg,fps,mtp_ms_p99\n";
     for (const DesignResult& d : o.designs) {
-        const RuntimeDesign k = d.spec.design;
-        const bool fixed = k == RuntimeDesign::kFixed || k == RuntimeDesign::kFfr;
-        const bool adaptive = k == RuntimeDesign::kQvr || k == RuntimeDesign::kSw;
+        const Design k = d.spec.design;
+        const bool fixed = k == Design::Fixed || k == Design::Ffr;
+        const bool adaptive = k == Design::Qvr || k == Design::Sw;
         if (!fixed && !adaptive)
             continue;
         fixed_points += fixed ? 1 : 0;

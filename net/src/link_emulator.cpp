@@ -2,7 +2,6 @@
 #include "qvr/net/link_emulator.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 
 #include "qvr/core/check.h"
@@ -10,173 +9,12 @@
 namespace qvr::net {
 namespace {
 
-bool parseDouble(std::string_view s, double& out) {
-    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return ec == std::errc() && p == s.data() + s.size() && std::isfinite(out);
-}
-
-// "A:B:C" into up to `n` numbers; false unless there are between min_n and n of them.
-bool parseList(std::string_view s, size_t min_n, size_t n, double* out) {
-    size_t i = 0;
-    while (true) {
-        const size_t colon = s.find(':');
-        if (i == n || !parseDouble(s.substr(0, colon), out[i])) {
-            return false;
-        }
-        ++i;
-        if (colon == std::string_view::npos) {
-            break;
-        }
-        s.remove_prefix(colon + 1);
-    }
-    return i >= min_n;
-}
-
-bool parseU64(std::string_view s, uint64_t& out) {
-    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-    return ec == std::errc() && p == s.data() + s.size();
-}
-
-// Below 1 kbit/s a full queue (up to 1 GiB) would take longer than int64 nanoseconds can count.
-constexpr double kMinLinkMbps = 0.001;
 // Deliveries later than this (~146 years) are refused rather than rounded into overflow.
 constexpr double kMaxDeliveryNs = 4.6e18;
 
 }  // namespace
 
-const std::vector<std::string>& linkProfileNames() {
-    static const std::vector<std::string> names{"none", "wifi", "lte", "5g"};
-    return names;
-}
-
-Expected<LinkConfig> parseLinkSpec(const std::string& spec) {
-    std::vector<std::string_view> parts;
-    std::string_view rest = spec;
-    while (true) {
-        const size_t comma = rest.find(',');
-        parts.push_back(rest.substr(0, comma));
-        if (comma == std::string_view::npos) {
-            break;
-        }
-        rest.remove_prefix(comma + 1);
-    }
-    LinkConfig c;
-    const std::string_view profile = parts[0];
-    c.name = std::string(profile);
-    if (profile == "none") {
-    } else if (profile == "wifi") {
-        c.rate_bps = 200e6;
-    } else if (profile == "lte") {
-        c.rate_bps = 100e6;
-    } else if (profile == "5g") {
-        c.rate_bps = 500e6;
-    } else if (profile.starts_with("rate:")) {
-        double mbps = 0;
-        if (!parseDouble(profile.substr(5), mbps) || mbps < kMinLinkMbps || mbps > 1e6) {
-            return makeError("link '" + spec +
-                             "': rate:MBPS needs a rate in [0.001, 1e6] Mbit/s (slower rates "
-                             "would hold a packet for longer than the clock can count)");
-        }
-        c.rate_bps = mbps * 1e6;
-    } else if (profile.starts_with("trace:")) {
-        std::string_view path = profile.substr(6);
-        const size_t at = path.rfind('@');
-        if (at != std::string_view::npos) {
-            double mbps = 0;
-            if (!parseDouble(path.substr(at + 1), mbps) || mbps < kMinLinkMbps || mbps > 1e6) {
-                return makeError("link '" + spec +
-                                 "': trace:PATH@MBPS needs a mean in [0.001, 1e6] Mbit/s");
-            }
-            c.trace_target_bps = mbps * 1e6;
-            path = path.substr(0, at);
-        }
-        auto trace = loadMahimahiTrace(std::string(path));
-        if (!trace) {
-            return makeError(trace.error());
-        }
-        c.trace = std::make_shared<const MahimahiTrace>(std::move(trace).value());
-    } else {
-        return makeError("link '" + spec +
-                         "': unknown profile (none, wifi, lte, 5g, rate:MBPS, trace:PATH[@MBPS])");
-    }
-    for (size_t i = 1; i < parts.size(); ++i) {
-        const size_t eq = parts[i].find('=');
-        if (eq == std::string_view::npos) {
-            return makeError("link '" + spec + "': option '" + std::string(parts[i]) +
-                             "' is not key=value");
-        }
-        const std::string_view key = parts[i].substr(0, eq);
-        const std::string_view value = parts[i].substr(eq + 1);
-        double v = 0;
-        uint64_t u = 0;
-        const auto bad = [&](const char* what) {
-            return makeError("link '" + spec + "': " + std::string(key) + " " + what);
-        };
-        if (key == "delay_ms" || key == "jitter_ms") {
-            if (!parseDouble(value, v) || v < 0 || v > 10'000) {
-                return bad("must be in [0, 10000] ms");
-            }
-            (key == "delay_ms" ? c.delay_ms : c.jitter_ms) = v;
-        } else if (key == "loss") {
-            if (!parseDouble(value, v) || v < 0 || v >= 1) {
-                return bad("must be a probability in [0, 1)");
-            }
-            c.loss = v;
-        } else if (key == "queue_kb") {
-            if (!parseU64(value, u) || u == 0 || u > (1u << 20)) {
-                return bad("must be in [1, 1048576] KiB");
-            }
-            c.queue_bytes = static_cast<int64_t>(u) * 1024;
-        } else if (key == "seed") {
-            if (!parseU64(value, u)) {
-                return bad("must be an unsigned integer");
-            }
-            c.seed = u;
-        } else if (key == "ge") {
-            double prl[3] = {0, 0, 1.0};
-            if (!parseList(value, 2, 3, prl) || prl[0] < 0 || prl[0] >= 1 || prl[1] <= 0 ||
-                prl[1] > 1 || prl[2] <= 0 || prl[2] > 1) {
-                return bad(
-                    "must be P:R[:LOSS_BAD], P = P(good→bad) in [0, 1), R = P(bad→good) in "
-                    "(0, 1], LOSS_BAD = loss in the bad state in (0, 1] (default 1)");
-            }
-            c.ge_p = prl[0];
-            c.ge_r = prl[1];
-            c.ge_loss_bad = prl[2];
-        } else if (key == "reorder") {
-            double pm[2] = {0, 5.0};
-            if (!parseList(value, 1, 2, pm) || pm[0] < 0 || pm[0] >= 1 || pm[1] <= 0 ||
-                pm[1] > 10'000) {
-                return bad("must be P[:MS], P in [0, 1), MS in (0, 10000]");
-            }
-            c.reorder = pm[0];
-            c.reorder_ms = pm[1];
-        } else if (key == "dup") {
-            if (!parseDouble(value, v) || v < 0 || v >= 1) {
-                return bad("must be a probability in [0, 1)");
-            }
-            c.duplicate = v;
-        } else if (key == "spike") {
-            double e[3] = {0, 0, 0};
-            if (!parseList(value, 3, 3, e) || e[0] <= 0 || e[0] > 3'600'000 || e[1] <= 0 ||
-                e[1] > e[0] || e[2] <= 0 || e[2] > 10'000) {
-                return bad(
-                    "must be EVERY:LEN:EXTRA ms, 0 < LEN <= EVERY <= 3600000, "
-                    "0 < EXTRA <= 10000");
-            }
-            c.spike_every_ms = e[0];
-            c.spike_len_ms = e[1];
-            c.spike_extra_ms = e[2];
-        } else {
-            return makeError("link '" + spec + "': unknown option '" + std::string(key) +
-                             "' (delay_ms, jitter_ms, loss, queue_kb, seed, ge, reorder, dup, "
-                             "spike)");
-        }
-    }
-    return c;
-}
-
-LinkEmulator::LinkEmulator(LinkConfig config)
+LinkEmulator::LinkEmulator(LinkSpec config)
     : m_config(std::move(config)),
       m_loss_rng(m_config.seed * 0x9E3779B97F4A7C15ull + 1),
       m_jitter_rng(m_config.seed * 0xBF58476D1CE4E5B9ull + 2),
@@ -184,6 +22,8 @@ LinkEmulator::LinkEmulator(LinkConfig config)
       m_reorder_rng(m_config.seed * 0xD6E8FEB86659FD93ull + 4),
       m_dup_rng(m_config.seed * 0xA0761D6478BD642Full + 5) {
     QVR_CHECK(m_config.rate_bps >= 0 && m_config.delay_ms >= 0 && m_config.jitter_ms >= 0);
+    QVR_CHECK_MSG(m_config.trace_path.empty() || m_config.trace,
+                  "a trace link's spec must be loaded (loadLinkSpec)");
     QVR_CHECK(m_config.loss >= 0 && m_config.loss < 1 && m_config.queue_bytes > 0 &&
               m_config.max_in_flight_bytes > 0);
     QVR_CHECK(m_config.ge_p >= 0 && m_config.ge_p < 1 && m_config.ge_r >= 0 && m_config.ge_r <= 1 &&

@@ -137,9 +137,8 @@ public:
         m_renderer = std::move(*r);
         if (auto st = m_renderer->upload(*m_scene); !st)
             return makeError("headset: " + st.error());
-        if (m_config.cluster_ring_counts &&
-            (m_config.design == RuntimeDesign::kQvr || m_config.design == RuntimeDesign::kSw ||
-             m_config.workload)) {
+        if (m_config.cluster_ring_counts && (m_config.design == Design::Qvr ||
+                                             m_config.design == Design::Sw || m_config.workload)) {
             // LIWC's rings from the draw clusters (what the fovea submits), not the BVH.
             auto clusters = std::make_shared<DrawList>(buildDrawList(*m_scene));
             if (m_config.lod_error_px > 0.0f)
@@ -147,18 +146,18 @@ public:
             m_probe.useClusters(std::move(clusters), m_config.lod_error_px);
         }
         switch (m_config.design) {
-            case RuntimeDesign::kQvr: {
+            case Design::Qvr: {
                 auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(false));
                 m_liwc = liwc.get();
                 m_policy = std::move(liwc);
                 break;
             }
-            case RuntimeDesign::kSw:
+            case Design::Sw:
                 // The same model as qvr's, fed as software would be (docs/RUNTIME.md).
                 m_policy = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(true));
                 break;
-            case RuntimeDesign::kFfr:
-            case RuntimeDesign::kFixed:
+            case Design::Ffr:
+            case Design::Fixed:
                 m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
                 break;
             default:
@@ -472,8 +471,8 @@ private:
         tel(ti).connected = connected;
 
         // 2. Decision: e1 before rendering.
-        const bool needs_workload = m_config.design == RuntimeDesign::kQvr ||
-                                    m_config.design == RuntimeDesign::kSw || m_config.workload;
+        const bool needs_workload =
+            m_config.design == Design::Qvr || m_config.design == Design::Sw || m_config.workload;
         std::optional<WorkloadFrame> wf;
         double probe_ms = 0.0;
         if (needs_workload) {
@@ -491,10 +490,10 @@ private:
         double t_local_pred_ms = 0.0;
         double t_remote_pred_ms = 0.0;
         switch (m_config.design) {
-            case RuntimeDesign::kLocal:
+            case Design::Local:
                 plan = m_planner.plan(gaze, 180.0);
                 break;
-            case RuntimeDesign::kRemote:
+            case Design::Remote:
                 if (connected) {
                     plan = wholeFramePlan(m_planner, gaze);
                 } else {
@@ -534,9 +533,9 @@ private:
         t->probe_ms = probe_ms;
         t->t_local_pred_ms = t_local_pred_ms;
         t->t_remote_pred_ms = t_remote_pred_ms;
-        t->e1_deg = m_config.design == RuntimeDesign::kRemote && !fallback ? 0.0
-                    : m_config.design == RuntimeDesign::kLocal || fallback ? plan.cover_deg
-                                                                           : plan.e1_deg;
+        t->e1_deg = m_config.design == Design::Remote && !fallback ? 0.0
+                    : m_config.design == Design::Local || fallback ? plan.cover_deg
+                                                                   : plan.e1_deg;
         t->e2_deg = plan.e2_deg;
         if (wf)
             t->fovea_triangles =

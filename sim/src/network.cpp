@@ -2,13 +2,12 @@
 #include "qvr/sim/network.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <sstream>
 
 #include <fmt/format.h>
+
+#include "qvr/core/link_spec.h"
 
 namespace qvr {
 
@@ -62,89 +61,28 @@ LinkTransfer NoisyLink::transfer(double /*start_ms*/, double payload_bytes) {
     return {payload_bytes * 8.0 / goodput_bps * 1e3, goodput_bps};
 }
 
-double MahimahiTrace::meanBps() const {
-    if (period_ms <= 0.0)
-        return 0.0;
-    return static_cast<double>(opportunities_ms.size()) * kMahimahiPacketBytes * 8.0 /
-           (period_ms * 1e-3);
-}
-
-Expected<MahimahiTrace> parseMahimahiTrace(std::string_view text, const std::string& source) {
-    MahimahiTrace trace;
-    int64_t line_no = 0;
-    size_t pos = 0;
-    double previous = -1.0;
-    while (pos < text.size()) {
-        size_t end = text.find('\n', pos);
-        if (end == std::string_view::npos)
-            end = text.size();
-        std::string_view line = text.substr(pos, end - pos);
-        pos = end + 1;
-        ++line_no;
-        while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t'))
-            line.remove_suffix(1);
-        while (!line.empty() && (line.front() == ' ' || line.front() == '\t'))
-            line.remove_prefix(1);
-        if (line.empty())
-            continue;
-        if (line_no > kMaxMahimahiLines)
-            return makeError(fmt::format("{}: more than {} lines", source, kMaxMahimahiLines));
-        uint64_t value = 0;
-        const auto [ptr, ec] = std::from_chars(line.data(), line.data() + line.size(), value);
-        if (ec != std::errc() || ptr != line.data() + line.size())
-            return makeError(
-                fmt::format("{}:{}: expected a non-negative integer millisecond stamp, got '{}'",
-                            source, line_no, std::string(line.substr(0, 40))));
-        if (value > 1'000'000'000ULL)
-            return makeError(
-                fmt::format("{}:{}: stamp {} ms is beyond 1e9", source, line_no, value));
-        const double ms = static_cast<double>(value);
-        if (ms < previous)
-            return makeError(fmt::format("{}:{}: stamp {} is earlier than the previous {}", source,
-                                         line_no, value, previous));
-        previous = ms;
-        trace.opportunities_ms.push_back(ms);
-    }
-    if (trace.opportunities_ms.empty())
-        return makeError(fmt::format("{}: no delivery opportunities in the trace", source));
-    trace.period_ms = trace.opportunities_ms.back();
-    if (trace.period_ms <= 0.0)
-        return makeError(
-            fmt::format("{}: the last stamp must be > 0 ms (the loop length)", source));
-    return trace;
-}
-
-Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in)
-        return makeError(fmt::format("cannot open Mahimahi trace '{}'", path));
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return parseMahimahiTrace(ss.str(), path);
-}
-
-TraceLink::TraceLink(std::string name, MahimahiTrace trace, double target_mean_bps,
+TraceLink::TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
                      double efficiency, RadioPower radio)
     : m_name(std::move(name)),
-      m_trace(std::move(trace)),
       m_target_mean_bps(target_mean_bps),
       m_efficiency(efficiency),
       m_radio(radio) {
-    QVR_CHECK(target_mean_bps > 0.0 && m_trace.period_ms > 0.0);
+    QVR_CHECK(target_mean_bps > 0.0 && trace.period_ms > 0);
     // Dividing every stamp by target/trace mean scales the capacity to the target.
-    m_time_scale = m_trace.meanBps() / target_mean_bps;
-    for (double& t : m_trace.opportunities_ms)
-        t *= m_time_scale;
-    m_trace.period_ms *= m_time_scale;
+    m_time_scale = trace.meanBps() / target_mean_bps;
+    m_opportunities_ms.reserve(trace.stamps_ms.size());
+    for (int64_t t : trace.stamps_ms)
+        m_opportunities_ms.push_back(static_cast<double>(t) * m_time_scale);
+    m_period_ms = static_cast<double>(trace.period_ms) * m_time_scale;
 }
 
 LinkTransfer TraceLink::transfer(double start_ms, double payload_bytes) {
     if (payload_bytes <= 0.0)
         return {0.0, meanGoodputBps()};
-    const auto& opp = m_trace.opportunities_ms;
-    const double period = m_trace.period_ms;
-    const int64_t packets =
-        static_cast<int64_t>(std::ceil(payload_bytes / (m_efficiency * kMahimahiPacketBytes)));
+    const auto& opp = m_opportunities_ms;
+    const double period = m_period_ms;
+    const int64_t packets = static_cast<int64_t>(
+        std::ceil(payload_bytes / (m_efficiency * static_cast<double>(kMahimahiPacketBytes))));
     const double start = std::max(0.0, start_ms);
     double cycle = std::floor(start / period);
     const double offset = start - cycle * period;
@@ -194,34 +132,30 @@ const std::vector<std::string>& networkNames() {
 }
 
 Expected<NetworkSpec> networkSpecByName(const std::string& name) {
-    if (name == "wifi")
-        return NetworkSpec{"wifi", 200e6, 20.0, kWifiRadio, ""};
-    if (name == "lte" || name == "4g")
-        return NetworkSpec{"lte", kLteNominalBps, 20.0, kLteRadio, ""};
-    if (name == "5g")
-        return NetworkSpec{"5g", 500e6, 20.0, kNrRadio, ""};
-    if (name.rfind("trace:", 0) == 0) {
-        std::string rest = name.substr(6);
-        double mbps = kLteNominalBps / 1e6;
-        const size_t at = rest.rfind('@');
-        if (at != std::string::npos) {
-            const std::string num = rest.substr(at + 1);
-            char* end = nullptr;
-            mbps = std::strtod(num.c_str(), &end);
-            if (num.empty() || end != num.c_str() + num.size() || !std::isfinite(mbps) ||
-                mbps <= 0.0 || mbps > 100'000.0)
-                return makeError(fmt::format(
-                    "network '{}': the rate after '@' must be a positive number of Mbps", name));
-            rest = rest.substr(0, at);
-        }
-        if (rest.empty())
-            return makeError(fmt::format("network '{}': expected trace:PATH[@MBPS]", name));
-        return NetworkSpec{name, mbps * 1e6, std::numeric_limits<double>::infinity(), kLteRadio,
-                           rest};
+    auto link = parseLinkSpec(name);
+    if (!link)
+        return makeError(link.error());
+    const auto refuse = [&](const char* what) {
+        return makeError(
+            fmt::format("network '{}': the paper simulator models no {} (wifi, lte or 4g, 5g, "
+                        "trace:PATH[@MBPS])",
+                        name, what));
+    };
+    if (link->options > 0)
+        return refuse("link options");
+    if (link->profile == "wifi")
+        return NetworkSpec{"wifi", link->rate_bps, 20.0, kWifiRadio, ""};
+    if (link->profile == "lte")
+        return NetworkSpec{"lte", link->rate_bps, 20.0, kLteRadio, ""};
+    if (link->profile == "5g")
+        return NetworkSpec{"5g", link->rate_bps, 20.0, kNrRadio, ""};
+    if (link->profile == "trace") {
+        const double bps = link->trace_target_bps > 0.0 ? link->trace_target_bps : kLteNominalBps;
+        return NetworkSpec{name, bps, std::numeric_limits<double>::infinity(), kLteRadio,
+                           link->trace_path};
     }
-    return makeError(fmt::format(
-        "unknown network '{}': expected wifi, lte, 5g or trace:PATH[@MBPS] (a Mahimahi file)",
-        name));
+    return refuse(link->profile == "rate" ? "rate:MBPS link (it has no radio)"
+                                          : "unshaped link ('none')");
 }
 
 Expected<std::unique_ptr<Link>> makeLink(const NetworkSpec& spec, uint64_t seed) {
@@ -233,8 +167,8 @@ Expected<std::unique_ptr<Link>> makeLink(const NetworkSpec& spec, uint64_t seed)
     auto trace = loadMahimahiTrace(spec.trace_path);
     if (!trace)
         return makeError(trace.error());
-    return std::unique_ptr<Link>(std::make_unique<TraceLink>(
-        spec.name, std::move(*trace), spec.nominal_bps, efficiency, spec.radio));
+    return std::unique_ptr<Link>(
+        std::make_unique<TraceLink>(spec.name, *trace, spec.nominal_bps, efficiency, spec.radio));
 }
 
 }  // namespace qvr

@@ -17,6 +17,7 @@
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
 #include "qvr/core/canvas_policy.h"
+#include "qvr/core/link_spec.h"
 #include "qvr/core/silence.h"
 #include "qvr/foveation/layer_plan.h"
 
@@ -97,95 +98,64 @@ double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes
                                                                  : m_costs.keyframe_bits_ratio);
 }
 
-namespace {
-
-double nearestRankP99(std::vector<double> v) {
-    if (v.empty())
-        return 0.0;
-    std::sort(v.begin(), v.end());
-    const double rank = std::ceil(0.99 * static_cast<double>(v.size()));
-    const size_t idx = static_cast<size_t>(std::clamp(rank, 1.0, double(v.size()))) - 1;
-    return v[idx];
-}
-
-}  // namespace
-
 Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double* delay_ms) {
-    const size_t comma = spec.find(',');
-    const std::string profile = spec.substr(0, comma);
     if (delay_ms)
         *delay_ms = 0.0;
-    for (size_t pos = comma; pos != std::string::npos;) {
-        const size_t end = spec.find(',', pos + 1);
-        const std::string opt =
-            spec.substr(pos + 1, end == std::string::npos ? end : end - pos - 1);
-        pos = end;
-        if (opt.rfind("delay_ms=", 0) == 0) {
-            char* stop = nullptr;
-            const double v = std::strtod(opt.c_str() + 9, &stop);
-            if (stop == opt.c_str() + 9 || *stop != '\0' || !std::isfinite(v) || v < 0 || v > 10000)
-                return makeError("link '" + spec + "': bad delay_ms");
-            if (delay_ms)
-                *delay_ms = v;
-        }
-    }
-    auto rate = [&](double bps) -> Expected<std::unique_ptr<Link>> {
-        return std::unique_ptr<Link>(std::make_unique<NoisyLink>(
-            profile, bps, 1.0, std::numeric_limits<double>::infinity(), RadioPower{}, 1));
-    };
-    if (profile == "wifi")
-        return rate(200e6);
-    if (profile == "lte")
-        return rate(100e6);
-    if (profile == "5g")
-        return rate(500e6);
-    if (profile.rfind("rate:", 0) == 0) {
-        char* stop = nullptr;
-        const double mbps = std::strtod(profile.c_str() + 5, &stop);
-        if (stop == profile.c_str() + 5 || *stop != '\0' || !(mbps > 0) || mbps > 1e6)
-            return makeError("link '" + spec + "': rate:MBPS needs a rate in (0, 1e6]");
-        return rate(mbps * 1e6);
-    }
-    if (profile.rfind("trace:", 0) == 0) {
-        std::string path = profile.substr(6);
-        double target_bps = 0.0;
-        if (const size_t at = path.rfind('@'); at != std::string::npos) {
-            char* stop = nullptr;
-            const double mbps = std::strtod(path.c_str() + at + 1, &stop);
-            if (stop == path.c_str() + at + 1 || *stop != '\0' || !(mbps > 0) || mbps > 1e6)
-                return makeError("link '" + spec + "': trace:PATH@MBPS needs a mean in (0, 1e6]");
-            target_bps = mbps * 1e6;
-            path.resize(at);
-        }
-        auto trace = loadMahimahiTrace(path);
-        if (!trace)
-            return makeError(trace.error());
-        if (target_bps <= 0)
-            target_bps = trace->meanBps();
+    auto link = loadLinkSpec(spec);
+    if (!link)
+        return makeError(link.error());
+    if (delay_ms)
+        *delay_ms = link->delay_ms;
+    if (link->trace) {
+        const double target_bps =
+            link->trace_target_bps > 0.0 ? link->trace_target_bps : link->trace->meanBps();
         return std::unique_ptr<Link>(
-            std::make_unique<TraceLink>(profile, std::move(*trace), target_bps, 1.0, RadioPower{}));
+            std::make_unique<TraceLink>(link->name, *link->trace, target_bps, 1.0, RadioPower{}));
     }
+    if (link->rate_bps > 0.0)
+        return std::unique_ptr<Link>(
+            std::make_unique<NoisyLink>(link->name, link->rate_bps, 1.0,
+                                        std::numeric_limits<double>::infinity(), RadioPower{}, 1));
     return makeError("link '" + spec +
-                     "': the runtime model knows wifi, lte, 5g, rate:MBPS and trace:PATH[@MBPS]");
+                     "': the runtime model needs a rate or a trace (wifi, lte or 4g, 5g, "
+                     "rate:MBPS, trace:PATH[@MBPS])");
+}
+
+FrameSample runtimeFrameSample(const RuntimeFrame& f, double first_layers_ms) {
+    FrameSample x;
+    x.pose_ms = f.pose_ms;
+    x.display_ms = f.display_ms;
+    x.mtp_ms = f.mtp_ms;
+    x.bytes = f.bytes;
+    x.e1_deg = f.e1_deg;
+    x.t_local_ms = f.t_local_ms;
+    x.t_remote_ms = f.t_remote_ms;
+    x.headset_busy_ms = f.headset_busy_ms;
+    x.remote_requested = f.requested;
+    // The runtime's shown_frame ≥ 0: the server's first layers were on screen by its UCA.
+    x.remote_shown = f.uca_start_ms >= first_layers_ms;
+    x.reused = f.reused;
+    return x;
+}
+
+RuntimeSummary summarizeRuntimeFrames(const std::vector<RuntimeFrame>& frames,
+                                      const RuntimeSimConfig& config) {
+    double first_layers_ms = std::numeric_limits<double>::infinity();
+    for (const RuntimeFrame& f : frames)
+        if (f.remote_done_ms >= 0.0)
+            first_layers_ms = std::min(first_layers_ms, f.remote_done_ms);
+    FrameSummarizer summarizer(config.warmup_frames);
+    for (const RuntimeFrame& f : frames)
+        summarizer.add(runtimeFrameSample(f, first_layers_ms));
+    RuntimeSummary s;
+    static_cast<RunStats&>(s) = summarizer.finish();
+    s.design = designLabel(config.design, config.fixed_e1_deg);
+    return s;
 }
 
 double serverLayerTriangles(double cone_triangles_both_eyes, double scale) {
     const double s = std::max(scale, 1.0);
     return cone_triangles_both_eyes / 2.0 / (s * s);
-}
-
-Expected<Design> runtimeDesignByName(const std::string& name) {
-    if (name == "local")
-        return Design::Local;
-    if (name == "remote")
-        return Design::Remote;
-    if (name == "ffr")
-        return Design::Ffr;
-    if (name == "sw")
-        return Design::Sw;
-    if (name == "qvr")
-        return Design::Qvr;
-    return makeError("runtime model: unknown design '" + name + "' (local, remote, ffr, sw, qvr)");
 }
 
 double coRunEnd(double start, double work, const std::vector<BusySpan>& other, double slowdown) {
@@ -651,61 +621,11 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         rf.key_frames = fs.key_frames;
     }
 
-    // Summary, as summarizeRun (runtime/telemetry.cpp) computes it.
-    RuntimeSummary& s = result.summary;
-    s.design = std::string(traits.name);
-    // Statistics over the frames after the warm-up, as summarizeRun skips them: the first
-    // warmup_frames, and after them every frame that asked for layers while none had yet come
-    // (the runtime's shown_frame < 0); all frames when the start-up is the whole run.
-    double first_layers_ms = std::numeric_limits<double>::infinity();
-    for (const RuntimeFrame& f : result.frames)
-        if (f.remote_done_ms >= 0.0)
-            first_layers_ms = std::min(first_layers_ms, f.remote_done_ms);
-    int skip = config.warmup_frames > 0 ? config.warmup_frames : 0;
-    if (skip > 0)
-        while (skip < n_frames && skip < static_cast<int64_t>(kMaxStartupFrames)) {
-            const RuntimeFrame& f = result.frames[static_cast<size_t>(skip)];
-            if (!f.requested || f.uca_start_ms >= first_layers_ms)
-                break;
-            ++skip;
-        }
-    if (skip >= n_frames)
-        skip = 0;
-    const int counted = n_frames - skip;
-    s.frames = counted;
-    if (counted <= 0)
-        return result;
-    const double n = double(counted);
-    std::vector<double> mtp;
-    int remote_frames = 0, busy_frames = 0;
-    for (size_t k = static_cast<size_t>(skip); k < result.frames.size(); ++k) {
-        const RuntimeFrame& f = result.frames[k];
-        mtp.push_back(f.mtp_ms);
-        s.mtp_ms_mean += f.mtp_ms / n;
-        s.bytes_per_frame_mean += f.bytes / n;
-        s.e1_deg_mean += f.e1_deg / n;
-        s.t_local_ms_mean += f.t_local_ms / n;
-        s.frames_reused += f.reused ? 1 : 0;
-        if (f.requested) {
-            s.t_remote_ms_mean += f.t_remote_ms;
-            ++remote_frames;
-        }
-        if (f.headset_busy_ms > 0) {
-            s.headset_busy_ms_mean += f.headset_busy_ms;
-            ++busy_frames;
-        }
-    }
-    s.mtp_ms_p99 = nearestRankP99(mtp);
-    if (remote_frames > 0)
-        s.t_remote_ms_mean /= remote_frames;
-    if (busy_frames > 0)
-        s.headset_busy_ms_mean /= busy_frames;
+    const int requests_dropped = result.summary.requests_dropped;
+    result.summary = summarizeRuntimeFrames(result.frames, config);
+    result.summary.requests_dropped = requests_dropped;
     if (served_frames > 0)
-        s.server_busy_ms_mean = server_busy_total / served_frames;
-    const double span =
-        result.frames.back().display_ms - result.frames[static_cast<size_t>(skip)].display_ms;
-    if (counted > 1 && span > 0)
-        s.fps_mean = (n - 1.0) * 1000.0 / span;
+        result.summary.server_busy_ms_mean = server_busy_total / served_frames;
     return result;
 }
 

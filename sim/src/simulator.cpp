@@ -14,6 +14,7 @@
 
 #include "qvr/controller/liwc.h"
 #include "qvr/core/check.h"
+#include "qvr/core/run_summary.h"
 #include "qvr/sim/gpu_timeline.h"
 
 namespace qvr {
@@ -48,17 +49,6 @@ TileSplit splitTiles(const PixelRect& fovea, int width_px, int height_px, int ti
     const double touching = static_cast<double>(tx) * ty;
     const double interior = static_cast<double>(std::max(0, tx - 2)) * std::max(0, ty - 2);
     return {interior, touching - interior, total - touching};
-}
-
-double percentile(std::vector<double> v, double p) {
-    if (v.empty())
-        return 0.0;
-    std::sort(v.begin(), v.end());
-    const double pos = p * static_cast<double>(v.size() - 1);
-    const size_t lo = static_cast<size_t>(std::floor(pos));
-    const size_t hi = std::min(v.size() - 1, lo + 1);
-    const double w = pos - static_cast<double>(lo);
-    return v[lo] * (1.0 - w) + v[hi] * w;
 }
 
 }  // namespace
@@ -389,7 +379,7 @@ RunSummary summarize(const std::vector<FrameRecord>& frames, const SimConfig& co
             ++steady_n;
         }
     }
-    s.mtp_ms_p99 = percentile(mtp, 0.99);
+    s.mtp_ms_p99 = percentile(mtp, 99.0);
     s.fps_mean = period_sum > 0.0 ? 1000.0 * n / period_sum : 0.0;
     const double span_ms = frames.back().display_ready_ms - frames.front().display_ready_ms;
     s.fps_pipeline = span_ms > 0.0 ? 1000.0 * (n - 1.0) / span_ms : s.fps_mean;
@@ -398,7 +388,7 @@ RunSummary summarize(const std::vector<FrameRecord>& frames, const SimConfig& co
     std::vector<double> tail;
     for (size_t i = frames.size() > 30 ? frames.size() - 30 : 0; i < frames.size(); ++i)
         tail.push_back(frames[i].latency_ratio);
-    s.latency_ratio_final = percentile(tail, 0.5);
+    s.latency_ratio_final = percentile(tail, 50.0);
     s.meets_refresh = s.fps_mean >= refresh_hz;
     return s;
 }

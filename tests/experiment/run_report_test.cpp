@@ -11,7 +11,7 @@
 namespace qvr::experiment {
 namespace {
 
-using runtime::RuntimeDesign;
+using Design;
 
 std::set<std::string> keysOf(const nlohmann::json& j) {
     std::set<std::string> keys;
@@ -20,7 +20,7 @@ std::set<std::string> keysOf(const nlohmann::json& j) {
     return keys;
 }
 
-DesignResult design(RuntimeDesign kind, double e1, double fps, double bytes) {
+DesignResult design(Design kind, double e1, double fps, double bytes) {
     DesignResult d;
     d.spec.design = kind;
     d.spec.fixed_e1_deg = e1;
@@ -36,7 +36,7 @@ DesignResult design(RuntimeDesign kind, double e1, double fps, double bytes) {
 
 // A design measured, predicted by both models and at the probes' speed.
 DesignResult predictedQvr() {
-    DesignResult d = design(RuntimeDesign::kQvr, 0.0, 50.0, 2000.0);
+    DesignResult d = design(Design::Qvr, 0.0, 50.0, 2000.0);
     d.summary.e1_deg_mean = 10.0;
     d.summary.headset_busy_ms_mean = 15.0;
     d.summary.headset_busy_frames = 100;
@@ -129,7 +129,7 @@ TEST(DesignJson, MeasuredPredictedErrorsAndSpeed) {
 }
 
 TEST(DesignJson, AnUnpredictedDesignHasNullsAndNoPrediction) {
-    const nlohmann::json j = designJson(design(RuntimeDesign::kLocal, 0.0, 30.0, 0.0));
+    const nlohmann::json j = designJson(design(Design::Local, 0.0, 30.0, 0.0));
     EXPECT_TRUE(j["headset_busy_ms_mean"].is_null());
     EXPECT_TRUE(j["server_busy_ms_mean"].is_null());
     EXPECT_FALSE(j.contains("predicted"));
@@ -139,12 +139,12 @@ TEST(DesignJson, AnUnpredictedDesignHasNullsAndNoPrediction) {
 }
 
 TEST(BestFixed, TheFastestFixedDesignAndTheAdaptiveOnesOverIt) {
-    const std::vector<DesignResult> designs = {design(RuntimeDesign::kLocal, 0.0, 90.0, 0.0),
-                                               design(RuntimeDesign::kFfr, 5.0, 40.0, 0.0),
-                                               design(RuntimeDesign::kFixed, 10.0, 50.0, 0.0),
-                                               design(RuntimeDesign::kFixed, 20.0, 45.0, 0.0),
-                                               design(RuntimeDesign::kQvr, 0.0, 60.0, 0.0),
-                                               design(RuntimeDesign::kSw, 0.0, 25.0, 0.0)};
+    const std::vector<DesignResult> designs = {design(Design::Local, 0.0, 90.0, 0.0),
+                                               design(Design::Ffr, 5.0, 40.0, 0.0),
+                                               design(Design::Fixed, 10.0, 50.0, 0.0),
+                                               design(Design::Fixed, 20.0, 45.0, 0.0),
+                                               design(Design::Qvr, 0.0, 60.0, 0.0),
+                                               design(Design::Sw, 0.0, 25.0, 0.0)};
     const auto bf = bestFixed(designs);
     ASSERT_TRUE(bf);
     EXPECT_EQ(bf->design, "fixed:10");
@@ -155,13 +155,13 @@ TEST(BestFixed, TheFastestFixedDesignAndTheAdaptiveOnesOverIt) {
     EXPECT_DOUBLE_EQ(bf->fps_over_best[0].second, 1.2);
     EXPECT_EQ(bf->fps_over_best[1].first, "sw");
     EXPECT_DOUBLE_EQ(bf->fps_over_best[1].second, 0.5);
-    EXPECT_FALSE(bestFixed({design(RuntimeDesign::kQvr, 0.0, 60.0, 0.0)}));
+    EXPECT_FALSE(bestFixed({design(Design::Qvr, 0.0, 60.0, 0.0)}));
 }
 
 TEST(HeadlineRatios, MeasuredAndPaperModel) {
-    DesignResult local = design(RuntimeDesign::kLocal, 0.0, 20.0, 0.0);
-    DesignResult remote = design(RuntimeDesign::kRemote, 0.0, 30.0, 10000.0);
-    DesignResult qvr = design(RuntimeDesign::kQvr, 0.0, 50.0, 2500.0);
+    DesignResult local = design(Design::Local, 0.0, 20.0, 0.0);
+    DesignResult remote = design(Design::Remote, 0.0, 30.0, 10000.0);
+    DesignResult qvr = design(Design::Qvr, 0.0, 50.0, 2500.0);
     local.prediction.paper_hardware = DesignMetrics{10.0, 0, 0, 0.0, 0, std::nullopt, std::nullopt};
     qvr.prediction.paper_hardware =
         DesignMetrics{40.0, 0, 0, 1000.0, 0, std::nullopt, std::nullopt};
@@ -215,7 +215,7 @@ RunOutcome handMadeOutcome() {
     o.net = "wifi";
     o.frames_per_design = 20;
     o.designs_requested = 2;
-    o.designs = {design(RuntimeDesign::kFfr, 5.0, 40.0, 500.0), predictedQvr()};
+    o.designs = {design(Design::Ffr, 5.0, 40.0, 500.0), predictedQvr()};
     o.designs[0].quality = DesignQuality{};
     o.designs[0].quality->frames = 1;
     o.designs[0].quality->counted = {1, 0, 0, 0, 1};

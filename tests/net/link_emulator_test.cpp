@@ -9,8 +9,8 @@
 #include <cstring>
 #include <fstream>
 
+#include "qvr/core/mahimahi.h"
 #include "qvr/net/clock.h"
-#include "qvr/net/mahimahi.h"
 
 namespace qvr::net {
 namespace {
@@ -42,7 +42,7 @@ int64_t drainAll(LinkEmulator& link, FakeClock& clock, int64_t& packets, int64_t
 TEST(NetLinkEmulator, SerializesAtTheConfiguredRate) {
     // N bytes at R bit/s leave the bottleneck after N·8/R; with a fixed delay d, arrive d later.
     for (double mbps : {100.0, 200.0, 500.0}) {
-        LinkConfig c;
+        LinkSpec c;
         c.rate_bps = mbps * 1e6;
         c.delay_ms = 3.0;
         c.queue_bytes = 64 << 20;
@@ -62,7 +62,7 @@ TEST(NetLinkEmulator, SerializesAtTheConfiguredRate) {
 }
 
 TEST(NetLinkEmulator, PacedSenderSeesOnlyTheDelay) {
-    LinkConfig c;
+    LinkSpec c;
     c.rate_bps = 100e6;
     c.delay_ms = 10.0;
     LinkEmulator link(c);
@@ -89,7 +89,7 @@ TEST(NetLinkEmulator, PacedSenderSeesOnlyTheDelay) {
 }
 
 TEST(NetLinkEmulator, JitterStaysInBoundsAndKeepsOrder) {
-    LinkConfig c;
+    LinkSpec c;
     c.delay_ms = 20.0;
     c.jitter_ms = 5.0;
     c.seed = 7;
@@ -125,7 +125,7 @@ TEST(NetLinkEmulator, JitterStaysInBoundsAndKeepsOrder) {
 }
 
 TEST(NetLinkEmulator, LossMatchesItsProbabilityAndIsDeterministic) {
-    LinkConfig c;
+    LinkSpec c;
     c.loss = 0.05;
     c.seed = 11;
     auto run = [&] {
@@ -145,7 +145,7 @@ TEST(NetLinkEmulator, LossMatchesItsProbabilityAndIsDeterministic) {
 }
 
 TEST(NetLinkEmulator, DropTailQueueBoundsTheBacklog) {
-    LinkConfig c;
+    LinkSpec c;
     c.rate_bps = 8e6;  // 1 byte per µs
     c.queue_bytes = 10'000;
     LinkEmulator link(c);
@@ -165,7 +165,7 @@ TEST(NetLinkEmulator, DropTailQueueBoundsTheBacklog) {
 }
 
 TEST(NetLinkEmulator, DelayLineIsBoundedWithoutARateLimit) {
-    LinkConfig c;
+    LinkSpec c;
     c.delay_ms = 1000.0;  // no rate: nothing waits in the queue, everything in the delay line
     c.max_in_flight_bytes = 100'000;
     LinkEmulator link(c);
@@ -199,7 +199,7 @@ TEST(NetLinkEmulator, ParsesProfilesAndOptions) {
          {"wlan", "lte,loss=1", "lte,loss=-0.1", "lte,delay_ms=x", "lte,foo=1", "lte,delay_ms",
           "rate:0", "rate:abc", "trace:/nonexistent.down", "lte,queue_kb=0", "rate:1e-300",
           "rate:0.0009", "rate:nan", "rate:inf", "rate:1e7"}) {
-        EXPECT_FALSE(parseLinkSpec(bad)) << bad;
+        EXPECT_FALSE(loadLinkSpec(bad)) << bad;
     }
 }
 
@@ -217,7 +217,7 @@ TEST(NetLinkEmulator, UnrepresentableRatesAreRefusedNotOverflowed) {
     // A config built by hand with a rate near zero (which the parser refuses): the packet could
     // never leave, so it is a counted queue drop rather than an instant delivery of llround's
     // overflow that stays in the queue for ever.
-    LinkConfig c;
+    LinkSpec c;
     c.rate_bps = 1e-300;
     LinkEmulator link(c);
     FakeClock clock;
@@ -249,7 +249,7 @@ TEST(NetMahimahi, TracesMatchTheReadmeTable) {
 // A saturating sender over one loop of the trace measures the trace's mean; rescaled, the
 // target mean. The sender keeps 1 MB queued (more than any burst of opportunities drains in
 // a 1 ms step), so the link never idles.
-double measuredMeanBps(LinkConfig c, double loop_ns) {
+double measuredMeanBps(LinkSpec c, double loop_ns) {
     c.queue_bytes = 2 << 20;
     LinkEmulator link(c);
     FakeClock clock;
@@ -272,7 +272,7 @@ double measuredMeanBps(LinkConfig c, double loop_ns) {
 TEST(NetMahimahi, TraceLinkDeliversTheMeanAndRescales) {
     auto trace = loadMahimahiTrace(kTraceDir + "TMobile-LTE-short.down");
     ASSERT_TRUE(trace) << trace.error();
-    LinkConfig c;
+    LinkSpec c;
     c.trace = std::make_shared<const MahimahiTrace>(std::move(trace).value());
     const double mean = c.trace->meanBps();
     const double period_ns = static_cast<double>(c.trace->period_ms) * 1e6;
@@ -289,7 +289,7 @@ TEST(NetMahimahi, OpportunitiesFollowTheStampsAndLoop) {
     // shifted by 10 ms (Mahimahi's rule: the last stamp is the period).
     auto trace = parseMahimahiTrace("0\n0\n5\n10\n", "tiny");
     ASSERT_TRUE(trace) << trace.error();
-    LinkConfig c;
+    LinkSpec c;
     c.trace = std::make_shared<const MahimahiTrace>(std::move(trace).value());
     LinkEmulator link(c);
     std::vector<int64_t> times;
@@ -381,7 +381,7 @@ Delivered sendNumbered(LinkEmulator& link, uint32_t n, std::vector<bool>* accept
 }
 
 TEST(NetLinkFaults, GilbertElliottLosesInBurstsAtItsLongRunRate) {
-    LinkConfig c = parseLinkSpec("none,ge=0.01:0.25,seed=4").value();
+    LinkSpec c = parseLinkSpec("none,ge=0.01:0.25,seed=4").value();
     LinkEmulator link(c);
     std::vector<bool> ok;
     sendNumbered(link, 200'000, &ok);
@@ -561,7 +561,7 @@ TEST(NetLinkFaults, WithoutFaultsTheLinkIsUnchangedAndBadSpecsAreRefused) {
         }
     }
     // The defaults and the optional parts.
-    const LinkConfig g = parseLinkSpec("wifi,ge=0.05:0.2,reorder=0.1,dup=0.02").value();
+    const LinkSpec g = parseLinkSpec("wifi,ge=0.05:0.2,reorder=0.1,dup=0.02").value();
     EXPECT_EQ(g.ge_p, 0.05);
     EXPECT_EQ(g.ge_r, 0.2);
     EXPECT_EQ(g.ge_loss_bad, 1.0);
@@ -569,7 +569,7 @@ TEST(NetLinkFaults, WithoutFaultsTheLinkIsUnchangedAndBadSpecsAreRefused) {
     EXPECT_EQ(g.reorder_ms, 5.0);
     EXPECT_EQ(g.duplicate, 0.02);
     EXPECT_TRUE(g.faulty());
-    const LinkConfig h = parseLinkSpec("none,ge=0.05:0.2:0.25,spike=500:50:30").value();
+    const LinkSpec h = parseLinkSpec("none,ge=0.05:0.2:0.25,spike=500:50:30").value();
     EXPECT_EQ(h.ge_loss_bad, 0.25);
     EXPECT_EQ(h.spike_every_ms, 500.0);
     EXPECT_EQ(h.spike_len_ms, 50.0);

@@ -1474,13 +1474,13 @@ TEST(NetTransport, ThroughputFromAcksTracksAShapedLink) {
 TEST(NetTransport, ServesFramesOverATraceDrivenLinkWithDelayAndJitter) {
     const std::string spec = "trace:" + std::string(QVR_SHARED_DIR) +
                              "/data/network/TMobile-LTE-short.down@100,delay_ms=10,jitter_ms=3";
-    auto link = parseLinkSpec(spec);
+    auto link = loadLinkSpec(spec);
     ASSERT_TRUE(link) << link.error();
     // The fastest the link can carry the 40 streams: all datagrams queued at its first instant
     // (later sends only lose opportunities), plus the smallest delay, 10 − 3 ms.
     int64_t fastest_ns = 0;
     {
-        LinkConfig bare = link.value();
+        LinkSpec bare = link.value();
         bare.delay_ms = bare.jitter_ms = 0;
         LinkEmulator model(bare);
         uint32_t seq = 0;

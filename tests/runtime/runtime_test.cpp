@@ -73,15 +73,15 @@ RenderServerConfig serverConfig(const std::string& link, const std::string& code
                                 bool gl = false) {
     RenderServerConfig c;
     c.net.key = keyA();
-    c.net.link = net::parseLinkSpec(link).value();
+    c.net.link = qvr::loadLinkSpec(link).value();
     c.profile = world().profile;
     c.codec.backend = codec;
     c.renderer = gl ? glRendererFactory() : nullRendererFactory();
     return c;
 }
 
-HeadsetConfig headsetConfig(RuntimeDesign design, uint16_t port, const std::string& codec,
-                            int frames, bool gl = false) {
+HeadsetConfig headsetConfig(Design design, uint16_t port, const std::string& codec, int frames,
+                            bool gl = false) {
     HeadsetConfig h;
     h.design = design;
     h.profile = world().profile;
@@ -118,22 +118,22 @@ TEST(VsyncPacer, ScansOutAtTheFirstSlotAfterReadyAndNeverTwiceInOne) {
 }
 
 TEST(RuntimeDesigns, ParseListsAndRejectUnknownNames) {
-    auto d = parseDesignList("local,qvr,fixed:12");
+    auto d = parseDesignList("local,qvr,fixed:12", DesignScope::Runtime);
     ASSERT_TRUE(d.ok()) << d.error();
     ASSERT_EQ(d->size(), 3u);
-    EXPECT_EQ((*d)[0].design, RuntimeDesign::kLocal);
-    EXPECT_EQ((*d)[1].design, RuntimeDesign::kQvr);
-    EXPECT_EQ((*d)[2].design, RuntimeDesign::kFixed);
+    EXPECT_EQ((*d)[0].design, Design::Local);
+    EXPECT_EQ((*d)[1].design, Design::Qvr);
+    EXPECT_EQ((*d)[2].design, Design::Fixed);
     EXPECT_DOUBLE_EQ((*d)[2].fixed_e1_deg, 12.0);
     EXPECT_EQ((*d)[2].label(), "fixed:12");
-    EXPECT_FALSE(parseDesignList("local,dfr").ok());
-    EXPECT_FALSE(parseDesignList("").ok());
+    EXPECT_FALSE(parseDesignList("local,dfr", DesignScope::Runtime).ok());
+    EXPECT_FALSE(parseDesignList("", DesignScope::Runtime).ok());
 }
 
 TEST(Runtime, QvrFramesComeFromTheServerOnACleanLink) {
     auto server = RenderServer::start(serverConfig("none", "raw"), world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    const HeadsetResult r = runOn(headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 30));
+    const HeadsetResult r = runOn(headsetConfig(Design::Ffr, (*server)->port(), "raw", 30));
     ASSERT_EQ(r.frames.size(), 30u);
     EXPECT_EQ(r.summary.frames_displayed, 30);
     EXPECT_EQ(r.stats.connects, 1u);
@@ -156,7 +156,7 @@ TEST(Runtime, QvrFramesComeFromTheServerOnACleanLink) {
 TEST(Runtime, WrongKeyIsRefusedAndTheHeadsetRendersLocally) {
     auto server = RenderServer::start(serverConfig("none", "raw"), world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kQvr, (*server)->port(), "raw", 12);
+    HeadsetConfig h = headsetConfig(Design::Qvr, (*server)->port(), "raw", 12);
     h.key = keyB();
     const HeadsetResult r = runOn(h);
     EXPECT_EQ(r.stats.connects, 0u);
@@ -208,7 +208,7 @@ TEST(Runtime, MalformedTruncatedAndOversizedControlMessagesAreDroppedAndCounted)
     truncated.resize(net::kControlHeaderBytes + 10);
     sendRaw(port, truncated);
     // The server keeps serving a real headset afterwards.
-    const HeadsetResult r = runOn(headsetConfig(RuntimeDesign::kFfr, port, "raw", 20));
+    const HeadsetResult r = runOn(headsetConfig(Design::Ffr, port, "raw", 20));
     EXPECT_EQ(r.stats.connects, 1u);
     EXPECT_EQ(r.summary.frames_displayed, 20);
     EXPECT_LT(r.summary.frames_reused, 10);
@@ -223,8 +223,7 @@ TEST(Runtime, FivePercentPacketLossKeepsFramesComingWithReusedFramesCounted) {
     auto server = RenderServer::start(serverConfig("wifi,loss=0.05,seed=3", "x264"), world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
     const int frames = 90;
-    const HeadsetResult r =
-        runOn(headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "x264", frames));
+    const HeadsetResult r = runOn(headsetConfig(Design::Ffr, (*server)->port(), "x264", frames));
     EXPECT_EQ(r.summary.frames_displayed, frames);
     // Reused frames are counted (with FEC and in-order NACK recovery there may be none).
     int reused = 0;
@@ -251,7 +250,7 @@ TEST(Runtime, ALongSessionHoldsOnlyItsNewestFramesAndStreamsTheRestInOrder) {
     // late streams of frames already shown do arrive while older frames are retired).
     auto server = RenderServer::start(serverConfig("wifi,loss=0.05,seed=5", "raw"), world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kQvr, (*server)->port(), "raw", 200);
+    HeadsetConfig h = headsetConfig(Design::Qvr, (*server)->port(), "raw", 200);
     h.keep_frames = 10;  // held: at least 64
     h.warmup_frames = 10;
     std::vector<FrameTelemetry> sunk;
@@ -304,7 +303,7 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
     };
     auto server = RenderServer::start(sc, world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 240);
+    HeadsetConfig h = headsetConfig(Design::Ffr, (*server)->port(), "raw", 240);
     h.before_frame = [&headset_frame](int64_t f) { headset_frame.store(f); };
     const HeadsetResult r = runOn(h);
     ASSERT_EQ(r.frames.size(), 240u);
@@ -391,7 +390,7 @@ TEST(Runtime, AServerSlowerThanTheWaitLimitStillGetsItsFramesShown) {
     };
     auto server = RenderServer::start(sc, world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kRemote, (*server)->port(), "raw", 200);
+    HeadsetConfig h = headsetConfig(Design::Remote, (*server)->port(), "raw", 200);
     h.remote_timeout_ms = 20.0;
     const HeadsetResult r = runOn(h);
     ASSERT_EQ(r.frames.size(), 200u);
@@ -415,7 +414,7 @@ TEST(Runtime, ALateFramesStreamsCountAsItsBytesAfterItWasShown) {
     RenderServerConfig sc = serverConfig("rate:40", "raw");
     auto server = RenderServer::start(sc, world().scene);
     ASSERT_TRUE(server.ok()) << server.error();
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", 60);
+    HeadsetConfig h = headsetConfig(Design::Ffr, (*server)->port(), "raw", 60);
     h.pipeline_depth = 1;
     h.remote_timeout_ms = 30.0;
     const HeadsetResult r = runOn(h);
@@ -437,7 +436,7 @@ TEST(Runtime, KillingTheServerLeavesTheHeadsetDisplayingAndItReconnects) {
     const int frames = 150;
     // ffr, so every frame asks for remote layers: with the null renderer's ~0.1 ms fovea, LIWC
     // rightly grows the fovea over the whole field after the reconnect and asks for nothing.
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, port, "raw", frames);
+    HeadsetConfig h = headsetConfig(Design::Ffr, port, "raw", frames);
     bool restarted = false;
     h.before_frame = [&](int64_t i) {
         if (i == 30)
@@ -488,7 +487,7 @@ TEST(Runtime, ASlowLinkChoosesALargerMeanFoveaThan5g) {
         if (!server)
             return 0.0;
         const HeadsetResult r =
-            runOn(headsetConfig(RuntimeDesign::kQvr, (*server)->port(), "raw", 90, true));
+            runOn(headsetConfig(Design::Qvr, (*server)->port(), "raw", 90, true));
         EXPECT_EQ(r.summary.frames_displayed, 90);
         return meanE1(r, 30);
     };
@@ -852,7 +851,7 @@ TEST(Runtime, MalformedMediaDatagramsAreDroppedByReasonWhileFramesKeepComing) {
         MediaTamperingProxy proxy((*server)->port(), keyA(), frames - 15);
         // ffr: a fixed fovea, so every frame asks for remote layers (with the null renderer
         // LIWC may grow the fovea over the whole field and stop asking).
-        r = runOn(headsetConfig(RuntimeDesign::kFfr, proxy.port(), "raw", frames));
+        r = runOn(headsetConfig(Design::Ffr, proxy.port(), "raw", frames));
         EXPECT_GT(proxy.forwarded(), 100u);
         injected = proxy.injected();
     }
@@ -914,7 +913,7 @@ TEST(Runtime, TwoFramesInFlightRequestTheNextFrameBeforeComposingThisOne) {
     for (int depth : {2, 1}) {
         // ffr: every frame requests remote layers (LIWC with the null renderer may grow the
         // fovea over the whole field, and then a frame asks for nothing).
-        HeadsetConfig h = headsetConfig(RuntimeDesign::kFfr, (*server)->port(), "raw", frames);
+        HeadsetConfig h = headsetConfig(Design::Ffr, (*server)->port(), "raw", frames);
         h.pipeline_depth = depth;
         const HeadsetResult r = runOn(h);
         ASSERT_EQ(r.frames.size(), size_t(frames));
@@ -938,7 +937,7 @@ TEST(Runtime, TwoFramesInFlightRequestTheNextFrameBeforeComposingThisOne) {
 TEST(Runtime, LocalDesignIgnoresThePipelineDepth) {
     // Nothing remote to overlap with: frame n + 1's pose is sampled after n is displayed.
     const int frames = 30;
-    HeadsetConfig h = headsetConfig(RuntimeDesign::kLocal, 0, "raw", frames);
+    HeadsetConfig h = headsetConfig(Design::Local, 0, "raw", frames);
     h.pipeline_depth = 2;
     const HeadsetResult r = runOn(h);
     ASSERT_EQ(r.frames.size(), size_t(frames));

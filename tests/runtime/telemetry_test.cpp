@@ -103,7 +103,7 @@ TEST(RunSummarizer, TheStartUpLastsUntilTheServersFirstLayersAreOnScreen) {
 
 TEST(RunSummarizer, AHourLongSessionKeepsItsP99WithinTheHistogramsPrecision) {
     // More frames than kept exactly: the p99 comes from the histogram, every mean stays exact.
-    const size_t n = RunSummarizer::kExactMtpFrames * 3 + 123;
+    const size_t n = FrameSummarizer::kExactMtpFrames * 3 + 123;
     const auto v = frames(n, 2);
     const DesignSummary s = summarizeRun("qvr", v, 10);
     EXPECT_EQ(s.frames, static_cast<int>(n - 10));

@@ -46,14 +46,16 @@ TEST(Network, TwentyDbWhiteNoiseHasTenPercentSpreadAndNoBias) {
     EXPECT_NEAR(std::sqrt(sum2 / n - mean * mean), 0.1, 0.005);
 }
 
+// The simulator reads traces with the one reader net's emulator uses (qvr/core/mahimahi.h):
+// digits only on a line, so a stamp with spaces around it is refused as net refuses it.
 TEST(Mahimahi, ParsesStampsAndRejectsMalformedTraces) {
-    auto ok = parseMahimahiTrace("0\n1\n1\r\n 5 \n\n10\n", "t");
+    auto ok = parseMahimahiTrace("0\n1\n1\r\n5\n\n10\n", "t");
     ASSERT_TRUE(ok.ok()) << ok.error();
-    EXPECT_EQ(ok->opportunities_ms.size(), 5u);
-    EXPECT_EQ(ok->period_ms, 10.0);
+    EXPECT_EQ(ok->stamps_ms.size(), 5u);
+    EXPECT_EQ(ok->period_ms, 10);
     EXPECT_NEAR(ok->meanBps(), 5 * 1500 * 8 / 0.010, 1e-6);
     for (const char* bad : {"", "\n\n", "0\n", "1\nx\n", "5\n3\n", "-1\n2\n", "1.5\n",
-                            "99999999999999999999\n", "2000000000\n", "12abc\n"}) {
+                            "99999999999999999999\n", "2000000000\n", "12abc\n", "1\n 5 \n"}) {
         auto r = parseMahimahiTrace(bad, "bad.down");
         EXPECT_FALSE(r.ok()) << "accepted: '" << bad << "'";
         if (!r.ok()) {
@@ -93,7 +95,7 @@ TEST(Mahimahi, SharedVerizonTraceHasItsDocumentedMeanAndRescales) {
         GTEST_SKIP() << "no " << path;
     auto trace = loadMahimahiTrace(path);
     ASSERT_TRUE(trace.ok()) << trace.error();
-    EXPECT_EQ(trace->opportunities_ms.size(), 58655u);
+    EXPECT_EQ(trace->stamps_ms.size(), 58655u);
     EXPECT_NEAR(trace->meanBps() / 1e6, 5.0, 0.1);
     TraceLink link("verizon", *trace, 100e6, 1.0, {});
     // Over the whole (rescaled) loop the goodput is the target mean.
@@ -113,10 +115,21 @@ TEST(Network, ProfilesByNameAndClearErrors) {
     EXPECT_EQ(tr->trace_path, "/x/y.down");
     EXPECT_EQ(tr->nominal_bps, 50e6);
     EXPECT_EQ(networkSpecByName("trace:/x/y.down")->nominal_bps, 100e6);
+    // "4g" is lte's other name in the link grammar; the simulator names the link lte.
+    auto four = networkSpecByName("4g");
+    ASSERT_TRUE(four.ok()) << four.error();
+    EXPECT_EQ(four->name, "lte");
+    EXPECT_EQ(four->nominal_bps, 100e6);
     for (const char* bad :
          {"wlan", "", "trace:", "trace:/a@", "trace:/a@-3", "trace:/a@x", "trace:/a@nan"}) {
         auto r = networkSpecByName(bad);
         EXPECT_FALSE(r.ok()) << bad;
+    }
+    // Valid link specs the paper simulator has no model for are refused with a message.
+    for (const char* unmodelled : {"none", "rate:50", "wifi,delay_ms=5", "lte,loss=0.01"}) {
+        auto r = networkSpecByName(unmodelled);
+        ASSERT_FALSE(r.ok()) << unmodelled;
+        EXPECT_NE(r.error().find("paper simulator models no"), std::string::npos) << r.error();
     }
     auto missing = networkSpecByName("trace:/nonexistent.down");
     ASSERT_TRUE(missing.ok());

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 
 #include "qvr/foveation/layer_plan.h"
@@ -689,11 +690,55 @@ TEST(RuntimeModel, SwAndQvrPayTheRingCountsEveryFrame) {
     }
 }
 
+// The model reads `qvr run --net` with the link grammar: rates and traces as the emulator runs
+// them, delay_ms used, the other options accepted and not modelled, and a message for the rest.
+TEST(RuntimeModel, LinksFromTheLinkGrammar) {
+    double delay_ms = -1.0;
+    auto lte = makeRuntimeLink("4g,delay_ms=7,loss=0.01", &delay_ms);
+    ASSERT_TRUE(lte.ok()) << lte.error();
+    EXPECT_EQ((*lte)->nominalBps(), 100e6);
+    EXPECT_EQ((*lte)->meanGoodputBps(), 100e6);  // efficiency 1: headers are the model's
+    EXPECT_EQ(delay_ms, 7.0);
+    auto rate = makeRuntimeLink("rate:42", &delay_ms);
+    ASSERT_TRUE(rate.ok()) << rate.error();
+    EXPECT_EQ((*rate)->nominalBps(), 42e6);
+    EXPECT_EQ(delay_ms, 0.0);
+    const std::string trace =
+        std::string(QVR_SOURCE_DIR) + "/../shared/data/network/TMobile-LTE-short.down";
+    if (std::ifstream(trace).good()) {
+        auto t = makeRuntimeLink("trace:" + trace + "@50", nullptr);
+        ASSERT_TRUE(t.ok()) << t.error();
+        EXPECT_EQ((*t)->nominalBps(), 50e6);
+    }
+    for (const std::string bad : {"none", "wlan", "", "lte,delay_ms=-1", "lte,foo=1", "rate:0",
+                                  "trace:/nonexistent.down", "trace:"}) {
+        auto r = makeRuntimeLink(bad, &delay_ms);
+        ASSERT_FALSE(r.ok()) << "'" << bad << "' was accepted";
+        EXPECT_FALSE(r.error().empty());
+    }
+}
+
 TEST(RuntimeModel, DesignNames) {
-    EXPECT_EQ(*runtimeDesignByName("qvr"), Design::Qvr);
-    EXPECT_EQ(*runtimeDesignByName("local"), Design::Local);
-    EXPECT_FALSE(runtimeDesignByName("dfr").ok());
-    EXPECT_FALSE(runtimeDesignByName("").ok());
+    EXPECT_EQ(parseDesign("qvr", DesignScope::Runtime)->design, Design::Qvr);
+    EXPECT_EQ(parseDesign("local", DesignScope::Runtime)->design, Design::Local);
+    EXPECT_FALSE(parseDesign("dfr", DesignScope::Runtime).ok());
+    EXPECT_FALSE(parseDesign("", DesignScope::Runtime).ok());
+}
+
+TEST(RuntimeModel, FixedEIsAFixedFoveaAtItsE1) {
+    // fixed:E runs as the runtime runs it: FFR's pipeline at e1 = E.
+    auto spec = parseDesign("fixed:12", DesignScope::Runtime);
+    ASSERT_TRUE(spec.ok()) << spec.error();
+    RuntimeSimConfig cfg;
+    cfg.design = spec->design;
+    cfg.fixed_e1_deg = spec->fixed_e1_deg;
+    cfg.costs = flatCosts(1.0, 1.0, 1.0);
+    cfg.frames = 10;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(flatTrace(10), cfg, link);
+    ASSERT_EQ(r.frames.size(), 10u);
+    for (const RuntimeFrame& f : r.frames)
+        EXPECT_DOUBLE_EQ(f.e1_deg, 12.0);
 }
 
 TEST(RuntimeModel, ASlowServerIsNotASilentOne) {

@@ -9,11 +9,6 @@
 
 namespace qvr {
 
-// The longest start-up a summary holds back (frames): a design that asks the server for layers
-// starts up until the first of them is on screen, at most this many frames. The runtime's
-// RunSummarizer and the simulator's model of it leave out the same frames.
-inline constexpr size_t kMaxStartupFrames = 4096;
-
 // A server is silent when nothing has come from it for longer than the wait limit and for
 // longer than twice its recent spacing between streams (the median of the last kGaps gaps).
 // The second condition keeps a slow server from being called silent between two of its

@@ -24,7 +24,7 @@
 #include "qvr/runtime/chrome_trace.h"
 #include "qvr/runtime/cpu_share.h"
 #include "qvr/runtime/headset_client.h"
-#include "qvr/runtime/runtime_design.h"
+#include "qvr/core/design.h"
 #include "qvr/runtime/session.h"
 
 namespace qvr::experiment {
@@ -65,7 +65,7 @@ struct DesignRun {
     runtime::HeadsetResult result;
     // The machine's speed just before and just after the design ran (calibration.h SpeedProbe).
     std::optional<SpeedSample> speed_before, speed_after;
-    runtime::RuntimeDesign design() const { return spec.design; }
+    Design design() const { return spec.design; }
     std::string label() const { return spec.label(); }
 };
 

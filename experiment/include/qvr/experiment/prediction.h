@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "qvr/experiment/design_runs.h"
-#include "qvr/sim/design.h"
+#include "qvr/core/design.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/runtime_model.h"
 #include "qvr/workload/workload.h"

@@ -8,7 +8,7 @@
 #include "qvr/experiment/run_plan.h"
 #include "qvr/experiment/run_report.h"
 #include "qvr/foveation/hmd_profile.h"
-#include "qvr/runtime/runtime_design.h"
+#include "qvr/core/design.h"
 
 namespace qvr::experiment {
 

@@ -2,7 +2,7 @@
 // Mahimahi traces), since the kernel's netem is unavailable: a drop-tail bottleneck queue served
 // at a rate or by trace opportunities, then a delay line with jitter, with random loss before
 // the queue. Pure in time: every call takes now_ns, so a fake clock makes it deterministic.
-// Model and profiles: docs/NETWORK.md.
+// Configured by a link spec (qvr/core/link_spec.h). Model and profiles: docs/NETWORK.md.
 #pragma once
 
 #include <cstdint>
@@ -14,57 +14,9 @@
 #include <vector>
 
 #include "qvr/core/expected.h"
-#include "qvr/net/mahimahi.h"
+#include "qvr/core/link_spec.h"
 
 namespace qvr::net {
-
-struct LinkConfig {
-    std::string name = "none";
-    double rate_bps = 0.0;                       // 0: no rate limit (and no trace)
-    std::shared_ptr<const MahimahiTrace> trace;  // replaces rate_bps when set
-    double trace_target_bps = 0.0;               // rescale the trace to this mean; 0: as recorded
-    double delay_ms = 0.0;                       // one way, after the queue
-    double jitter_ms = 0.0;                      // uniform in [-jitter, +jitter], order kept
-    double loss = 0.0;                           // per-packet drop probability before the queue
-    int64_t queue_bytes = 4 << 20;               // drop-tail bottleneck buffer
-    int64_t max_in_flight_bytes = 64 << 20;      // the delay line (rate × delay) is bounded too
-    uint64_t seed = 1;
-    // Faults (issue 12's matrix), each off at 0; each draws from a seeded stream of its own, so
-    // turning one on does not change which packets random loss, jitter or another fault pick.
-    // Gilbert-Elliott burst loss: per packet Good→Bad with ge_p, Bad→Good with ge_r; a packet
-    // sent in Bad is lost with ge_loss_bad (1: all). Long-run loss ge_loss_bad · ge_p /
-    // (ge_p + ge_r), mean Bad run 1 / ge_r packets. The chain steps on every packet sent,
-    // whether random loss took it or not: the two losses are independent.
-    double ge_p = 0.0;
-    double ge_r = 0.0;
-    double ge_loss_bad = 1.0;
-    // With probability `reorder` a packet is held reorder_ms longer, outside the order-keeping
-    // delay line: packets sent after it overtake it.
-    double reorder = 0.0;
-    double reorder_ms = 5.0;
-    double duplicate = 0.0;  // a packet is delivered twice (the copy right after it)
-    // Delay spikes (a Wi-Fi stall): packets sent during the last spike_len_ms of every
-    // spike_every_ms (from the link's first packet) wait spike_extra_ms more, order kept.
-    double spike_every_ms = 0.0;
-    double spike_len_ms = 0.0;
-    double spike_extra_ms = 0.0;
-    bool faulty() const {
-        return ge_p > 0.0 || reorder > 0.0 || duplicate > 0.0 || spike_every_ms > 0.0;
-    }
-    bool shaped() const {
-        return rate_bps > 0.0 || trace != nullptr || delay_ms > 0.0 || jitter_ms > 0.0 ||
-               loss > 0.0 || faulty();
-    }
-};
-
-// "none", "wifi" (200 Mbit/s), "lte" (100), "5g" (500) — paper Table 2 — "rate:MBPS", or
-// "trace:PATH[@MBPS]" (a Mahimahi file, rescaled to MBPS when given), followed by options
-// ",delay_ms=D", ",jitter_ms=J", ",loss=P" (0 ≤ P < 1), ",queue_kb=Q", ",seed=S", and the
-// faults ",ge=P:R[:LOSS_BAD]" (Gilbert-Elliott), ",reorder=P[:MS]", ",dup=P",
-// ",spike=EVERY:LEN:EXTRA" (ms).
-// A trace starts (its time 0) with the first packet sent through the link.
-Expected<LinkConfig> parseLinkSpec(const std::string& spec);
-const std::vector<std::string>& linkProfileNames();
 
 struct LinkStats {
     uint64_t packets_in = 0;
@@ -95,13 +47,13 @@ public:
 
 class LinkEmulator final : public PacketLink {
 public:
-    explicit LinkEmulator(LinkConfig config);
+    explicit LinkEmulator(LinkSpec config);  // config.trace loaded (loadLinkSpec) when a trace
     bool send(std::vector<uint8_t> packet, int64_t now_ns) override;
     void deliver(int64_t now_ns, std::vector<std::vector<uint8_t>>& out) override;
     std::optional<int64_t> nextDeliveryNs() const override;
     int64_t queuedBytes(int64_t now_ns) override;
     LinkStats stats() const override { return m_stats; }
-    const LinkConfig& config() const { return m_config; }
+    const LinkSpec& config() const { return m_config; }
     // Trace mode: how much one trace millisecond lasts, in ns (1e6 · mean / target).
     double traceNsPerMs() const { return m_trace_ns_per_ms; }
 
@@ -123,7 +75,7 @@ private:
         double departure_ns;
         int64_t bytes;
     };
-    LinkConfig m_config;
+    LinkSpec m_config;
     std::mt19937_64 m_loss_rng;
     std::mt19937_64 m_jitter_rng;
     std::mt19937_64 m_ge_rng;

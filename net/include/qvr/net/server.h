@@ -42,7 +42,7 @@ struct ServerOptions {
     int route_probe_attempts = 4;
     size_t max_control_queue = 256;           // outgoing control messages per client
     int64_t max_media_queue_bytes = 8 << 20;  // accepted by sendStream, not yet in the link
-    LinkConfig link;                          // each client gets its own emulator with this
+    LinkSpec link;                            // each client gets its own emulator with this
     double throughput_alpha = 0.25;
     // Sent datagrams kept per client and stream for NACKed retransmission (~1.2 MB a stream).
     int retransmit_history_packets = 1024;

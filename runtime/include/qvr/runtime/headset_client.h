@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "qvr/codec/video_codec.h"
+#include "qvr/core/design.h"
 #include "qvr/core/expected.h"
 #include "qvr/core/image.h"
 #include "qvr/foveation/layer_plan.h"
@@ -24,7 +25,6 @@
 #include "qvr/net/client.h"
 #include "qvr/runtime/pacing.h"
 #include "qvr/runtime/render_server.h"
-#include "qvr/runtime/runtime_design.h"
 #include "qvr/runtime/telemetry.h"
 #include "qvr/scene/scene.h"
 #include "qvr/scene/triangle_bvh.h"
@@ -48,7 +48,7 @@ struct HeadsetTraces {
 };
 
 struct HeadsetConfig {
-    RuntimeDesign design = RuntimeDesign::kQvr;
+    Design design = Design::Qvr;
     HmdProfile profile;
     CodecConfig codec;  // the decoders' backend must match the server's encoders
     RendererFactory renderer = glRendererFactory();
@@ -62,7 +62,7 @@ struct HeadsetConfig {
     double remote_timeout_ms = 250.0;
     int connect_timeout_ms = 500;
     int reconnect_interval_ms = 250;
-    double fixed_e1_deg = kFfrE1Deg;  // kFfr and kFixed
+    double fixed_e1_deg = kFfrE1Deg;  // Design::Ffr and Design::Fixed
     // Frames in flight (docs/RUNTIME.md): 1 runs each frame to its scan-out before the next
     // frame's pose is sampled; 2 samples frame n+1 and sends its request before frame n's fovea
     // renders, so the server renders n+1 while the headset finishes n (paper Fig. 4's overlap

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "qvr/core/expected.h"
+#include "qvr/core/mahimahi.h"
 
 namespace qvr {
 
@@ -76,27 +77,13 @@ private:
     std::normal_distribution<double> m_normal{0.0, 1.0};
 };
 
-// A Mahimahi capacity trace: one integer a line, the millisecond at which one 1500-byte packet
-// may leave; repeated stamps are several packets in that millisecond; the trace loops.
-struct MahimahiTrace {
-    std::vector<double> opportunities_ms;  // non-decreasing
-    double period_ms = 0.0;                // the last stamp: the loop length
-    double meanBps() const;
-};
-inline constexpr double kMahimahiPacketBytes = 1500.0;
-inline constexpr int64_t kMaxMahimahiLines = 50'000'000;
-
-// Grammar (untrusted): lines of decimal digits (optional surrounding spaces, optional CR),
-// values ≤ 1e9 and non-decreasing; empty lines skipped; at least one line, last stamp > 0.
-Expected<MahimahiTrace> parseMahimahiTrace(std::string_view text, const std::string& source);
-Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path);
-
-// Replays a trace rescaled to a target mean capacity: every stamp divided by
-// target_mean / trace_mean. A payload of B bytes occupies ceil(B / (η·1500)) opportunities.
+// Replays a Mahimahi trace (qvr/core/mahimahi.h) rescaled to a target mean capacity: every stamp
+// divided by target_mean / trace_mean. A payload of B bytes occupies ceil(B / (η·1500))
+// opportunities.
 class TraceLink final : public Link {
 public:
-    TraceLink(std::string name, MahimahiTrace trace, double target_mean_bps, double efficiency,
-              RadioPower radio);
+    TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
+              double efficiency, RadioPower radio);
     std::string_view name() const override { return m_name; }
     double meanGoodputBps() const override { return m_target_mean_bps * m_efficiency; }
     double nominalBps() const override { return m_target_mean_bps; }
@@ -106,15 +93,18 @@ public:
 
 private:
     std::string m_name;
-    MahimahiTrace m_trace;  // rescaled stamps
+    std::vector<double> m_opportunities_ms;  // the rescaled stamps, non-decreasing
+    double m_period_ms = 0.0;                // the rescaled loop length
     double m_target_mean_bps;
     double m_efficiency;
     double m_time_scale;
     RadioPower m_radio;
 };
 
-// Network profiles by name: "wifi", "lte", "5g", or "trace:PATH[@MBPS]" (a Mahimahi file
-// rescaled to MBPS, by default the LTE profile's 100 Mbps; cellular radio power).
+// The paper simulator's links, named in the link grammar (qvr/core/link_spec.h): "wifi", "lte" or
+// "4g", "5g", or "trace:PATH[@MBPS]" (a Mahimahi file rescaled to MBPS, by default the LTE
+// profile's 100 Mbps; cellular radio power). It models no "none", "rate:MBPS" or ",key=value"
+// options (they have no radio or noise here) and refuses them with a message.
 struct NetworkSpec {
     std::string name;
     double nominal_bps = 0.0;

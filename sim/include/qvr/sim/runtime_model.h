@@ -14,8 +14,9 @@
 #include <vector>
 
 #include "qvr/core/canvas_policy.h"
+#include "qvr/core/design.h"
+#include "qvr/core/run_summary.h"
 #include "qvr/foveation/layer_plan.h"
-#include "qvr/sim/design.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/network.h"
 #include "qvr/workload/workload.h"
@@ -24,8 +25,8 @@ namespace qvr {
 
 // The runtime model's settings: which pipeline `qvr sim` uses and the runtime's knobs.
 struct RuntimeSimConfig {
-    Design design = Design::Qvr;  // local, remote, ffr (fixed e1), sw, qvr/dfr (LIWC)
-    double fixed_e1_deg = 5.0;    // ffr's e1
+    Design design = Design::Qvr;  // local, remote, ffr and fixed (fixed e1), sw, qvr/dfr (LIWC)
+    double fixed_e1_deg = 5.0;    // the e1 of ffr and fixed
     RuntimeCosts costs;
     int pipeline_depth = 2;        // frames in flight (1 or 2); local always runs 1
     int server_queue = 2;          // the server's request queue; the newest request wins
@@ -92,19 +93,11 @@ struct RuntimeFrame {
     int key_frames = 0;
 };
 
-struct RuntimeSummary {
-    std::string design;
-    int frames = 0;
-    int frames_reused = 0;
+// The run's statistics as the runtime's telemetry computes them (FrameSummarizer, the same
+// start-up left out), and what only the model knows.
+struct RuntimeSummary : RunStats {
+    std::string design;  // its label: "qvr", "ffr", "fixed:10"
     int requests_dropped = 0;
-    double fps_mean = 0.0;  // scan-outs per second between the first and the last
-    double mtp_ms_mean = 0.0;
-    double mtp_ms_p99 = 0.0;
-    double bytes_per_frame_mean = 0.0;
-    double e1_deg_mean = 0.0;
-    double t_local_ms_mean = 0.0;
-    double t_remote_ms_mean = 0.0;  // frames that requested remote layers
-    double headset_busy_ms_mean = 0.0;
     double server_busy_ms_mean = 0.0;  // render + encode per served frame
 };
 
@@ -152,6 +145,14 @@ struct BusySpan {
 // otherwise.
 double coRunEnd(double start, double work, const std::vector<BusySpan>& other, double slowdown);
 
+// What the runtime's summary reads of a modelled frame; first_layers_ms is when the run's first
+// remote layers were decoded (the start-up ends when they are on screen).
+FrameSample runtimeFrameSample(const RuntimeFrame& f, double first_layers_ms);
+// The summary of a replay's frames, config.warmup_frames and the start-up left out as the
+// runtime's RunSummarizer leaves them (requests_dropped and server_busy_ms_mean are the replay's).
+RuntimeSummary summarizeRuntimeFrames(const std::vector<RuntimeFrame>& frames,
+                                      const RuntimeSimConfig& config);
+
 // Replays `trace` through the runtime's pipeline on `link` (a constant rate or a trace; the
 // caller gives it the link emulator's rate and no noise, efficiency 1: the payload share of a
 // packet is applied here). Deterministic. With a co-running slowdown over 1 on either side
@@ -163,11 +164,12 @@ double coRunEnd(double start, double work, const std::vector<BusySpan>& other, d
 RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
                                  Link& link);
 
-// The link net's emulator (net/link_emulator.h) makes of a `qvr run --net` spec, for this model:
-// "wifi" (200 Mbit/s), "lte" (100), "5g" (500), "rate:MBPS", "trace:PATH[@MBPS]" (a Mahimahi
-// trace at its recorded mean unless MBPS is given), each with optional ",key=value" options of
-// which delay_ms is used (one way; *delay_ms) and the rest (loss, jitter, queue) are not
-// modelled. No noise: the emulator has none; packet headers are charged by the model.
+// The link net's emulator (net/link_emulator.h) makes of a `qvr run --net` spec (the link grammar,
+// qvr/core/link_spec.h), for this model: a named profile or "rate:MBPS" at its rate, or
+// "trace:PATH[@MBPS]" (a Mahimahi trace at its recorded mean unless MBPS is given); of the
+// ",key=value" options delay_ms is used (one way; *delay_ms) and the rest (loss, jitter, queue,
+// faults) are not modelled; "none" (no rate) is refused. No noise: the emulator has none; packet
+// headers are charged by the model.
 Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double* delay_ms);
 
 // The triangle feature of one server layer: the BVH's triangles in the layer's cone (both eyes)
@@ -175,8 +177,5 @@ Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double*
 // the layer's own pixels, a layer s times coarser draws about s² times fewer of a dense scene's
 // triangles. `qvr calibrate` fits server_render on it, the model charges it.
 double serverLayerTriangles(double cone_triangles_both_eyes, double scale);
-
-// The runtime design names (`qvr run --designs`) on the simulator's designs.
-Expected<Design> runtimeDesignByName(const std::string& name);
 
 }  // namespace qvr

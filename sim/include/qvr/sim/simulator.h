@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "qvr/controller/policy.h"
-#include "qvr/sim/design.h"
+#include "qvr/core/design.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/network.h"
 #include "qvr/workload/workload.h"
@@ -79,7 +79,7 @@ struct RunSummary {
     std::string net;
     int frames = 0;
     double mtp_ms_mean = 0.0;
-    double mtp_ms_p99 = 0.0;
+    double mtp_ms_p99 = 0.0;    // nearest rank (qvr/core/run_summary.h percentile)
     double fps_mean = 0.0;      // 1000 / mean(max(T_GPU, T_network))
     double fps_pipeline = 0.0;  // frames displayed per second in the event timeline
     double bytes_per_frame_mean = 0.0;
@@ -88,7 +88,7 @@ struct RunSummary {
     FrameEnergy energy_mean;
     double e1_deg_mean = 0.0;
     double e1_deg_steady = 0.0;        // mean over frames after the warm-up
-    double latency_ratio_final = 0.0;  // median over the last 30 frames
+    double latency_ratio_final = 0.0;  // median (nearest rank) over the last 30 frames
     double t_local_ms_mean = 0.0;
     double t_remote_ms_mean = 0.0;
     double render_wait_ms_mean = 0.0;  // T_local − render work: time behind/preempted by passes

@@ -1,5 +1,7 @@
 // Mahimahi capacity traces (../shared/data/network/README.md): one millisecond stamp a line, each
-// an opportunity for one 1500-byte packet; the trace repeats when it ends. Files are untrusted.
+// an opportunity for one 1500-byte packet; the trace repeats when it ends. Files are untrusted:
+// this is the one reader of them (fuzz/mahimahi_fuzz.cpp), for net's link emulator and the
+// simulator's trace links alike.
 #pragma once
 
 #include <cstdint>
@@ -9,7 +11,7 @@
 
 #include "qvr/core/expected.h"
 
-namespace qvr::net {
+namespace qvr {
 
 inline constexpr int64_t kMahimahiPacketBytes = 1500;
 inline constexpr int64_t kMaxMahimahiLines = 20'000'000;
@@ -32,4 +34,4 @@ Expected<MahimahiTrace> parseMahimahiTrace(std::string_view text, const std::str
 // Refuses files over kMaxMahimahiFileBytes before reading them.
 Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path);
 
-}  // namespace qvr::net
+}  // namespace qvr

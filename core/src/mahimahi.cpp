@@ -1,11 +1,11 @@
 // Mahimahi trace reader: a strict line grammar, checked before anything is stored.
-#include "qvr/net/mahimahi.h"
+#include "qvr/core/mahimahi.h"
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
-namespace qvr::net {
+namespace qvr {
 
 double MahimahiTrace::meanBps() const {
     if (period_ms <= 0) {
@@ -41,8 +41,10 @@ Expected<MahimahiTrace> parseMahimahiTrace(std::string_view text, const std::str
         int64_t value = 0;
         for (char c : line) {
             if (c < '0' || c > '9') {
-                return makeError(where + "expected a millisecond timestamp (digits only), got '" +
-                                 std::string(line) + "'");
+                return makeError(
+                    where +
+                    "expected a non-negative integer millisecond timestamp (digits only), got '" +
+                    std::string(line) + "'");
             }
             value = value * 10 + (c - '0');
         }
@@ -75,7 +77,7 @@ Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path) {
     std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     if (ec) {
-        return makeError(path + ": cannot read Mahimahi trace: " + ec.message());
+        return makeError(path + ": cannot open Mahimahi trace: " + ec.message());
     }
     if (size > static_cast<uintmax_t>(kMaxMahimahiFileBytes)) {
         return makeError(path + ": Mahimahi trace of " + std::to_string(size) +
@@ -90,4 +92,4 @@ Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path) {
     return parseMahimahiTrace(text.str(), path);
 }
 
-}  // namespace qvr::net
+}  // namespace qvr
