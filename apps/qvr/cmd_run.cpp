@@ -13,11 +13,11 @@
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/video_codec.h"
+#include "qvr/core/design.h"
 #include "qvr/experiment/run_experiment.h"
 #include "qvr/experiment/run_plan.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/cpu_share.h"
-#include "qvr/core/design.h"
 #include "qvr/runtime/session.h"
 
 namespace qvr::cli {

@@ -106,7 +106,7 @@ int runExitStatus(const RunOutcome& o, const std::string& out) {
     return 0;
 }
 
-int runExperiment(const RunOptions& plan, const std::vector<runtime::DesignSpec>& designs,
+int runExperiment(const RunOptions& plan, const std::vector<DesignSpec>& designs,
                   const HmdProfile& profile) {
     const auto t_start = std::chrono::steady_clock::now();
     auto inputs = runtime::loadHeadsetInputs(plan.scene, plan.motion, plan.gaze, profile.refresh_hz,

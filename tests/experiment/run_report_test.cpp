@@ -11,8 +11,6 @@
 namespace qvr::experiment {
 namespace {
 
-using Design;
-
 std::set<std::string> keysOf(const nlohmann::json& j) {
     std::set<std::string> keys;
     for (auto it = j.begin(); it != j.end(); ++it)
@@ -139,12 +137,10 @@ TEST(DesignJson, AnUnpredictedDesignHasNullsAndNoPrediction) {
 }
 
 TEST(BestFixed, TheFastestFixedDesignAndTheAdaptiveOnesOverIt) {
-    const std::vector<DesignResult> designs = {design(Design::Local, 0.0, 90.0, 0.0),
-                                               design(Design::Ffr, 5.0, 40.0, 0.0),
-                                               design(Design::Fixed, 10.0, 50.0, 0.0),
-                                               design(Design::Fixed, 20.0, 45.0, 0.0),
-                                               design(Design::Qvr, 0.0, 60.0, 0.0),
-                                               design(Design::Sw, 0.0, 25.0, 0.0)};
+    const std::vector<DesignResult> designs = {
+        design(Design::Local, 0.0, 90.0, 0.0),  design(Design::Ffr, 5.0, 40.0, 0.0),
+        design(Design::Fixed, 10.0, 50.0, 0.0), design(Design::Fixed, 20.0, 45.0, 0.0),
+        design(Design::Qvr, 0.0, 60.0, 0.0),    design(Design::Sw, 0.0, 25.0, 0.0)};
     const auto bf = bestFixed(designs);
     ASSERT_TRUE(bf);
     EXPECT_EQ(bf->design, "fixed:10");

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qvr/codec/mp4_writer.h"
+#include "qvr/core/design.h"
 #include "qvr/experiment/calibration.h"
 #include "qvr/experiment/run_plan.h"
 #include "qvr/experiment/scanout_recorder.h"
@@ -24,7 +25,6 @@
 #include "qvr/runtime/chrome_trace.h"
 #include "qvr/runtime/cpu_share.h"
 #include "qvr/runtime/headset_client.h"
-#include "qvr/core/design.h"
 #include "qvr/runtime/session.h"
 
 namespace qvr::experiment {
@@ -61,7 +61,7 @@ Expected<DesignQuality> measureDesignQuality(const std::vector<QualitySample>& s
                                              Renderer& renderer);
 
 struct DesignRun {
-    runtime::DesignSpec spec;
+    DesignSpec spec;
     runtime::HeadsetResult result;
     // The machine's speed just before and just after the design ran (calibration.h SpeedProbe).
     std::optional<SpeedSample> speed_before, speed_after;
@@ -112,10 +112,11 @@ struct RunError {
 // Runs every design of `designs` in turn, writing telemetry.csv, frames_<design>.csv,
 // workload.jsonl, server_*.csv, server_stats.json and trace.json into plan.out as it goes.
 // SIGINT or SIGTERM ends the current design at its next frame boundary and starts no other.
-std::variant<RunMeasurement, RunError> measureDesigns(
-    const RunOptions& plan, const std::vector<runtime::DesignSpec>& designs,
-    const HmdProfile& profile, const runtime::HeadsetInputs& inputs,
-    const RuntimeCosts& calibrated);
+std::variant<RunMeasurement, RunError> measureDesigns(const RunOptions& plan,
+                                                      const std::vector<DesignSpec>& designs,
+                                                      const HmdProfile& profile,
+                                                      const runtime::HeadsetInputs& inputs,
+                                                      const RuntimeCosts& calibrated);
 
 // The qvr design's display as qvr_display.mp4 and a still, and the MP4 read back through
 // libavformat as a player sees it.

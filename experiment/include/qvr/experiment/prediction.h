@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "qvr/experiment/design_runs.h"
 #include "qvr/core/design.h"
+#include "qvr/experiment/design_runs.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/runtime_model.h"
 #include "qvr/workload/workload.h"

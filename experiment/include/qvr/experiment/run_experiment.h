@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
+#include "qvr/core/design.h"
 #include "qvr/experiment/run_plan.h"
 #include "qvr/experiment/run_report.h"
 #include "qvr/foveation/hmd_profile.h"
-#include "qvr/core/design.h"
 
 namespace qvr::experiment {
 
@@ -21,7 +21,7 @@ int runExitStatus(const RunOutcome& outcome, const std::string& out);
 
 // Runs `designs` as the plan says, once its options are checked. Returns the exit status (2 for
 // bad input found on the way: the traces, the calibration file, --headset-share).
-int runExperiment(const RunOptions& plan, const std::vector<runtime::DesignSpec>& designs,
+int runExperiment(const RunOptions& plan, const std::vector<DesignSpec>& designs,
                   const HmdProfile& profile);
 
 }  // namespace qvr::experiment

@@ -32,7 +32,7 @@ std::optional<DesignLimits> designLimits(const std::vector<runtime::FrameTelemet
 
 // One design's run: what it measured, what was predicted, the errors, its quality, its counters.
 struct DesignResult {
-    runtime::DesignSpec spec;
+    DesignSpec spec;
     std::string name;  // the label: "qvr", "fixed:10"
     runtime::DesignSummary summary;
     runtime::HeadsetStats stats;  // the headset's transport and security counters
