@@ -75,16 +75,19 @@ TEST(Evaluation, WritesEveryExperimentAndASummaryOfEveryRun) {
                     r["energy_mj_per_frame"].get<double>(), 1e-9);
         EXPECT_LE(r["radio_w_max"].get<double>(), 3.0);
     }
-    // The fitted variant recovers the 41% it was fitted to (within the fit's 0.5 points).
+    // The slope is fitted over the whole suite (41% there, within the fit's 0.5 points); on
+    // two of its benches the fitted variant shades more than the faithful model, not all.
     bool found = false;
     for (const Headline& h : result->headlines) {
         if (h.metric.find("shaded-pixel") == std::string::npos)
             continue;
         found = true;
-        EXPECT_NEAR(h.fitted, 41.0, 0.5);
+        EXPECT_LT(h.fitted, h.ours);
+        EXPECT_GT(h.fitted, 0.0);
     }
     EXPECT_TRUE(found);
-    EXPECT_GT(result->fitted_slope, 0.0);
+    EXPECT_GT(result->fitted_slope, 1e-4);
+    EXPECT_LT(result->fitted_slope, 0.0275);
     // Fig. 14 always covers 300 frames, whatever --frames says.
     std::stringstream fig14(slurp(out / "fig14_latency_ratio.csv"));
     int lines = 0;
