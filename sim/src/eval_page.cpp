@@ -306,7 +306,7 @@ void figuresSection(const ReportInputs& in, HtmlReport& page, const Outputs& out
     figure("Fig. 13: transmitted data and shaded resolution, normalised to remote", "fig13.png",
            "<a href='fig13_data_resolution.csv'>fig13_data_resolution.csv</a>");
     page.table(Table::fromCsv(in.fig13));
-    figure("Fig. 14: latency ratio and FPS over 300 frames from e1 = 5&deg;", "fig14.png",
+    figure("Fig. 14: latency ratio and FPS over 300 frames from e1 = 5°", "fig14.png",
            "<a href='fig14_latency_ratio.csv'>fig14_latency_ratio.csv</a>, "
            "<a href='fig14_fps.csv'>fig14_fps.csv</a>, <a href='fig14_e1.csv'>fig14_e1.csv</a> "
            "(every frame's e1, T_local, T_remote, raw and smoothed ratio, and the oracle's on the "
