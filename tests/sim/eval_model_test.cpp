@@ -81,6 +81,29 @@ TEST(DisplayPath, DramTrafficAtTable2sBandwidth) {
     EXPECT_DOUBLE_EQ(ucaDramBytes(0.6 * px, px), 1.6 * px * 4.0);
 }
 
+TEST(DisplayPath, EachFramesTrafficIsItsPassesOrItsUcaPass) {
+    auto trace = makeSuiteBench("doom3-l", 20);
+    ASSERT_TRUE(trace.ok());
+    const double frame_px =
+        2.0 * trace->header.profile.width_px * static_cast<double>(trace->header.profile.height_px);
+    for (Design d : {Design::Local, Design::Dfr, Design::Qvr}) {
+        NoisyLink link("quiet", 200e6, calibratedLinkEfficiency(),
+                       std::numeric_limits<double>::infinity(), RadioPower{}, 1);
+        SimConfig cfg;
+        cfg.design = d;
+        cfg.frames = 20;
+        const RunResult run = simulate(*trace, cfg, link);
+        for (const FrameRecord& r : run.frames) {
+            const double expected = d == Design::Qvr ? ucaDramBytes(r.shaded_pixels, frame_px)
+                                    : d == Design::Dfr
+                                        ? gpuPassDramBytes(frame_px, 1.0) * 2.0  // C + ATW
+                                        : gpuPassDramBytes(frame_px, 1.0);       // ATW
+            EXPECT_NEAR(r.display_dram_bytes, expected, 1e-6) << traitsOf(d).name;
+            EXPECT_NEAR(r.display_dram_ms, dramMs(expected), 1e-9);
+        }
+    }
+}
+
 TEST(DisplayPath, UcaReadsFiveHundredThirtyTwoCyclesAsEachUnitsOccupancyPerTile) {
     const UcaConfig uca = defaultHardware(500.0).uca;
     // A 1920×2160 eye is 60 × 68 tiles of 32×32; two eyes; one tile at a time per unit.
