@@ -52,13 +52,24 @@ NoisyLink::NoisyLink(std::string name, double nominal_bps, double efficiency, do
 }
 
 LinkTransfer NoisyLink::transfer(double /*start_ms*/, double payload_bytes) {
+    // The noise is per sample (§5: white noise in the channel); a frame's goodput averages it over
+    // the frame's packets, so its spread is σ/√packets. One N(0,1) draw scaled so is that mean
+    // exactly in distribution.
     double factor = 1.0;
     if (m_sigma > 0.0)
-        factor = std::max(0.05, 1.0 + m_sigma * m_normal(m_rng));
+        factor = std::max(0.05, 1.0 + noiseSigmaOver(payload_bytes) * m_normal(m_rng));
     const double goodput_bps = meanGoodputBps() * factor;
     if (payload_bytes <= 0.0)
         return {0.0, goodput_bps};
     return {payload_bytes * 8.0 / goodput_bps * 1e3, goodput_bps};
+}
+
+double NoisyLink::packetsOf(double payload_bytes) const {
+    return std::max(1.0, std::ceil(payload_bytes / (m_efficiency * kMahimahiPacketBytes)));
+}
+
+double NoisyLink::noiseSigmaOver(double payload_bytes) const {
+    return m_sigma / std::sqrt(packetsOf(payload_bytes));
 }
 
 TraceLink::TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,

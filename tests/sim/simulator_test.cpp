@@ -196,8 +196,15 @@ TEST(Simulator, EnergyIsTheSumOfItsParts) {
             const double period = std::max(r.gpu_ms, r.net_ms);
             EXPECT_NEAR(r.energy.gpu_dynamic_mj, gpu.dynamicPowerW() * r.gpu_ms, 1e-9);
             EXPECT_NEAR(r.energy.gpu_static_mj, gpu.staticPowerW() * period, 1e-9);
-            EXPECT_NEAR(r.energy.radio_mj,
-                        r.bytes * 8.0 * radio.energyPerBitNj(r.goodput_bps) * 1e-6, 1e-9);
+            // The radio draws α·min(R, 20 Mbit/s) + β while the payload arrives.
+            const double radio_w =
+                r.bytes > 0.0 ? (radio.alpha_mw_per_mbps * std::min(r.goodput_bps, 20e6) * 1e-6 +
+                                 radio.beta_mw) *
+                                    1e-3
+                              : 0.0;
+            EXPECT_NEAR(r.energy.radio_mj, radio_w * r.net_ms, 1e-9);
+            EXPECT_NEAR(r.energy.gpuMj(), r.energy.gpu_dynamic_mj + r.energy.gpu_static_mj, 1e-12);
+            EXPECT_NEAR(r.energy.otherMj(), r.energy.uca_mj + r.energy.liwc_mj, 1e-12);
             const bool liwc = d == Design::Dfr || d == Design::Qvr;
             EXPECT_NEAR(r.energy.liwc_mj, liwc ? 0.025 * period : 0.0, 1e-12);
             EXPECT_NEAR(r.energy.uca_mj, d == Design::Qvr ? 0.094 * r.uca_ms * 2.0 : 0.0, 1e-9);

@@ -53,9 +53,10 @@ public:
     virtual const RadioPower& radio() const = 0;
 };
 
-// Constant capacity C with white noise: each transfer sees goodput η·C·(1 + σ·n), n ~ N(0,1),
-// σ = 10^(−SNR/20) (noise amplitude relative to the signal for the given power ratio), floored
-// at 5% of the mean so a deep fade stalls rather than reverses. snr_db = +inf turns it off.
+// Constant capacity C with white noise per sample, σ = 10^(−SNR/20) (noise amplitude relative to
+// the signal for the given power ratio). A transfer of P packets (payload / (η·1500 bytes))
+// sees the noise averaged over them: goodput η·C·(1 + σ/√P · n), n ~ N(0,1), floored at 5% of
+// the mean so a deep fade stalls rather than reverses. snr_db = +inf turns it off.
 class NoisyLink final : public Link {
 public:
     NoisyLink(std::string name, double nominal_bps, double efficiency, double snr_db,
@@ -65,7 +66,10 @@ public:
     double nominalBps() const override { return m_nominal_bps; }
     LinkTransfer transfer(double start_ms, double payload_bytes) override;
     const RadioPower& radio() const override { return m_radio; }
-    double noiseSigma() const { return m_sigma; }
+    double noiseSigma() const { return m_sigma; }  // per sample
+    double packetsOf(double payload_bytes) const;  // ≥ 1
+    // The relative spread of a transfer's goodput: σ/√packets.
+    double noiseSigmaOver(double payload_bytes) const;
 
 private:
     std::string m_name;

@@ -11,6 +11,7 @@
 
 #include "qvr/controller/policy.h"
 #include "qvr/core/design.h"
+#include "qvr/sim/energy.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/network.h"
 #include "qvr/workload/workload.h"
@@ -27,16 +28,12 @@ struct SimConfig {
     // waiting behind a composition/ATW pass does not; the default) or from submission (waits
     // count). docs/MODEL.md §6 shows what it changes.
     bool t_local_from_submission = false;
-};
-
-// Energy of one frame (Fig. 15), millijoules; total() is their sum and nothing else.
-struct FrameEnergy {
-    double gpu_dynamic_mj = 0.0;  // dynamic power × GPU busy time
-    double gpu_static_mj = 0.0;   // leakage × frame period
-    double radio_mj = 0.0;        // received bits × energy per bit at the measured goodput
-    double uca_mj = 0.0;          // 94 mW × unit-busy time
-    double liwc_mj = 0.0;         // 25 mW × frame period
-    double total() const { return gpu_dynamic_mj + gpu_static_mj + radio_mj + uca_mj + liwc_mj; }
+    // Frames start at most once per refresh period and each is shown at the first vsync after
+    // its display path ends (MTP runs to that vsync); off: shown when ready.
+    bool vsync_paced = false;
+    // The oracle policy (knows each frame's true cost curve) picks e1 instead of the design's
+    // own: the floor a foveated design's balance is checked against (Fig. 14).
+    bool oracle_policy = false;
 };
 
 struct FrameRecord {
@@ -50,6 +47,7 @@ struct FrameRecord {
     double render_end_ms = 0.0;
     double remote_ready_ms = 0.0;
     double display_ready_ms = 0.0;  // composition + ATW done
+    double shown_ms = 0.0;          // on the display: display_ready_ms, or its vsync when paced
     // Durations.
     double render_work_ms = 0.0;  // local render at the GPU's rate, no interruptions
     double t_local_ms = 0.0;      // submission → render end: waits and preemptions included
@@ -58,10 +56,13 @@ struct FrameRecord {
     double server_render_ms = 0.0;
     double encode_ms = 0.0;
     double decode_ms = 0.0;
-    double comp_ms = 0.0;  // on the GPU
-    double atw_ms = 0.0;   // on the GPU
-    double uca_ms = 0.0;   // UCA wall time (both units)
-    double gpu_ms = 0.0;   // T_GPU: GPU busy time this frame
+    double comp_ms = 0.0;             // on the GPU
+    double atw_ms = 0.0;              // on the GPU
+    double uca_ms = 0.0;              // UCA wall time (both units)
+    double gpu_ms = 0.0;              // T_GPU: GPU busy time this frame
+    double display_dram_bytes = 0.0;  // composition + ATW (GPU passes or UCA): read + written
+    double display_dram_ms = 0.0;     // those bytes at Table 2's DRAM bandwidth
+    double radio_w = 0.0;             // radio power while this frame's payload arrives
     int preemptions = 0;
     double bytes = 0.0;
     double goodput_bps = 0.0;
@@ -95,6 +96,12 @@ struct RunSummary {
     double gpu_ms_mean = 0.0;
     double net_ms_mean = 0.0;
     double preemptions_per_frame = 0.0;
+    double comp_ms_mean = 0.0;
+    double atw_ms_mean = 0.0;
+    double uca_ms_mean = 0.0;
+    double display_dram_mb_per_frame = 0.0;
+    double display_dram_ms_mean = 0.0;
+    double radio_w_max = 0.0;    // the most the radio drew while receiving, any frame
     bool meets_refresh = false;  // fps_mean ≥ the HMD's refresh rate
 };
 
