@@ -20,7 +20,7 @@ QVR_BUILD_PACKAGES=(
 )
 # What the built `qvr` loads at run time (the container image's final stage).
 QVR_RUNTIME_PACKAGES=(
-    libfmt9 libtbb12 libhwy1 libpng16-16 libtomlplusplus3 libsodium23 libisal2 libzip4
+    libfmt9 libtbb12 libhwy1 libpng16-16 libtomlplusplus3 libsodium23 libisal2 libzip4 libstb0
     libassimp5 libavcodec59 libavformat59 libavutil57 libswscale6 libx264-164
     libegl1 libopengl0 libgl1 libegl-mesa0 libgl1-mesa-dri
 )

@@ -12,6 +12,9 @@ image=${QVR_IMAGE:-localhost/qvr-server:test}
 podman=(podman)
 # crun refuses hosts whose cgroups are in hybrid mode; runc runs there.
 if command -v runc > /dev/null; then podman+=(--runtime runc); fi
+# Containers get limits they may lower but not raise (podman's defaults are higher than some
+# sandboxes allow).
+limits=(--ulimit nofile=1024:1024 --ulimit nproc=4096:4096)
 base=${QVR_BASE_IMAGE:-}
 if [ -z "$base" ]; then
     base=localhost/qvr-debian:bookworm
@@ -52,7 +55,7 @@ mkdir -p "$tmp/key"
 head -c 32 /dev/urandom | od -An -tx1 | tr -d ' \n' > "$tmp/key/psk"
 chmod 755 "$tmp/key"
 chmod 644 "$tmp/key/psk"
-"${podman[@]}" run -d --name "$name" --network host -e AGONES_SDK_HTTP_PORT="$sdk_port" \
+"${podman[@]}" run -d --name "$name" "${limits[@]}" --network host -e AGONES_SDK_HTTP_PORT="$sdk_port" \
     -v "$tmp/key:/etc/qvr:ro" "$image" \
     --bind 127.0.0.1 --port "$qvr_port" --key-file /etc/qvr/psk --agones > /dev/null
 for _ in $(seq 1 120); do
