@@ -4,8 +4,10 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -15,6 +17,7 @@
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/video_codec.h"
+#include "qvr/net/agones_sdk.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/affinity.h"
 #include "qvr/runtime/chrome_trace.h"
@@ -51,6 +54,7 @@ struct ServerCmdOptions {
     bool one_pass_periphery = false;
     bool no_holes = false;
     float lod_px = 1.0f;
+    bool agones = false;  // report Ready / Health / Shutdown to Agones' SDK sidecar
 };
 
 using StampsFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
@@ -239,6 +243,40 @@ int writeServerOutputs(const ServerCmdOptions& o, const RenderServerStats& s,
     return 0;
 }
 
+// --agones (docs/DEPLOY.md): Health pings every kAgonesHealthPeriodMs while the server serves,
+// shorter than the fleet's health period (deploy/agones; scripts/check_agones.py checks it).
+constexpr int kAgonesHealthPeriodMs = 2000;
+
+// The SDK sidecar's address from AGONES_SDK_HTTP_PORT, checked before any work.
+Expected<net::AgonesSdkOptions> agonesOptions() {
+    auto port = net::agonesHttpPort(std::getenv("AGONES_SDK_HTTP_PORT"));
+    if (!port)
+        return makeError("--agones: " + port.error());
+    net::AgonesSdkOptions options;
+    options.port = *port;
+    return options;
+}
+
+// Serves until stopped; with the SDK, Ready first (the server takes headsets only once the
+// fleet may allocate it), Health all along, Shutdown after.
+Status serveWithLifecycle(const ServerCmdOptions& o, std::optional<net::AgonesSdk>& sdk) {
+    if (!sdk) {
+        serveUntilStopped(o.duration_s);
+        return Status::success();
+    }
+    if (Status st = sdk->ready(); !st)
+        return st;
+    fmt::print("qvr server: Agones SDK: Ready sent (port {})\n", sdk->options().port);
+    std::fflush(stdout);
+    {
+        net::AgonesHealthPinger pinger(*sdk, kAgonesHealthPeriodMs);
+        serveUntilStopped(o.duration_s);
+    }
+    if (Status st = sdk->shutdown(); !st)
+        std::fprintf(stderr, "qvr server: %s\n", st.error().c_str());
+    return Status::success();
+}
+
 int runServer(const ServerCmdOptions& o) {
     // Pin the whole process before any work: threads made from here on (asio, the render
     // thread, llvmpipe's rasterizers, x264) inherit the mask.
@@ -247,6 +285,15 @@ int runServer(const ServerCmdOptions& o) {
             std::fprintf(stderr, "qvr server: --core: %s\n", st.error().c_str());
             return 2;
         }
+    }
+    std::optional<net::AgonesSdk> sdk;
+    if (o.agones) {
+        auto options = agonesOptions();
+        if (!options) {
+            std::fprintf(stderr, "qvr server: %s\n", options.error().c_str());
+            return 2;
+        }
+        sdk.emplace(*options);
     }
     StampsFile stamps(nullptr, std::fclose);
     auto cfg = serverConfig(o, stamps);
@@ -267,7 +314,7 @@ int runServer(const ServerCmdOptions& o) {
     fmt::print("qvr server: listening on {}:{} ({}x{} per eye, link {}); Ctrl-C stops\n", o.bind,
                (*server)->port(), cfg->profile.width_px, cfg->profile.height_px, o.net);
     std::fflush(stdout);
-    serveUntilStopped(o.duration_s);
+    const Status served = serveWithLifecycle(o, sdk);
     // Stop first (the frame in flight finishes, the render thread is joined), then read: the
     // stats and the frames CSV then describe the same frames, however the server was ended.
     (*server)->stop();
@@ -278,6 +325,10 @@ int runServer(const ServerCmdOptions& o) {
     if (const int rc = writeServerOutputs(o, s, frame_records); rc != 0)
         return rc;
     printServerStats(s);
+    if (!served) {
+        std::fprintf(stderr, "qvr server: %s\n", served.error().c_str());
+        return 1;
+    }
     return 0;
 }
 
@@ -316,6 +367,9 @@ static Registered registerServer(CLI::App& app) {
                   "layer");
     cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
                   "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
+    cmd->add_flag("--agones", o->agones,
+                  "Report Ready, Health and Shutdown to Agones' SDK sidecar at "
+                  "localhost:$AGONES_SDK_HTTP_PORT (docs/DEPLOY.md)");
     cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")
         ->check(finiteRange(0.0, kMaxDurationS))
         ->capture_default_str();
