@@ -9,7 +9,7 @@
 #include <cstring>
 #include <fstream>
 
-#include "qvr/net/clock.h"
+#include "qvr/core/clock.h"
 #include "qvr/net/mahimahi.h"
 
 namespace qvr::net {
