@@ -1,6 +1,8 @@
 // MP4 display video through libavcodec (libx264) and libavformat (mp4_writer.h).
 #include "qvr/codec/mp4_writer.h"
 
+#include "ffmpeg_util.h"
+
 #include <mutex>
 
 #include <fmt/format.h>
@@ -17,23 +19,6 @@ extern "C" {
 namespace qvr {
 
 namespace {
-
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-constexpr int kAvErrorEagain = AVERROR(EAGAIN);
-constexpr int kAvErrorEof = AVERROR_EOF;
-#pragma GCC diagnostic pop
-
-std::string avError(int err) {
-    char buf[AV_ERROR_MAX_STRING_SIZE] = {};
-    av_strerror(err, buf, sizeof(buf));
-    return buf;
-}
-
-void quietLog() {
-    static std::once_flag once;
-    std::call_once(once, [] { av_log_set_level(AV_LOG_FATAL); });
-}
 
 class AvMp4Writer final : public Mp4Writer {
 public:
@@ -52,7 +37,7 @@ public:
     Status init(int fps, int crf) {
         int err = avformat_alloc_output_context2(&m_fmt, nullptr, "mp4", m_path.c_str());
         if (err < 0 || !m_fmt)
-            return makeError("mp4: no MP4 muxer in libavformat: " + avError(err));
+            return makeError("mp4: no MP4 muxer in libavformat: " + detail::avErrorText(err));
         const AVCodec* codec = avcodec_find_encoder_by_name("libx264");
         if (!codec)
             return makeError("mp4: libavcodec was built without libx264");
@@ -75,22 +60,24 @@ public:
             av_opt_set(m_enc->priv_data, "crf", std::to_string(crf).c_str(), 0) < 0)
             return makeError("mp4: libx264 rejected an option");
         if ((err = avcodec_open2(m_enc, codec, nullptr)) < 0)
-            return makeError(fmt::format("mp4: open x264 at {}x{}: {}", m_w, m_h, avError(err)));
+            return makeError(
+                fmt::format("mp4: open x264 at {}x{}: {}", m_w, m_h, detail::avErrorText(err)));
         m_stream = avformat_new_stream(m_fmt, nullptr);
         if (!m_stream)
             return makeError("mp4: out of memory");
         m_stream->time_base = m_enc->time_base;
         m_stream->avg_frame_rate = m_enc->framerate;
         if ((err = avcodec_parameters_from_context(m_stream->codecpar, m_enc)) < 0)
-            return makeError("mp4: " + avError(err));
+            return makeError("mp4: " + detail::avErrorText(err));
         if ((err = avio_open(&m_fmt->pb, m_path.c_str(), AVIO_FLAG_WRITE)) < 0)
-            return makeError(fmt::format("mp4: cannot write '{}': {}", m_path, avError(err)));
+            return makeError(
+                fmt::format("mp4: cannot write '{}': {}", m_path, detail::avErrorText(err)));
         AVDictionary* opts = nullptr;
         av_dict_set(&opts, "movflags", "+faststart", 0);
         err = avformat_write_header(m_fmt, &opts);
         av_dict_free(&opts);
         if (err < 0)
-            return makeError(fmt::format("mp4: '{}': {}", m_path, avError(err)));
+            return makeError(fmt::format("mp4: '{}': {}", m_path, detail::avErrorText(err)));
         m_frame->format = AV_PIX_FMT_YUV420P;
         m_frame->width = m_w;
         m_frame->height = m_h;
@@ -126,9 +113,11 @@ public:
             return st;
         int err = av_write_trailer(m_fmt);
         if (err < 0)
-            return makeError(fmt::format("mp4: finishing '{}': {}", m_path, avError(err)));
+            return makeError(
+                fmt::format("mp4: finishing '{}': {}", m_path, detail::avErrorText(err)));
         if ((err = avio_closep(&m_fmt->pb)) < 0)
-            return makeError(fmt::format("mp4: closing '{}': {}", m_path, avError(err)));
+            return makeError(
+                fmt::format("mp4: closing '{}': {}", m_path, detail::avErrorText(err)));
         return {};
     }
 
@@ -136,18 +125,19 @@ private:
     Status send(AVFrame* frame) {
         int err = avcodec_send_frame(m_enc, frame);
         if (err < 0)
-            return makeError("mp4: encode: " + avError(err));
+            return makeError("mp4: encode: " + detail::avErrorText(err));
         while (true) {
             err = avcodec_receive_packet(m_enc, m_pkt);
-            if (err == kAvErrorEagain || err == kAvErrorEof)
+            if (err == detail::kAvErrorEagain || err == detail::kAvErrorEof)
                 return {};
             if (err < 0)
-                return makeError("mp4: encode: " + avError(err));
+                return makeError("mp4: encode: " + detail::avErrorText(err));
             av_packet_rescale_ts(m_pkt, m_enc->time_base, m_stream->time_base);
             m_pkt->stream_index = m_stream->index;
             err = av_interleaved_write_frame(m_fmt, m_pkt);  // takes the packet's data
             if (err < 0)
-                return makeError(fmt::format("mp4: writing '{}': {}", m_path, avError(err)));
+                return makeError(
+                    fmt::format("mp4: writing '{}': {}", m_path, detail::avErrorText(err)));
         }
     }
 
@@ -175,7 +165,7 @@ Expected<std::unique_ptr<Mp4Writer>> Mp4Writer::open(const std::string& path, in
         return makeError(fmt::format("mp4: frame rate {} must be within 1..1000", fps));
     if (crf < 0 || crf > 51)
         return makeError(fmt::format("mp4: crf {} must be within 0..51", crf));
-    quietLog();
+    detail::quietFfmpegLog();
     auto w = std::make_unique<AvMp4Writer>(path, width, height);
     if (auto st = w->init(fps, crf); !st)
         return makeError(st.error());
@@ -183,17 +173,18 @@ Expected<std::unique_ptr<Mp4Writer>> Mp4Writer::open(const std::string& path, in
 }
 
 Expected<VideoFileInfo> probeVideoFile(const std::string& path) {
-    quietLog();
+    detail::quietFfmpegLog();
     AVFormatContext* fmt_ctx = nullptr;
     int err = avformat_open_input(&fmt_ctx, path.c_str(), nullptr, nullptr);
     if (err < 0)
-        return makeError(fmt::format("'{}': not a readable video file: {}", path, avError(err)));
+        return makeError(
+            fmt::format("'{}': not a readable video file: {}", path, detail::avErrorText(err)));
     struct Closer {
         AVFormatContext** c;
         ~Closer() { avformat_close_input(c); }
     } closer{&fmt_ctx};
     if ((err = avformat_find_stream_info(fmt_ctx, nullptr)) < 0)
-        return makeError(fmt::format("'{}': {}", path, avError(err)));
+        return makeError(fmt::format("'{}': {}", path, detail::avErrorText(err)));
     const int index = av_find_best_stream(fmt_ctx, AVMEDIA_TYPE_VIDEO, -1, -1, nullptr, 0);
     if (index < 0)
         return makeError(fmt::format("'{}': no video stream", path));
@@ -219,8 +210,8 @@ Expected<VideoFileInfo> probeVideoFile(const std::string& path) {
         av_packet_unref(pkt);
     }
     av_packet_free(&pkt);
-    if (err != kAvErrorEof)
-        return makeError(fmt::format("'{}': reading packets: {}", path, avError(err)));
+    if (err != detail::kAvErrorEof)
+        return makeError(fmt::format("'{}': reading packets: {}", path, detail::avErrorText(err)));
     return info;
 }
 

@@ -1,12 +1,12 @@
 // The fake codec (STYLE.md §4): raw RGBA in the same framing and with the same key-frame and
 // loss semantics as x264, so runtime logic (paper Fig. 4) is testable without FFmpeg.
-#include <chrono>
 #include <cstring>
 
 #include <fmt/format.h>
 
 #include "backends.h"
 #include "qvr/codec/frame_header.h"
+#include "qvr/core/clock.h"
 
 namespace qvr::detail {
 
@@ -17,7 +17,7 @@ public:
     explicit RawEncoder(const CodecConfig& config) : m_config(config) {}
 
     Expected<EncodedFrame> encode(const ImageRgba8& image, bool force_keyframe) override {
-        const auto t0 = std::chrono::steady_clock::now();
+        const Stopwatch t0;
         if (image.width() < 1 || image.height() < 1 || image.width() > m_config.max_side_px ||
             image.height() > m_config.max_side_px)
             return makeError(fmt::format("raw encoder: layer size {}x{} outside [1, {}]",
@@ -31,22 +31,15 @@ public:
         h.frame_id = m_next_id++;
         h.width = static_cast<uint16_t>(image.width());
         h.height = static_cast<uint16_t>(image.height());
-        EncodedFrame out;
-        out.bytes = packFrame(h, std::span<const uint8_t>(image.data(), image.sizeBytes()));
-        out.is_keyframe = key;
-        out.frame_id = h.frame_id;
+        EncodedFrame out =
+            packEncodedFrame(h, std::span<const uint8_t>(image.data(), image.sizeBytes()), m_stats);
         if (resized && m_width != 0)
             ++m_stats.reopens;
         m_width = image.width();
         m_height = image.height();
         m_force_key = false;
         m_since_key = key ? 1 : m_since_key + 1;
-        ++m_stats.frames;
-        m_stats.keyframes += key ? 1 : 0;
-        m_stats.bytes += static_cast<int64_t>(out.bytes.size());
-        out.encode_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                .count();
+        out.encode_ms = t0.elapsedMs();
         return out;
     }
     void requestKeyframe() override { m_force_key = true; }
@@ -67,13 +60,11 @@ private:
 class RawDecoder final : public VideoDecoder {
 public:
     Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
-        const auto t0 = std::chrono::steady_clock::now();
-        auto parsed = parseFrame(bytes);
+        const Stopwatch t0;
+        auto parsed = parseFrameFor(bytes, true, "raw decoder");
         if (!parsed)
             return makeError(parsed.error());
         const FrameHeader& h = parsed->header;
-        if ((h.flags & FrameHeader::kFlagRaw) == 0)
-            return makeError(fmt::format("raw decoder: frame {} is not a raw frame", h.frame_id));
         if (Status s = m_tracker.admit(h); !s)
             return makeError(s.error());
         const size_t want = size_t{h.width} * h.height * 4;
@@ -87,8 +78,7 @@ public:
         m_tracker.decoded(h, true);
         ImageRgba8 image(h.width, h.height);
         std::memcpy(image.data(), parsed->payload.data(), want);
-        m_last_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                        .count();
+        m_last_ms = t0.elapsedMs();
         return image;
     }
     bool needsKeyframe() const override { return m_tracker.needsKeyframe(); }

@@ -1,7 +1,6 @@
 // H.264 layer streams through libavcodec + libx264 with low-latency settings (paper §3.2: the
 // server streams each periphery layer as video; the headset decodes it before UCA composes).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -20,32 +19,14 @@ extern "C" {
 }
 
 #include "backends.h"
+#include "ffmpeg_util.h"
 #include "qvr/codec/frame_header.h"
 #include "qvr/core/canvas_policy.h"
+#include "qvr/core/clock.h"
 
 namespace qvr::detail {
 
 namespace {
-
-// FFmpeg's error macros expand to C casts; compute them once here with the warning silenced.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-constexpr int kAvErrorEagain = AVERROR(EAGAIN);
-constexpr int kAvErrorEof = AVERROR_EOF;
-#pragma GCC diagnostic pop
-
-std::string avErrorText(int err) {
-    char buf[AV_ERROR_MAX_STRING_SIZE] = {};
-    av_strerror(err, buf, sizeof(buf));
-    return buf;
-}
-
-// libavcodec logs every bitstream error at ERROR level; decoding untrusted bytes would flood
-// stderr, and every error already reaches the caller as an Expected. Process-wide, set once.
-void quietFfmpegLog() {
-    static std::once_flag once;
-    std::call_once(once, [] { av_log_set_level(AV_LOG_FATAL); });
-}
 
 struct ContextDeleter {
     void operator()(AVCodecContext* c) const { avcodec_free_context(&c); }
@@ -59,10 +40,6 @@ struct PacketDeleter {
 using ContextPtr = std::unique_ptr<AVCodecContext, ContextDeleter>;
 using FramePtr = std::unique_ptr<AVFrame, FrameDeleter>;
 using PacketPtr = std::unique_ptr<AVPacket, PacketDeleter>;
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // swscale's SIMD paths process pixels in groups and may touch a few pixels past a row's end, so
 // rows handed to it are 64-byte aligned with slack; a tightly packed image of another width is
@@ -100,7 +77,7 @@ public:
     ~X264Encoder() override { sws_freeContext(m_sws); }
 
     Expected<EncodedFrame> encode(const ImageRgba8& image, bool force_keyframe) override {
-        const auto t0 = std::chrono::steady_clock::now();
+        const Stopwatch t0;
         const int w = image.width();
         const int h = image.height();
         if (w < 1 || h < 1 || w > m_config.max_side_px || h > m_config.max_side_px)
@@ -153,14 +130,8 @@ public:
         fh.frame_id = m_next_id++;
         fh.width = static_cast<uint16_t>(w);
         fh.height = static_cast<uint16_t>(h);
-        EncodedFrame out;
-        out.bytes = packFrame(fh, m_payload);
-        out.is_keyframe = idr;
-        out.frame_id = fh.frame_id;
-        ++m_stats.frames;
-        m_stats.keyframes += idr ? 1 : 0;
-        m_stats.bytes += static_cast<int64_t>(out.bytes.size());
-        out.encode_ms = msSince(t0);
+        EncodedFrame out = packEncodedFrame(fh, m_payload, m_stats);
+        out.encode_ms = t0.elapsedMs();
         return out;
     }
 
@@ -301,13 +272,11 @@ public:
     }
 
     Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
-        const auto t0 = std::chrono::steady_clock::now();
-        auto parsed = parseFrame(bytes);
+        const Stopwatch t0;
+        auto parsed = parseFrameFor(bytes, false, "h264 decoder");
         if (!parsed)
             return makeError(parsed.error());
         const FrameHeader& h = parsed->header;
-        if ((h.flags & FrameHeader::kFlagRaw) != 0)
-            return makeError(fmt::format("h264 decoder: frame {} is a raw frame", h.frame_id));
         if (h.keyframe() && !annexBHasIdr(parsed->payload))
             return makeError(
                 fmt::format("h264 decoder: frame {} claims to be a key frame but "
@@ -325,7 +294,7 @@ public:
                             "loss; {} more frame(s) until the intra refresh completes",
                             h.frame_id, m_tracker.recoveringFrames()));
         auto image = toRgba(h);
-        m_last_ms = msSince(t0);
+        m_last_ms = t0.elapsedMs();
         return image;
     }
 

@@ -151,6 +151,18 @@ struct EyeJob {
     bool prefetch_layers = false;
 };
 
+// Points the job's kernel at one eye's layer images, slot by slot, with their blend borders.
+void bindLayers(EyeJob& j, const LayerFrame& frame, int eye) {
+    j.params.slot_count = j.slots.count;
+    for (int k = 0; k < j.slots.count; ++k) {
+        const int layer = j.slots.layer[k];
+        j.params.slots[k] =
+            kernelLayer(layerImage(frame.eyes[static_cast<size_t>(eye)], layer),
+                        layerRect(frame.plan.eyes[static_cast<size_t>(eye)], layer));
+    }
+    setBorders(j.params, j.slots);
+}
+
 // Reads every cache line of the jobs' layers once, split over the arena's threads: sequential
 // reads the hardware prefetchers stream at full bandwidth, where the tiles' gathers would each
 // wait for memory. The layers are UCA's compulsory reads; this only moves them earlier.
@@ -569,14 +581,7 @@ Expected<ComposeReport> Compositor::compose(const LayerFrame& frame, const Pose&
                  &m_tile_kinds[static_cast<size_t>(eye)],
                  &m_tile_masks[static_cast<size_t>(eye)]};
         setWarpParams(j.params, j.warp, frame.plan.gaze, m_options.chromatic_aberration);
-        j.params.slot_count = j.slots.count;
-        for (int k = 0; k < j.slots.count; ++k) {
-            const int layer = j.slots.layer[k];
-            j.params.slots[k] =
-                kernelLayer(layerImage(frame.eyes[static_cast<size_t>(eye)], layer),
-                            layerRect(frame.plan.eyes[static_cast<size_t>(eye)], layer));
-        }
-        setBorders(j.params, j.slots);
+        bindLayers(j, frame, eye);
         ensureSize(out[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
         j.mesh = true;
         j.prefetch_layers = true;
@@ -633,14 +638,7 @@ Expected<ComposeReport> Compositor::composeTwoPass(const LayerFrame& frame,
                  &m_tile_masks[static_cast<size_t>(eye)]};
         setWarpParams(j.params, j.warp, frame.plan.gaze, false);
         j.params.identity_map = true;
-        j.params.slot_count = j.slots.count;
-        for (int k = 0; k < j.slots.count; ++k) {
-            const int layer = j.slots.layer[k];
-            j.params.slots[k] =
-                kernelLayer(layerImage(frame.eyes[static_cast<size_t>(eye)], layer),
-                            layerRect(frame.plan.eyes[static_cast<size_t>(eye)], layer));
-        }
-        setBorders(j.params, j.slots);
+        bindLayers(j, frame, eye);
         ensureSize(buffers[static_cast<size_t>(eye)], m_profile.width_px, m_profile.height_px);
         j.stream_output = false;
         compose_jobs.push_back(std::move(j));

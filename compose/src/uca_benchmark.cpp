@@ -154,24 +154,21 @@ Expected<UcaBenchResult> runUcaBenchmark(const UcaBenchOptions& o) {
     res.bandwidth_floor_min_ms = bytes / (copy.best_gbps * 1e6);
 
     if (o.quality) {
-        const ImageRgbD truth = groundTruthWarp(o.profile, full, render_pose, display_pose);
-        res.uca_quality =
-            measureQuality(o.profile, plan, render_pose, display_pose, uca_out[0], truth);
-        res.two_pass_quality =
-            measureQuality(o.profile, plan, render_pose, display_pose, two_pass_out[0], truth);
-        if (!opencv_ms.empty()) {
-            res.opencv_quality =
-                measureQuality(o.profile, plan, render_pose, display_pose, opencv_out[0], truth);
-        }
-        const ImageRgbD layers = layerReferenceWarp(o.profile, frame, 0, display_pose);
-        res.uca_vs_layers =
-            measureQuality(o.profile, plan, render_pose, display_pose, uca_out[0], layers);
-        res.two_pass_vs_layers =
-            measureQuality(o.profile, plan, render_pose, display_pose, two_pass_out[0], layers);
-        if (!opencv_ms.empty()) {
-            res.opencv_vs_layers =
-                measureQuality(o.profile, plan, render_pose, display_pose, opencv_out[0], layers);
-        }
+        // Each pipeline's left eye against one reference image.
+        auto against = [&](const ImageRgbD& reference, QualityReport& uca_q,
+                           QualityReport& two_pass_q, std::optional<QualityReport>& opencv_q) {
+            uca_q =
+                measureQuality(o.profile, plan, render_pose, display_pose, uca_out[0], reference);
+            two_pass_q = measureQuality(o.profile, plan, render_pose, display_pose, two_pass_out[0],
+                                        reference);
+            if (!opencv_ms.empty())
+                opencv_q = measureQuality(o.profile, plan, render_pose, display_pose, opencv_out[0],
+                                          reference);
+        };
+        against(groundTruthWarp(o.profile, full, render_pose, display_pose), res.uca_quality,
+                res.two_pass_quality, res.opencv_quality);
+        against(layerReferenceWarp(o.profile, frame, 0, display_pose), res.uca_vs_layers,
+                res.two_pass_vs_layers, res.opencv_vs_layers);
     }
     return res;
 }

@@ -78,14 +78,16 @@ double LiwcPolicy::localMs(double e1_deg) const {
                     m_gpu_theta[0] + m_gpu_theta[1] * tris * 1e-5 + m_gpu_theta[2] * pixels * 1e-5);
 }
 
+double LiwcPolicy::peripheryBits(const Gaze& gaze, double e1_deg) const {
+    const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
+    return 2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
+}
+
 double LiwcPolicy::remoteMs(const Gaze& gaze, double e1_deg) const {
     // Eq. 2: the periphery's bytes over the throughput measured from acknowledgements.
     if (e1_deg >= m_cover_deg)
         return 0.0;
-    const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
-    const double bits =
-        2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
-    return m_remote_base_ms + bits / m_throughput_bps * 1000.0;
+    return m_remote_base_ms + peripheryBits(gaze, e1_deg) / m_throughput_bps * 1000.0;
 }
 
 void LiwcPolicy::setLinkEstimate(double throughput_bps) {
@@ -111,11 +113,8 @@ double LiwcPolicy::peripheryPixels(const Gaze& gaze, double e1_deg) const {
 double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
     if (e1_deg >= m_cover_deg)
         return 0.0;
-    const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
-    const double bits =
-        2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
     const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
-    return bits / std::max(1.0, bps) * 1000.0;
+    return peripheryBits(gaze, e1_deg) / std::max(1.0, bps) * 1000.0;
 }
 
 Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double hi) {

@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "control_io.h"
-#include "qvr/net/clock.h"
+#include "qvr/core/clock.h"
 
 namespace qvr::net {
 namespace {
@@ -105,6 +105,7 @@ struct Connection {
 struct Client::Impl {
     explicit Impl(ClientOptions o) : options(std::move(o)) {}
 
+    struct Handshake;
     Status handshake(Connection& c, const std::string& host, uint16_t port);
     void startLoops(Connection& c);
     void readControl(Connection& c);
@@ -129,223 +130,254 @@ struct Client::Impl {
     double throughput_bps = 0.0;
 };
 
-Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t port) {
-    struct State {
-        bool done = false;
-        Status result;
-    } st;
-    const auto finish = [&st, &c](Status s) {
-        if (!st.done) {
-            st.done = true;
-            st.result = std::move(s);
+// One handshake (docs/PROTOCOL.md): hello, the server's challenge and our proof, then sealed
+// control, the return-routability probe and the welcome. Its handlers run on the caller's thread
+// inside handshake()'s io loop, so it lives on that stack.
+struct Client::Impl::Handshake {
+    Handshake(Impl& impl_, Connection& c_, std::string where_)
+        : impl(impl_), c(c_), where(std::move(where_)), client_nonce(randomNonce()) {}
+
+    Impl& impl;
+    Connection& c;
+    const std::string where;
+    const Nonce client_nonce;
+    ServerChallenge challenge;
+    ControlKey route_key{};
+    uint16_t media_port = 0;
+    bool route_echoed = false;
+    bool done = false;
+    Status result;
+
+    void finish(Status s) {
+        if (!done) {
+            done = true;
+            result = std::move(s);
             // Return at once, even with the probe's receive still pending (a refusal).
             c.io.stop();
         }
-    };
-    const std::string where = host + ":" + std::to_string(port);
+    }
 
+    Error connectError(const std::string& what) const {
+        return makeError("connect " + where + ": " + what);
+    }
+
+    void countIncompatible() {
+        std::lock_guard lock(impl.mutex);
+        ++impl.stats.incompatible_refusals;
+    }
+
+    // Why the server said bye; a refusal of our version or settings is counted as permanent.
+    Error byeError(ByeReason reason) {
+        std::string text = "the server " + std::string(byeText(reason));
+        if (reason == ByeReason::kVersionMismatch || reason == ByeReason::kCodecMismatch ||
+            reason == ByeReason::kProfileMismatch) {
+            countIncompatible();
+            if (reason == ByeReason::kVersionMismatch) {
+                text += " (this client speaks version " + std::to_string(kProtocolVersion) + ")";
+            } else if (reason == ByeReason::kCodecMismatch) {
+                text += " (this client: codec " + codecNameOf(impl.options.settings) + ")";
+            } else {
+                text += " (this client: " + profileTextOf(impl.options.settings) + ")";
+            }
+        }
+        return connectError(text);
+    }
+
+    void start(const tcp::resolver::results_type& endpoints) {
+        asio::async_connect(
+            c.control, endpoints,
+            [this](const asio::error_code& cec, const tcp::endpoint&) { onConnected(cec); });
+    }
+
+    // Media arrives on the local address the control connection uses.
+    asio::error_code openMediaSocket() {
+        asio::error_code e;
+        c.control.set_option(tcp::no_delay(true), e);
+        detail::enableKeepAlive(c.control);
+        const auto local = c.control.local_endpoint(e);
+        c.media.open(local.protocol() == tcp::v4() ? udp::v4() : udp::v6(), e);
+        if (!e) {
+            c.media.bind(udp::endpoint(local.address(), 0), e);
+        }
+        if (!e) {
+            c.media.set_option(asio::socket_base::receive_buffer_size(4 << 20), e);
+            e.clear();
+        }
+        return e;
+    }
+
+    void onConnected(const asio::error_code& cec) {
+        if (cec) {
+            finish(connectError(cec.message()));
+            return;
+        }
+        if (const asio::error_code e = openMediaSocket()) {
+            finish(connectError("cannot open the media socket: " + e.message()));
+            return;
+        }
+        asio::error_code pe;
+        media_port = c.media.local_endpoint(pe).port();
+        c.writer.push(c.control,
+                      encodeControl(ClientHello{client_nonce, media_port, impl.options.settings}));
+        c.reader.read(c.control, [this](detail::ReadResult r) { onChallenge(r); });
+    }
+
+    // The server's challenge: check its proof, send ours, and seal control from here on.
+    void onChallenge(const detail::ReadResult& r) {
+        if (!r.ec && r.error == WireError::kWrongVersion) {
+            countIncompatible();
+            finish(connectError(
+                "the server speaks another protocol version (this client speaks version " +
+                std::to_string(kProtocolVersion) + ")"));
+            return;
+        }
+        if (r.ec || r.error != WireError::kNone) {
+            finish(connectError("no valid challenge from the server (" +
+                                (r.ec ? r.ec.message() : std::string(wireErrorName(r.error))) +
+                                ")"));
+            return;
+        }
+        if (const auto* bye = std::get_if<Bye>(&r.message)) {
+            finish(byeError(bye->reason));
+            return;
+        }
+        const auto* ch = std::get_if<ServerChallenge>(&r.message);
+        if (!ch) {
+            finish(connectError("unexpected message in the handshake"));
+            return;
+        }
+        challenge = *ch;
+        const ClientOptions& o = impl.options;
+        const Mac expected =
+            serverProof(o.key, client_nonce, challenge.server_nonce, challenge.session_id);
+        if (!macEqual(expected, challenge.server_proof)) {
+            {
+                std::lock_guard lock(impl.mutex);
+                ++impl.stats.server_proof_failures;
+                impl.stats.control_drops.count(WireError::kBadMac);
+            }
+            finish(connectError("the server does not hold the pre-shared key"));
+            return;
+        }
+        c.writer.push(
+            c.control,
+            encodeControl(ClientAuth{clientProof(o.key, client_nonce, challenge.server_nonce,
+                                                 challenge.session_id, media_port)}));
+        // Everything after ClientAuth is sealed, both ways (docs/PROTOCOL.md §Sealed control);
+        // only a Bye refusing the handshake may still come plain.
+        const SessionKeys keys =
+            sessionKeys(o.key, client_nonce, challenge.server_nonce, challenge.session_id);
+        c.reader.seal(keys.server_to_client);
+        c.sealer.start(keys.client_to_server);
+        route_key = keys.route;
+        // The server probes our media port; echoing the token proves we receive there.
+        receiveProbe();
+        c.reader.read(c.control, [this](detail::ReadResult w) { onWelcome(w); });
+    }
+
+    // The return-routability probe: the first datagram that opens with the route key and names
+    // our session is answered with its token over sealed control; anything else is counted.
+    void receiveProbe() {
+        c.media.async_receive(asio::buffer(c.datagram),
+                              [this](const asio::error_code& rec, size_t n) { onProbe(rec, n); });
+    }
+
+    void onProbe(const asio::error_code& rec, size_t n) {
+        if (rec || done) {
+            return;
+        }
+        RouteToken token{};
+        const WireError e = openRouteProbe(std::span<const uint8_t>(c.datagram.data(), n),
+                                           route_key, challenge.session_id, token);
+        if (e != WireError::kNone) {
+            {
+                std::lock_guard lock(impl.mutex);
+                impl.stats.media_drops.count(e);
+            }
+            receiveProbe();
+            return;
+        }
+        route_echoed = true;
+        c.writer.push(c.control, c.sealer.encode(RouteConfirm{token}));
+    }
+
+    void countBadWelcome(const detail::ReadResult& w) {
+        std::lock_guard lock(impl.mutex);
+        impl.stats.control_drops.count(w.error);
+        impl.stats.control_forged +=
+            w.error == WireError::kBadMac || (w.error == WireError::kNone && !w.sealed) ? 1 : 0;
+        impl.stats.control_replayed += w.error == WireError::kReplayed ? 1 : 0;
+    }
+
+    void onWelcome(const detail::ReadResult& w) {
+        if (w.ec) {
+            finish(connectError("the server closed the connection (" + w.ec.message() + ")"));
+            return;
+        }
+        if (const auto* bye = std::get_if<Bye>(&w.message); bye && w.error == WireError::kNone) {
+            finish(byeError(bye->reason));
+            return;
+        }
+        const auto* welcome = std::get_if<Welcome>(&w.message);
+        if (w.error != WireError::kNone || !w.sealed || !welcome ||
+            welcome->session_id != challenge.session_id || !route_echoed) {
+            countBadWelcome(w);
+            finish(connectError("no valid welcome from the server"));
+            return;
+        }
+        asio::error_code ue;
+        // Only the server's media socket may feed ours.
+        c.media.connect(udp::endpoint(c.control.remote_endpoint(ue).address(), welcome->media_port),
+                        ue);
+        if (ue) {
+            finish(connectError(ue.message()));
+            return;
+        }
+        c.session_id = welcome->session_id;
+        c.media_key =
+            mediaKey(impl.options.key, client_nonce, challenge.server_nonce, challenge.session_id);
+        finish(Status::success());
+    }
+
+    // Runs the io loop until the handshake ends or the connect timeout passes.
+    void runUntilDone() {
+        const int timeout_ms = impl.options.connect_timeout_ms;
+        const auto deadline =
+            std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+        while (!done && !c.io.stopped()) {
+            const auto now = std::chrono::steady_clock::now();
+            if (now >= deadline) {
+                break;
+            }
+            c.io.run_for(deadline - now);
+        }
+        if (!done) {
+            finish(connectError("timed out after " + std::to_string(timeout_ms) + " ms"));
+        }
+    }
+};
+
+Status Client::Impl::handshake(Connection& c, const std::string& host, uint16_t port) {
+    Handshake h(*this, c, host + ":" + std::to_string(port));
     asio::error_code ec;
     tcp::resolver resolver(c.io);
     const auto endpoints = resolver.resolve(host, std::to_string(port), ec);
     if (ec) {
-        return makeError("connect " + where + ": cannot resolve: " + ec.message());
+        return h.connectError("cannot resolve: " + ec.message());
     }
-    const Nonce client_nonce = randomNonce();
-    ServerChallenge challenge;
-    // Why the server said bye; a refusal of our version or settings is counted as permanent.
-    const auto byeError = [this, &where](ByeReason reason) {
-        std::string text = "connect " + where + ": the server " + byeText(reason);
-        if (reason == ByeReason::kVersionMismatch || reason == ByeReason::kCodecMismatch ||
-            reason == ByeReason::kProfileMismatch) {
-            {
-                std::lock_guard lock(mutex);
-                ++stats.incompatible_refusals;
-            }
-            if (reason == ByeReason::kVersionMismatch) {
-                text += " (this client speaks version " + std::to_string(kProtocolVersion) + ")";
-            } else if (reason == ByeReason::kCodecMismatch) {
-                text += " (this client: codec " + codecNameOf(options.settings) + ")";
-            } else {
-                text += " (this client: " + profileTextOf(options.settings) + ")";
-            }
-        }
-        return makeError(text);
-    };
-
-    // The return-routability probe: the first datagram that opens with the route key and names
-    // our session is answered with its token over sealed control; anything else is counted.
-    ControlKey route_key{};
-    bool route_echoed = false;
-    std::function<void(const asio::error_code&, size_t)> probe_handler =
-        [&](const asio::error_code& rec, size_t n) {
-            if (rec || st.done) {
-                return;
-            }
-            RouteToken token{};
-            const WireError e = openRouteProbe(std::span<const uint8_t>(c.datagram.data(), n),
-                                               route_key, challenge.session_id, token);
-            if (e != WireError::kNone) {
-                {
-                    std::lock_guard lock(mutex);
-                    stats.media_drops.count(e);
-                }
-                c.media.async_receive(asio::buffer(c.datagram), probe_handler);
-                return;
-            }
-            route_echoed = true;
-            c.writer.push(c.control, c.sealer.encode(RouteConfirm{token}));
-        };
-
-    asio::async_connect(
-        c.control, endpoints, [&](const asio::error_code& cec, const tcp::endpoint&) {
-            if (cec) {
-                finish(makeError("connect " + where + ": " + cec.message()));
-                return;
-            }
-            asio::error_code e;
-            c.control.set_option(tcp::no_delay(true), e);
-            detail::enableKeepAlive(c.control);
-            // Media arrives on the local address the control connection uses.
-            const auto local = c.control.local_endpoint(e);
-            c.media.open(local.protocol() == tcp::v4() ? udp::v4() : udp::v6(), e);
-            if (!e) {
-                c.media.bind(udp::endpoint(local.address(), 0), e);
-            }
-            if (!e) {
-                c.media.set_option(asio::socket_base::receive_buffer_size(4 << 20), e);
-                e.clear();
-            }
-            if (e) {
-                finish(makeError("connect " + where +
-                                 ": cannot open the media socket: " + e.message()));
-                return;
-            }
-            const uint16_t media_port = c.media.local_endpoint(e).port();
-            c.writer.push(c.control,
-                          encodeControl(ClientHello{client_nonce, media_port, options.settings}));
-            c.reader.read(c.control, [&, media_port](detail::ReadResult r) {
-                if (!r.ec && r.error == WireError::kWrongVersion) {
-                    {
-                        std::lock_guard lock(mutex);
-                        ++stats.incompatible_refusals;
-                    }
-                    finish(makeError("connect " + where +
-                                     ": the server speaks another protocol version (this client "
-                                     "speaks version " +
-                                     std::to_string(kProtocolVersion) + ")"));
-                    return;
-                }
-                if (r.ec || r.error != WireError::kNone) {
-                    finish(makeError("connect " + where + ": no valid challenge from the server (" +
-                                     (r.ec ? r.ec.message() : std::string(wireErrorName(r.error))) +
-                                     ")"));
-                    return;
-                }
-                if (const auto* bye = std::get_if<Bye>(&r.message)) {
-                    finish(byeError(bye->reason));
-                    return;
-                }
-                const auto* ch = std::get_if<ServerChallenge>(&r.message);
-                if (!ch) {
-                    finish(makeError("connect " + where + ": unexpected message in the handshake"));
-                    return;
-                }
-                challenge = *ch;
-                const Mac expected = serverProof(options.key, client_nonce, challenge.server_nonce,
-                                                 challenge.session_id);
-                if (!macEqual(expected, challenge.server_proof)) {
-                    {
-                        std::lock_guard lock(mutex);
-                        ++stats.server_proof_failures;
-                        stats.control_drops.count(WireError::kBadMac);
-                    }
-                    finish(makeError("connect " + where +
-                                     ": the server does not hold the pre-shared key"));
-                    return;
-                }
-                c.writer.push(c.control, encodeControl(ClientAuth{clientProof(
-                                             options.key, client_nonce, challenge.server_nonce,
-                                             challenge.session_id, media_port)}));
-                // Everything after ClientAuth is sealed, both ways (docs/PROTOCOL.md §Sealed
-                // control); only a Bye refusing the handshake may still come plain.
-                const SessionKeys keys = sessionKeys(options.key, client_nonce,
-                                                     challenge.server_nonce, challenge.session_id);
-                c.reader.seal(keys.server_to_client);
-                c.sealer.start(keys.client_to_server);
-                route_key = keys.route;
-                // The server probes our media port; echoing the token proves we receive there.
-                c.media.async_receive(asio::buffer(c.datagram), probe_handler);
-                c.reader.read(c.control, [&](detail::ReadResult w) {
-                    if (w.ec) {
-                        finish(makeError("connect " + where +
-                                         ": the server closed the connection (" + w.ec.message() +
-                                         ")"));
-                        return;
-                    }
-                    if (const auto* bye = std::get_if<Bye>(&w.message);
-                        bye && w.error == WireError::kNone) {
-                        finish(byeError(bye->reason));
-                        return;
-                    }
-                    const auto* welcome = std::get_if<Welcome>(&w.message);
-                    if (w.error != WireError::kNone || !w.sealed || !welcome ||
-                        welcome->session_id != challenge.session_id || !route_echoed) {
-                        {
-                            std::lock_guard lock(mutex);
-                            stats.control_drops.count(w.error);
-                            stats.control_forged +=
-                                w.error == WireError::kBadMac ||
-                                        (w.error == WireError::kNone && !w.sealed)
-                                    ? 1
-                                    : 0;
-                            stats.control_replayed += w.error == WireError::kReplayed ? 1 : 0;
-                        }
-                        finish(
-                            makeError("connect " + where + ": no valid welcome from the server"));
-                        return;
-                    }
-                    asio::error_code ue;
-                    // Only the server's media socket may feed ours.
-                    c.media.connect(
-                        udp::endpoint(c.control.remote_endpoint(ue).address(), welcome->media_port),
-                        ue);
-                    if (ue) {
-                        finish(makeError("connect " + where + ": " + ue.message()));
-                        return;
-                    }
-                    c.session_id = welcome->session_id;
-                    c.media_key = mediaKey(options.key, client_nonce, challenge.server_nonce,
-                                           challenge.session_id);
-                    finish(Status::success());
-                });
-            });
-        });
-
+    h.start(endpoints);
     // Replaced by the connection's handler before the network thread starts (startLoops).
-    c.writer.setErrorHandler([&finish, where](const asio::error_code& we) {
-        finish(makeError("connect " + where + ": " + we.message()));
-    });
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::milliseconds(options.connect_timeout_ms);
-    while (!st.done && !c.io.stopped()) {
-        const auto now = std::chrono::steady_clock::now();
-        if (now >= deadline) {
-            break;
-        }
-        c.io.run_for(deadline - now);
-    }
-    if (!st.done) {
-        finish(makeError("connect " + where + ": timed out after " +
-                         std::to_string(options.connect_timeout_ms) + " ms"));
-    }
-    if (!st.result.ok()) {
+    c.writer.setErrorHandler(
+        [&h](const asio::error_code& we) { h.finish(h.connectError(we.message())); });
+    h.runUntilDone();
+    if (!h.result.ok()) {
         // Cancel what is in flight and let the handlers see it before the state goes away.
         c.control.close(ec);
         c.media.close(ec);
         c.io.restart();
         c.io.run();
     }
-    return st.result;
+    return h.result;
 }
 
 void Client::Impl::fail(Connection& c, Status reason) {

@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "control_io.h"
-#include "qvr/net/clock.h"
+#include "qvr/core/clock.h"
 #include "qvr/net/throughput_estimator.h"
 
 namespace qvr::net {

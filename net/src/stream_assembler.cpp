@@ -156,74 +156,76 @@ void StreamAssembler::onPacket(const MediaPacketView& packet, int64_t now_ns) {
     release(packet.header.stream_id);  // an answered NACK may unblock held frames
 }
 
-void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
-    const MediaHeader& h = packet.header;
-    Stream& s = m_streams[h.stream_id];
-    const uint32_t h_first = frameFirstSeq(h);
-
-    // Sequence gaps: packets that never came. A late packet (negative distance) fills no gap
-    // count back in; reordering on the emulated link cannot happen (it keeps order).
-    bool consecutive = false;  // the packet right after the stream's newest: a pacing sample
+// Sequence gaps: packets that never came. A late packet (negative distance) fills no gap count
+// back in; reordering on the emulated link cannot happen (it keeps order). Returns whether the
+// packet is the one right after the stream's newest (a pacing sample).
+bool StreamAssembler::trackSequence(Stream& s, const MediaHeader& h, int64_t now_ns) {
     if (!s.has_seq) {
         s.has_seq = true;
         s.next_seq = h.seq + 1;
         m_window_expected += 1;
-    } else {
-        const int64_t d = seqAfter(h.seq, s.next_seq);
-        consecutive = d == 0;
-        if (d >= 0) {
-            m_window_expected += static_cast<uint32_t>(d) + 1;
-            m_window_lost += static_cast<uint32_t>(d);
-            if (d > 0) {
-                m_stats.seq_gap_packets += static_cast<uint64_t>(d);
-            }
-            for (uint32_t k = 0; k < d; ++k) {
-                const uint32_t want = s.next_seq + k;
-                // A frame with parity may still rebuild what it lost (it NACKs its data
-                // packets itself once it cannot), and a finished frame needs nothing.
-                if ((h.fec_parity > 0 && seqAfter(want, h_first) >= 0) ||
-                    coveredElsewhere(s, want)) {
-                    continue;
-                }
-                if (!m_limits.retransmit) {
-                    s.awaiting_key = true;
-                    m_loss_mask |= static_cast<uint8_t>(1u << h.stream_id);
-                    break;
-                }
-                // Ask for the gap instead of giving up on it; a gap larger than what is
-                // tracked is left to the loss timeout.
-                if (static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream) {
-                    break;
-                }
-                // A stalled tail may have been asked for already.
-                if (std::none_of(s.missing.begin(), s.missing.end(),
-                                 [&](const Missing& m) { return m.seq == want; })) {
-                    s.missing.push_back({want, now_ns, 1});
-                    s.nack_now.push_back(want);
-                }
-            }
-            s.next_seq = h.seq + 1;
+        return false;
+    }
+    const int64_t d = seqAfter(h.seq, s.next_seq);
+    if (d >= 0) {
+        m_window_expected += static_cast<uint32_t>(d) + 1;
+        m_window_lost += static_cast<uint32_t>(d);
+        if (d > 0) {
+            m_stats.seq_gap_packets += static_cast<uint64_t>(d);
+        }
+        onGap(s, h, static_cast<uint32_t>(d), now_ns);
+        s.next_seq = h.seq + 1;
+    }
+    return d == 0;
+}
+
+// The d packets before h that never came: asked for again (retransmission) or given up on (a
+// key frame is needed).
+void StreamAssembler::onGap(Stream& s, const MediaHeader& h, uint32_t d, int64_t now_ns) {
+    const uint32_t h_first = frameFirstSeq(h);
+    for (uint32_t k = 0; k < d; ++k) {
+        const uint32_t want = s.next_seq + k;
+        // A frame with parity may still rebuild what it lost (it NACKs its data packets itself
+        // once it cannot), and a finished frame needs nothing.
+        if ((h.fec_parity > 0 && seqAfter(want, h_first) >= 0) || coveredElsewhere(s, want)) {
+            continue;
+        }
+        if (!m_limits.retransmit) {
+            s.awaiting_key = true;
+            m_loss_mask |= static_cast<uint8_t>(1u << h.stream_id);
+            break;
+        }
+        // Ask for the gap instead of giving up on it; a gap larger than what is tracked is left
+        // to the loss timeout.
+        if (static_cast<int>(s.missing.size()) >= m_limits.max_missing_per_stream) {
+            break;
+        }
+        // A stalled tail may have been asked for already.
+        if (std::none_of(s.missing.begin(), s.missing.end(),
+                         [&](const Missing& m) { return m.seq == want; })) {
+            s.missing.push_back({want, now_ns, 1});
+            s.nack_now.push_back(want);
         }
     }
-    if (m_window_expected >= kLossWindowPackets) {
-        const double sample =
-            static_cast<double>(m_window_lost) / static_cast<double>(m_window_expected);
-        m_loss_rate = m_loss_sampled ? 0.75 * m_loss_rate + 0.25 * sample : sample;
-        m_loss_sampled = true;
-        m_window_expected = 0;
-        m_window_lost = 0;
-    }
-    if (m_limits.retransmit && !s.missing.empty()) {
-        // An answer to a NACK: a gap packet (behind next_seq) or a lost tail (at or past it).
-        const auto before = s.missing.size();
-        std::erase_if(s.missing, [&](const Missing& m) { return m.seq == h.seq; });
-        m_stats.packets_recovered += before - s.missing.size();
-    }
+}
 
-    // Frames whose last packet is well behind the newest sequence number will not complete
-    // (without retransmission: with it, the late packets may still come). With retransmission,
-    // a frame with parity whose every packet was sent (the stream moved past its end) and
-    // that is still incomplete cannot rebuild itself: its missing data packets are NACKed.
+void StreamAssembler::sampleLossWindow() {
+    if (m_window_expected < kLossWindowPackets) {
+        return;
+    }
+    const double sample =
+        static_cast<double>(m_window_lost) / static_cast<double>(m_window_expected);
+    m_loss_rate = m_loss_sampled ? 0.75 * m_loss_rate + 0.25 * sample : sample;
+    m_loss_sampled = true;
+    m_window_expected = 0;
+    m_window_lost = 0;
+}
+
+// Frames whose last packet is well behind the newest sequence number will not complete (without
+// retransmission: with it, the late packets may still come). With retransmission, a frame with
+// parity whose every packet was sent (the stream moved past its end) and that is still
+// incomplete cannot rebuild itself: its missing data packets are NACKed.
+void StreamAssembler::sweepPartials(Stream& s, const MediaHeader& h, int64_t now_ns) {
     for (auto it = s.partials.begin(); it != s.partials.end();) {
         const auto next = std::next(it);
         if (!m_limits.retransmit) {
@@ -235,59 +237,65 @@ void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
         }
         it = next;
     }
+}
 
-    if (isFinished(s, h.frame_id)) {
-        ++(h.parity ? m_stats.fec_parity_unused : m_stats.packets_late);
-        return;
-    }
+// The partial frame h belongs to, made if it is new; end() when the budget has no room for it.
+// Allocates only what the validated header allows, within the budget: makes room by giving up
+// the oldest partial frames first. With parity the data is kept as whole shards for the code.
+std::map<uint32_t, StreamAssembler::Partial>::iterator StreamAssembler::partialFor(
+    Stream& s, const MediaHeader& h, int64_t now_ns) {
     auto it = s.partials.find(h.frame_id);
-    const uint32_t parity_count = parityPacketsFor(h.packet_count, h.fec_parity);
-    if (it == s.partials.end()) {
-        // Allocate only what the validated header allows, within the budget: make room by
-        // giving up the oldest partial frames first. With parity the data is kept as whole
-        // shards for the code.
-        const int64_t need = h.fec_parity == 0
-                                 ? static_cast<int64_t>(h.frame_bytes)
-                                 : static_cast<int64_t>(h.packet_count + parity_count) *
-                                       static_cast<int64_t>(kMediaChunkBytes);
-        while (!s.partials.empty() &&
-               (static_cast<int>(s.partials.size()) >= m_limits.max_partial_frames_per_stream ||
-                m_buffered_bytes + need > m_limits.max_buffered_bytes)) {
-            declareLost(h.stream_id, s.partials.begin());
-        }
-        if (m_buffered_bytes + need > m_limits.max_buffered_bytes) {
-            ++m_stats.packets_over_budget;
-            return;
-        }
-        Partial p;
-        p.key_frame = h.key_frame;
-        p.packet_count = h.packet_count;
-        p.frame_bytes = h.frame_bytes;
-        p.fec_parity = h.fec_parity;
-        p.first_seq = h_first;
-        p.last_seq = h_first + h.packet_count + parity_count - 1u;
-        p.first_rx_ns = now_ns;
-        if (h.fec_parity == 0) {
-            p.bytes.resize(h.frame_bytes);
-        } else {
-            p.bytes.assign(static_cast<size_t>(h.packet_count) * kMediaChunkBytes, 0);
-            p.parity.resize(static_cast<size_t>(parity_count) * kMediaChunkBytes);
-            p.have_parity.assign(parity_count, false);
-        }
-        p.allocated = need;
-        p.have.assign(h.packet_count, false);
-        m_buffered_bytes += need;
-        it = s.partials.emplace(h.frame_id, std::move(p)).first;
+    if (it != s.partials.end()) {
+        return it;
     }
-    Partial& p = it->second;
+    const uint32_t parity_count = parityPacketsFor(h.packet_count, h.fec_parity);
+    const int64_t need = h.fec_parity == 0 ? static_cast<int64_t>(h.frame_bytes)
+                                           : static_cast<int64_t>(h.packet_count + parity_count) *
+                                                 static_cast<int64_t>(kMediaChunkBytes);
+    while (!s.partials.empty() &&
+           (static_cast<int>(s.partials.size()) >= m_limits.max_partial_frames_per_stream ||
+            m_buffered_bytes + need > m_limits.max_buffered_bytes)) {
+        declareLost(h.stream_id, s.partials.begin());
+    }
+    if (m_buffered_bytes + need > m_limits.max_buffered_bytes) {
+        ++m_stats.packets_over_budget;
+        return s.partials.end();
+    }
+    const uint32_t h_first = frameFirstSeq(h);
+    Partial p;
+    p.key_frame = h.key_frame;
+    p.packet_count = h.packet_count;
+    p.frame_bytes = h.frame_bytes;
+    p.fec_parity = h.fec_parity;
+    p.first_seq = h_first;
+    p.last_seq = h_first + h.packet_count + parity_count - 1u;
+    p.first_rx_ns = now_ns;
+    if (h.fec_parity == 0) {
+        p.bytes.resize(h.frame_bytes);
+    } else {
+        p.bytes.assign(static_cast<size_t>(h.packet_count) * kMediaChunkBytes, 0);
+        p.parity.resize(static_cast<size_t>(parity_count) * kMediaChunkBytes);
+        p.have_parity.assign(parity_count, false);
+    }
+    p.allocated = need;
+    p.have.assign(h.packet_count, false);
+    m_buffered_bytes += need;
+    return s.partials.emplace(h.frame_id, std::move(p)).first;
+}
+
+// Copies the packet into its frame; false (and counted) when it does not fit the frame's first
+// packet or repeats one.
+bool StreamAssembler::store(Partial& p, const MediaPacketView& packet) {
+    const MediaHeader& h = packet.header;
     if (p.packet_count != h.packet_count || p.frame_bytes != h.frame_bytes ||
-        p.key_frame != h.key_frame || p.fec_parity != h.fec_parity || p.first_seq != h_first) {
+        p.key_frame != h.key_frame || p.fec_parity != h.fec_parity ||
+        p.first_seq != frameFirstSeq(h)) {
         ++m_stats.packets_inconsistent;
-        return;
+        return false;
     }
     if (h.parity ? p.have_parity[h.packet_index] : p.have[h.packet_index]) {
         ++m_stats.packets_duplicate;
-        return;
+        return false;
     }
     if (h.parity) {
         // decodeMediaPacket guaranteed a full shard and index < the frame's parity count.
@@ -302,6 +310,33 @@ void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
         p.have[h.packet_index] = true;
         ++p.data_have;
         p.bytes_received += h.payload_bytes;
+    }
+    return true;
+}
+
+void StreamAssembler::accept(const MediaPacketView& packet, int64_t now_ns) {
+    const MediaHeader& h = packet.header;
+    Stream& s = m_streams[h.stream_id];
+    const bool consecutive = trackSequence(s, h, now_ns);
+    sampleLossWindow();
+    if (m_limits.retransmit && !s.missing.empty()) {
+        // An answer to a NACK: a gap packet (behind next_seq) or a lost tail (at or past it).
+        const auto before = s.missing.size();
+        std::erase_if(s.missing, [&](const Missing& m) { return m.seq == h.seq; });
+        m_stats.packets_recovered += before - s.missing.size();
+    }
+    sweepPartials(s, h, now_ns);
+    if (isFinished(s, h.frame_id)) {
+        ++(h.parity ? m_stats.fec_parity_unused : m_stats.packets_late);
+        return;
+    }
+    const auto it = partialFor(s, h, now_ns);
+    if (it == s.partials.end()) {
+        return;
+    }
+    Partial& p = it->second;
+    if (!store(p, packet)) {
+        return;
     }
     if (consecutive && p.received > 0) {
         samplePacketGap(now_ns - std::max(p.first_rx_ns, p.last_rx_ns));

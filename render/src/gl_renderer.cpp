@@ -7,7 +7,6 @@
 #include <GL/glcorearb.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -20,6 +19,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "egl_context.h"
+#include "qvr/core/clock.h"
 #include "qvr/render/draw_list.h"
 
 namespace qvr {
@@ -115,23 +115,27 @@ void main() {
 }
 )";
 
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+// A shader after compiling or a program after linking (`status`: GL_COMPILE_STATUS or
+// GL_LINK_STATUS, read with get_iv): itself, or, deleted, an error with its info log.
+template <typename GetIv, typename GetLog, typename Delete>
+Expected<GLuint> builtOrError(GLuint object, GLenum status, GetIv get_iv, GetLog get_log,
+                              Delete destroy, const char* failure) {
+    GLint ok = GL_FALSE;
+    get_iv(object, status, &ok);
+    if (ok == GL_TRUE)
+        return object;
+    char log[2048] = {};
+    get_log(object, sizeof(log), nullptr, log);
+    destroy(object);
+    return makeError(fmt::format("GL: {}: {}", failure, log));
 }
 
 Expected<GLuint> compileShader(GLenum type, const char* source) {
     const GLuint shader = glCreateShader(type);
     glShaderSource(shader, 1, &source, nullptr);
     glCompileShader(shader);
-    GLint ok = GL_FALSE;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (ok != GL_TRUE) {
-        char log[2048] = {};
-        glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
-        glDeleteShader(shader);
-        return makeError(fmt::format("GL: shader compilation failed: {}", log));
-    }
-    return shader;
+    return builtOrError(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog,
+                        glDeleteShader, "shader compilation failed");
 }
 
 int mipLevels(int width, int height) {
@@ -315,15 +319,8 @@ struct GlRenderer::Impl {
             glDeleteShader(*shader);
         }
         glLinkProgram(prog);
-        GLint linked = GL_FALSE;
-        glGetProgramiv(prog, GL_LINK_STATUS, &linked);
-        if (linked != GL_TRUE) {
-            char log[2048] = {};
-            glGetProgramInfoLog(prog, sizeof(log), nullptr, log);
-            glDeleteProgram(prog);
-            return makeError(fmt::format("GL: program link failed: {}", log));
-        }
-        return prog;
+        return builtOrError(prog, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog,
+                            glDeleteProgram, "program link failed");
     }
 
     static Status checkGl(const char* what) {
@@ -498,7 +495,7 @@ struct GlRenderer::Impl {
         if (!fb)
             return Error{fb.error()};
 
-        const auto t0 = std::chrono::steady_clock::now();
+        const Stopwatch t0;
         glBindFramebuffer(GL_FRAMEBUFFER, (*fb)->fbo);
         glViewport(0, 0, view.width_px, view.height_px);
         glClearColor(kClearRgba[0] / 255.0f, kClearRgba[1] / 255.0f, kClearRgba[2] / 255.0f, 1.0f);
@@ -547,10 +544,10 @@ struct GlRenderer::Impl {
             read_fbo = (*fb)->resolve_fbo;
         }
         glFinish();
-        stats.render_ms = msSince(t0);
+        stats.render_ms = t0.elapsedMs();
         glBindFramebuffer(GL_READ_FRAMEBUFFER, read_fbo);
 
-        const auto t1 = std::chrono::steady_clock::now();
+        const Stopwatch t1;
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
         glReadPixels(0, 0, view.width_px, view.height_px, GL_RGBA, GL_UNSIGNED_BYTE, out.data());
         // GL's first row is the bottom one; images are stored top row first.
@@ -563,7 +560,7 @@ struct GlRenderer::Impl {
             std::memcpy(a, b, stride);
             std::memcpy(b, tmp.data(), stride);
         }
-        stats.readback_ms = msSince(t1);
+        stats.readback_ms = t1.elapsedMs();
 
         GLuint64 elapsed_ns = 0;
         GLuint64 primitives = 0;

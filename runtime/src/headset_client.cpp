@@ -100,7 +100,7 @@ public:
     Headset(const HeadsetConfig& config, std::shared_ptr<const Scene> scene,
             std::shared_ptr<const TriangleBvh> bvh, const HeadsetTraces& traces)
         : m_config(config),
-          m_clock(config.clock ? *config.clock : SteadyPacingClock::instance()),
+          m_clock(config.clock ? *config.clock : SteadyClock::instance()),
           m_pacer(m_clock, config.profile.refresh_hz),
           m_scene(std::move(scene)),
           m_traces(traces),
@@ -444,6 +444,58 @@ private:
         std::shared_ptr<LayerFrame> layers;
     };
 
+    // A frame's layer plan and how it was chosen.
+    struct Choice {
+        LayerPlan plan;
+        bool decided = false;   // the policy chose e1
+        bool fallback = false;  // no server: everything local
+        double t_local_pred_ms = 0.0;
+        double t_remote_pred_ms = 0.0;
+    };
+
+    // 2. Decision: e1 before rendering.
+    Choice decide(int64_t i, double content_ms, const Pose& head, const Gaze& gaze, bool connected,
+                  const std::optional<WorkloadFrame>& wf) {
+        Choice c;
+        switch (m_config.design) {
+            case Design::Local:
+                c.plan = m_planner.plan(gaze, 180.0);
+                break;
+            case Design::Remote:
+                if (connected) {
+                    c.plan = wholeFramePlan(m_planner, gaze);
+                } else {
+                    c.plan = m_planner.plan(gaze, 180.0);
+                    c.fallback = true;
+                }
+                break;
+            default:
+                if (connected) {
+                    // Policies other than LIWC read only the pose and gaze (policy.h).
+                    WorkloadFrame light;
+                    if (!wf) {
+                        light.index = i;
+                        light.time_ms = content_ms;
+                        light.head = head;
+                        light.gaze = gaze;
+                    }
+                    if (m_liwc)
+                        m_liwc->setLinkEstimate(m_client->throughputBps());
+                    const Decision d = m_policy->decide(wf ? *wf : light);
+                    m_last_e1_deg = d.e1_deg;
+                    c.t_local_pred_ms = d.t_local_pred_ms;
+                    c.t_remote_pred_ms = d.t_remote_pred_ms;
+                    c.plan = m_planner.plan(gaze, d.e1_deg);
+                    c.decided = true;
+                } else {
+                    c.plan = m_planner.plan(gaze, 180.0);
+                    c.fallback = true;
+                }
+                break;
+        }
+        return c;
+    }
+
     // Steps 1–3: pose sample, decision, request.
     Prepared prepare(int64_t i) {
         if (m_config.before_frame)
@@ -484,47 +536,12 @@ private:
                      : m_probe.frame(i, content_ms, head, gaze, m_last_e1_deg + 6.0);
             probe_ms = double(m_clock.nowNs() - probe_start_ns) * 1e-6;
         }
-        LayerPlan plan;
-        bool decided = false;
-        bool fallback = false;
-        double t_local_pred_ms = 0.0;
-        double t_remote_pred_ms = 0.0;
-        switch (m_config.design) {
-            case Design::Local:
-                plan = m_planner.plan(gaze, 180.0);
-                break;
-            case Design::Remote:
-                if (connected) {
-                    plan = wholeFramePlan(m_planner, gaze);
-                } else {
-                    plan = m_planner.plan(gaze, 180.0);
-                    fallback = true;
-                }
-                break;
-            default:
-                if (connected) {
-                    // Policies other than LIWC read only the pose and gaze (policy.h).
-                    WorkloadFrame light;
-                    if (!wf) {
-                        light.index = i;
-                        light.time_ms = content_ms;
-                        light.head = head;
-                        light.gaze = gaze;
-                    }
-                    if (m_liwc)
-                        m_liwc->setLinkEstimate(m_client->throughputBps());
-                    const Decision d = m_policy->decide(wf ? *wf : light);
-                    m_last_e1_deg = d.e1_deg;
-                    t_local_pred_ms = d.t_local_pred_ms;
-                    t_remote_pred_ms = d.t_remote_pred_ms;
-                    plan = m_planner.plan(gaze, d.e1_deg);
-                    decided = true;
-                } else {
-                    plan = m_planner.plan(gaze, 180.0);
-                    fallback = true;
-                }
-                break;
-        }
+        const Choice choice = decide(i, content_ms, head, gaze, connected, wf);
+        const LayerPlan& plan = choice.plan;
+        const bool decided = choice.decided;
+        const bool fallback = choice.fallback;
+        const double t_local_pred_ms = choice.t_local_pred_ms;
+        const double t_remote_pred_ms = choice.t_remote_pred_ms;
         if (m_config.workload && wf)
             m_config.workload->writeFrame(*wf);
         FrameTelemetry* t = &tel(ti);
@@ -583,107 +600,115 @@ private:
 
     // Steps 4–7: fovea, remote layers, UCA, scan-out, what the policy learns.
     void finish(Prepared& prep) {
-        const int64_t i = prep.frame;
-        const size_t ti = prep.telemetry;
-        const int64_t pose_ns = prep.pose_ns;
-        const double content_ms = prep.content_ms;
-        const Pose& head = prep.head;
-        const LayerPlan& plan = prep.plan;
-        const std::optional<WorkloadFrame>& wf = prep.wf;
-        const bool decided = prep.decided;
-        const uint8_t expected = prep.expected;
-        const std::shared_ptr<LayerFrame>& layers = prep.layers;
-        FrameTelemetry* t = &tel(ti);
+        const int64_t local_end_ns = renderFovea(prep);
+        const bool have_current = prep.expected == 0 || waitForRemote(prep, local_end_ns);
+        composeAndScanOut(prep, have_current);
+        if (prep.decided)
+            learn(prep, have_current);
+        // Frames already shown keep their slot only until their streams are decoded.
+        while (!m_pending.empty() &&
+               (m_pending.front().frame <= m_last_shown && m_pending.front().frame < prep.frame))
+            m_pending.pop_front();
+    }
 
-        // 4. The fovea (or the whole frame) locally.
+    // 4. The fovea (or the whole frame) locally; returns when it ended.
+    int64_t renderFovea(Prepared& prep) {
+        const LayerPlan& plan = prep.plan;
         const int64_t local_start_ns = m_clock.nowNs();
-        t->local_start_ns = rel(local_start_ns);
+        tel(prep.telemetry).local_start_ns = rel(local_start_ns);
         double fragments = 0.0;
         for (int eye = 0; eye < 2; ++eye) {
             if (plan.eyes[static_cast<size_t>(eye)].fovea.empty())
                 continue;
-            auto rs = renderLayer(*m_renderer, m_config.profile, plan, head, static_cast<Eye>(eye),
-                                  LayerKind::kFovea, layers->eyes[static_cast<size_t>(eye)].fovea);
+            auto rs =
+                renderLayer(*m_renderer, m_config.profile, plan, prep.head, static_cast<Eye>(eye),
+                            LayerKind::kFovea, prep.layers->eyes[static_cast<size_t>(eye)].fovea);
             if (!rs)
                 ++m_stats.render_failures;
             else
                 fragments += double(rs->fragment_invocations);
         }
         const int64_t local_end_ns = m_clock.nowNs();
-        t = &tel(ti);
+        FrameTelemetry* t = &tel(prep.telemetry);
         t->local_end_ns = rel(local_end_ns);
         t->fovea_fragments = fragments;
         t->t_local_ms = double(local_end_ns - local_start_ns) * 1e-6;
+        return local_end_ns;
+    }
 
-        // 5. Wait for this frame's remote layers, decoding each as it arrives.
-        bool have_current = expected == 0;
-        if (expected != 0) {
-            // The wait limit runs from when the server could start on this frame: with frames
-            // in flight its request waits behind the previous frame's.
-            const PendingFrame* started = pendingFor(i);
-            const int64_t wait_from_ns =
-                std::max({local_end_ns, pose_ns, started ? started->service_start_ns : 0});
-            // A server that has delivered no stream for a whole wait limit is stalled or its
-            // link is dead: waiting the limit for every frame would drop the display to
-            // 1 / limit (4 Hz at 250 ms, measured under a 2 s SIGSTOP of the server). Then
-            // wait one refresh and re-warp the newest layers, until streams come again. A
-            // server whose streams are spaced wider than half the limit is given twice its
-            // spacing before it is called silent (qvr/core/silence.h).
-            const int64_t limit_ns = static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
-            const bool silent =
-                m_silence.silent(double(local_end_ns) * 1e-6, m_config.remote_timeout_ms);
-            const int64_t deadline_ns =
-                silent ? std::max(local_end_ns, pose_ns) +
-                             static_cast<int64_t>(1e9 / m_config.profile.refresh_hz)
-                       : wait_from_ns + limit_ns;
-            if (silent)
-                ++m_stats.silent_server_frames;
-            for (;;) {
-                PendingFrame* p = pendingFor(i);
-                if (!p || p->complete() || p->broken())
-                    break;
-                const int64_t now_ns = m_clock.nowNs();
-                if (now_ns >= deadline_ns || !m_client->connected())
-                    break;
-                const int wait_ms =
-                    static_cast<int>(std::clamp<int64_t>((deadline_ns - now_ns) / 1'000'000, 1, 5));
-                pumpNetwork(wait_ms);
-            }
+    // When to stop waiting for a frame's remote layers. The wait limit runs from when the server
+    // could start on this frame: with frames in flight its request waits behind the previous
+    // frame's. A server that has delivered no stream for a whole wait limit is stalled or its
+    // link is dead: waiting the limit for every frame would drop the display to 1 / limit (4 Hz
+    // at 250 ms, measured under a 2 s SIGSTOP of the server). Then wait one refresh and re-warp
+    // the newest layers, until streams come again. A server whose streams are spaced wider than
+    // half the limit is given twice its spacing before it is called silent (qvr/core/silence.h).
+    int64_t remoteDeadlineNs(const Prepared& prep, int64_t local_end_ns) {
+        const PendingFrame* started = pendingFor(prep.frame);
+        const int64_t wait_from_ns =
+            std::max({local_end_ns, prep.pose_ns, started ? started->service_start_ns : 0});
+        const int64_t limit_ns = static_cast<int64_t>(m_config.remote_timeout_ms * 1e6);
+        const bool silent =
+            m_silence.silent(double(local_end_ns) * 1e-6, m_config.remote_timeout_ms);
+        if (!silent)
+            return wait_from_ns + limit_ns;
+        ++m_stats.silent_server_frames;
+        return std::max(local_end_ns, prep.pose_ns) +
+               static_cast<int64_t>(1e9 / m_config.profile.refresh_hz);
+    }
+
+    // 5. Waits for this frame's remote layers, decoding each as it arrives; whether they all
+    // came.
+    bool waitForRemote(const Prepared& prep, int64_t local_end_ns) {
+        const int64_t i = prep.frame;
+        const int64_t deadline_ns = remoteDeadlineNs(prep, local_end_ns);
+        for (;;) {
             PendingFrame* p = pendingFor(i);
-            t = &tel(ti);
-            have_current = p && p->complete();
+            if (!p || p->complete() || p->broken())
+                break;
             const int64_t now_ns = m_clock.nowNs();
-            const int64_t decoded_ns = have_current ? m_origin_ns + t->remote_done_ns : now_ns;
-            // The last packet's arrival, not its decode: decoding waits while the headset
-            // renders its own fovea on the same core, which is headset time, not the server's.
-            const int64_t rx_ns = have_current && p->last_rx_ns > 0 ? p->last_rx_ns : now_ns;
-            const int64_t start_ns = p ? p->service_start_ns : m_origin_ns + t->request_ns;
-            t->t_remote_ms = double(rx_ns - std::min(start_ns, rx_ns)) * 1e-6;
-            t->t_remote_decoded_ms = double(decoded_ns - std::min(start_ns, decoded_ns)) * 1e-6;
-            if (!have_current)
-                ++m_stats.late_frames;
+            if (now_ns >= deadline_ns || !m_client->connected())
+                break;
+            const int wait_ms =
+                static_cast<int>(std::clamp<int64_t>((deadline_ns - now_ns) / 1'000'000, 1, 5));
+            pumpNetwork(wait_ms);
         }
+        PendingFrame* p = pendingFor(i);
+        FrameTelemetry* t = &tel(prep.telemetry);
+        const bool have_current = p && p->complete();
+        const int64_t now_ns = m_clock.nowNs();
+        const int64_t decoded_ns = have_current ? m_origin_ns + t->remote_done_ns : now_ns;
+        // The last packet's arrival, not its decode: decoding waits while the headset renders its
+        // own fovea on the same core, which is headset time, not the server's.
+        const int64_t rx_ns = have_current && p->last_rx_ns > 0 ? p->last_rx_ns : now_ns;
+        const int64_t start_ns = p ? p->service_start_ns : m_origin_ns + t->request_ns;
+        t->t_remote_ms = double(rx_ns - std::min(start_ns, rx_ns)) * 1e-6;
+        t->t_remote_decoded_ms = double(decoded_ns - std::min(start_ns, decoded_ns)) * 1e-6;
+        if (!have_current)
+            ++m_stats.late_frames;
+        return have_current;
+    }
 
-        // 6. UCA with the newest pose, then scan-out at the next vsync.
+    // The layers to compose when this frame's did not all come: a frame older than this one
+    // whose layers completed after its own display is newer than what the compositor holds, so
+    // show it (still a reuse of older layers); null: re-warp what the compositor holds.
+    std::shared_ptr<const LayerFrame> newerLateLayers(int64_t i) const {
+        for (auto it = m_pending.rbegin(); it != m_pending.rend(); ++it) {
+            if (it->frame < i && it->complete() &&
+                static_cast<int64_t>(it->layers->frame_index) > m_last_shown)
+                return it->layers;
+        }
+        return nullptr;
+    }
+
+    // 6. UCA with the newest pose, then scan-out at the next vsync.
+    void composeAndScanOut(const Prepared& prep, bool have_current) {
         const int64_t uca_start_ns = m_clock.nowNs();
         const Pose display_pose =
-            poseAt(m_traces.motion, content_ms + double(uca_start_ns - pose_ns) * 1e-6);
-        std::shared_ptr<const LayerFrame> arrived;
-        bool reused = false;
-        if (have_current) {
-            arrived = layers;
-        } else {
-            // A frame older than this one whose layers completed after its own display: newer
-            // than what the compositor holds, so show it (still a reuse of older layers).
-            for (auto it = m_pending.rbegin(); it != m_pending.rend(); ++it) {
-                if (it->frame < i && it->complete() &&
-                    static_cast<int64_t>(it->layers->frame_index) > m_last_shown) {
-                    arrived = it->layers;
-                    break;
-                }
-            }
-            reused = true;
-        }
+            poseAt(m_traces.motion, prep.content_ms + double(uca_start_ns - prep.pose_ns) * 1e-6);
+        const std::shared_ptr<const LayerFrame> arrived =
+            have_current ? prep.layers : newerLateLayers(prep.frame);
+        bool reused = !have_current;
         auto report = m_compositor.present(arrived, display_pose, m_display);
         if (!report) {
             ++m_stats.compose_failures;
@@ -691,11 +716,11 @@ private:
             reused = true;
         }
         const int64_t uca_end_ns = m_clock.nowNs();
-        t = &tel(ti);
+        FrameTelemetry* t = &tel(prep.telemetry);
         t->uca_start_ns = rel(uca_start_ns);
         t->uca_end_ns = rel(uca_end_ns);
         t->uca_ms = double(uca_end_ns - uca_start_ns) * 1e-6;
-        t->mtp_ms = double(uca_end_ns - pose_ns) * 1e-6;
+        t->mtp_ms = double(uca_end_ns - prep.pose_ns) * 1e-6;
         t->reused = reused || (report && report->reused);
         if (report) {
             t->shown_frame = static_cast<int64_t>(report->frame_index);
@@ -708,64 +733,60 @@ private:
                                                            : m_pacer.queueForScanout(uca_end_ns);
         m_idle_ns += std::max<int64_t>(0, m_clock.nowNs() - vsync_wait_start_ns);
         // Busy time since the previous frame finished: the headset's cost of one frame.
-        {
-            const int64_t now_ns = m_clock.nowNs();
-            if (m_last_finish_ns > 0)
-                tel(ti).headset_busy_ms =
-                    double(std::max<int64_t>(0, now_ns - m_last_finish_ns - m_idle_ns)) * 1e-6;
-            m_last_finish_ns = now_ns;
-            m_idle_ns = 0;
-        }
-        t = &tel(ti);
+        const int64_t now_ns = m_clock.nowNs();
+        if (m_last_finish_ns > 0)
+            tel(prep.telemetry).headset_busy_ms =
+                double(std::max<int64_t>(0, now_ns - m_last_finish_ns - m_idle_ns)) * 1e-6;
+        m_last_finish_ns = now_ns;
+        m_idle_ns = 0;
+        t = &tel(prep.telemetry);
         t->display_ns = rel(display_ns);
         if (m_config.display && report) {
             const LayerFrame* shown = m_compositor.newestFrame();
-            m_config.display->onScanout(*t, shown ? shown->plan : plan, m_display);
+            m_config.display->onScanout(*t, shown ? shown->plan : prep.plan, m_display);
         }
+    }
 
-        // 7. The policy learns what the frame measured.
-        if (decided) {
-            PendingFrame* p = pendingFor(i);
-            FrameMeasurement m;
-            m.index = i;
-            m.e1_deg = plan.e1_deg;
-            // With frames in flight the headset's whole frame competes with the server, not
-            // only its fovea render (LIWC's GPU fit takes the fixed part as its intercept).
-            m.t_local_ms =
-                m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
-            m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
-            if (i < static_cast<int64_t>(m_depth)) {
-                // The frames requested before any completed are the session's start-up (the
-                // server's first renders and key frames, first use of every code path), not
-                // what the next frames will cost: no timing from them reaches the policy's
-                // fits (one 80–140 ms start-up frame biased LIWC's 32-frame window by ~15 ms).
-                m.t_local_ms = 0.0;
-                m.t_remote_ms = 0.0;
-            }
-            if (wf) {
-                m.triangles_local =
-                    sumWithinDeg(wf->triangles_per_ring, m_probe.header().ring_deg, plan.e1_deg);
-                m.pixels_local =
-                    sumWithinDeg(wf->pixels_per_ring, m_probe.header().ring_deg, plan.e1_deg);
-            }
-            if (p) {
-                m.middle_bytes = p->bytes[0] + p->bytes[2];
-                m.outer_bytes = p->bytes[1] + p->bytes[3];
-            }
-            m.middle_pixels = 2.0 * double(plan.middle_pixels);
-            m.outer_pixels = 2.0 * double(plan.outer_pixels);
-            m.s1 = plan.s1;
-            m.s2 = plan.s2;
-            m.throughput_bps = t->throughput_bps;
-            m_policy->observe(m);
-            if (p && have_current)
-                m_probe.observeBits(m.middle_bytes, m.middle_pixels, plan.s1, m.outer_bytes,
-                                    m.outer_pixels, plan.s2);
+    // 7. The policy learns what the frame measured.
+    void learn(const Prepared& prep, bool have_current) {
+        const int64_t i = prep.frame;
+        const LayerPlan& plan = prep.plan;
+        const FrameTelemetry* t = &tel(prep.telemetry);
+        PendingFrame* p = pendingFor(i);
+        FrameMeasurement m;
+        m.index = i;
+        m.e1_deg = plan.e1_deg;
+        // With frames in flight the headset's whole frame competes with the server, not only its
+        // fovea render (LIWC's GPU fit takes the fixed part as its intercept).
+        m.t_local_ms = m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
+        m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
+        if (i < static_cast<int64_t>(m_depth)) {
+            // The frames requested before any completed are the session's start-up (the
+            // server's first renders and key frames, first use of every code path), not what
+            // the next frames will cost: no timing from them reaches the policy's fits (one
+            // 80–140 ms start-up frame biased LIWC's 32-frame window by ~15 ms).
+            m.t_local_ms = 0.0;
+            m.t_remote_ms = 0.0;
         }
-        // Frames already shown keep their slot only until their streams are decoded.
-        while (!m_pending.empty() &&
-               (m_pending.front().frame <= m_last_shown && m_pending.front().frame < i))
-            m_pending.pop_front();
+        if (prep.wf) {
+            m.triangles_local =
+                sumWithinDeg(prep.wf->triangles_per_ring, m_probe.header().ring_deg, plan.e1_deg);
+            m.pixels_local =
+                sumWithinDeg(prep.wf->pixels_per_ring, m_probe.header().ring_deg, plan.e1_deg);
+        }
+        if (p) {
+            m.middle_bytes = p->bytes[0] + p->bytes[2];
+            m.outer_bytes = p->bytes[1] + p->bytes[3];
+        }
+        m.middle_pixels = 2.0 * double(plan.middle_pixels);
+        m.outer_pixels = 2.0 * double(plan.outer_pixels);
+        m.s1 = plan.s1;
+        m.s2 = plan.s2;
+        m.throughput_bps = t->throughput_bps;
+        m_policy->observe(m);
+        if (p && have_current)
+            m_probe.observeBits(m.middle_bytes, m.middle_pixels, plan.s1, m.outer_bytes,
+                                m.outer_pixels, plan.s2);
     }
 
     // No more pending frames than the telemetry holds: an older entry would be dropped with
@@ -775,7 +796,7 @@ private:
     static constexpr int kKeyMismatchBackoffMs = 2000;
 
     const HeadsetConfig& m_config;
-    PacingClock& m_clock;
+    Clock& m_clock;
     VsyncPacer m_pacer;
     std::shared_ptr<const Scene> m_scene;
     const HeadsetTraces& m_traces;

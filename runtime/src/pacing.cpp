@@ -1,39 +1,14 @@
-// Display pacing: the steady and fake clocks and the vsync slot grid.
+// Display pacing: the vsync slot grid on the clock seam.
 #include "qvr/runtime/pacing.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <thread>
 
 #include "qvr/core/check.h"
 
 namespace qvr::runtime {
 
-int64_t SteadyPacingClock::nowNs() const {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-}
-
-void SteadyPacingClock::sleepUntilNs(int64_t deadline_ns) {
-    const int64_t now_ns = nowNs();
-    if (deadline_ns > now_ns)
-        std::this_thread::sleep_for(std::chrono::nanoseconds(deadline_ns - now_ns));
-}
-
-SteadyPacingClock& SteadyPacingClock::instance() {
-    static SteadyPacingClock clock;
-    return clock;
-}
-
-void FakePacingClock::sleepUntilNs(int64_t deadline_ns) {
-    int64_t now_ns = m_now_ns.load();
-    while (deadline_ns > now_ns && !m_now_ns.compare_exchange_weak(now_ns, deadline_ns)) {
-    }
-}
-
-VsyncPacer::VsyncPacer(PacingClock& clock, double refresh_hz)
+VsyncPacer::VsyncPacer(Clock& clock, double refresh_hz)
     : m_clock(clock),
       m_period_ns(static_cast<int64_t>(std::llround(1e9 / std::max(refresh_hz, 1.0)))) {
     QVR_CHECK(m_period_ns > 0);

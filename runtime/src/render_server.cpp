@@ -3,7 +3,6 @@
 #include "qvr/runtime/render_server.h"
 
 #include <atomic>
-#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -59,20 +58,11 @@ bool planFits(const HmdProfile& profile, const LayerPlan& plan) {
     return true;
 }
 
-int64_t steadyNs() {
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(
-               std::chrono::steady_clock::now().time_since_epoch())
-        .count();
-}
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 }  // namespace
 
 struct RenderServer::Impl final : net::ServerHandler {
     RenderServerConfig config;
+    Clock* clock = &SteadyClock::instance();  // config.clock, or the steady clock
     std::shared_ptr<const Scene> scene;
     std::unique_ptr<net::Server> server;
     std::thread render_thread;
@@ -105,7 +95,7 @@ struct RenderServer::Impl final : net::ServerHandler {
             if (it == clients.end())
                 return;
             auto& q = it->second->pending;
-            q.push_back({request, steadyNs()});
+            q.push_back({request, clock->nowNs()});
             while (q.size() > std::max<size_t>(config.max_pending_requests, 1)) {
                 q.pop_front();
                 ++stats.requests_dropped;
@@ -147,7 +137,24 @@ struct RenderServer::Impl final : net::ServerHandler {
         }
     }
 
-    void renderLoop() {
+    // One request being served: what the render thread stamps and counts while it works.
+    struct Work {
+        net::ClientId id = 0;
+        ClientState* state = nullptr;
+        const net::FrameRequest* req = nullptr;
+        uint8_t key_mask = 0;
+        ServerFrameRecord rec;
+        RenderServerStats delta;
+        int64_t render_start_ns = 0, render_end_ns = 0;
+    };
+    // The render thread's images, reused from request to request.
+    struct Images {
+        ImageRgba8 image, outer, scratch;
+    };
+
+    // Pins the thread, makes the renderer and uploads the scene, then tells start() how it
+    // went; null when it failed.
+    std::unique_ptr<Renderer> startRenderer() {
         if (config.core >= 0) {
             if (auto st = pinCurrentThread(config.core); !st)
                 std::fprintf(stderr, "qvr server: %s (running unpinned)\n", st.error().c_str());
@@ -163,143 +170,170 @@ struct RenderServer::Impl final : net::ServerHandler {
         }
         cv.notify_all();
         if (!upload)
+            return nullptr;
+        return std::move(*renderer);
+    }
+
+    void renderLoop() {
+        std::unique_ptr<Renderer> renderer = startRenderer();
+        if (!renderer)
             return;
-        Renderer& r = **renderer;
-        ImageRgba8 image;
-        ImageRgba8 outer_image;
-        ImageRgba8 scratch;
+        Images images;
         net::ClientId id = 0;
         std::shared_ptr<ClientState> state;
         net::FrameRequest req;
         int64_t queued_ns = 0;
         ServerFrameStamps stamps;
-        while (next(id, state, req, queued_ns)) {
-            stamps.client = id;
-            stamps.frame_id = req.frame_id;
-            stamps.client_send_ns = req.client_send_ns;
-            stamps.queued_ns = queued_ns;
-            stamps.start_ns = steadyNs();
-            stamps.layers.clear();
-            int64_t render_start_ns = 0, render_end_ns = 0;
-            ServerFrameRecord rec;
-            rec.client = id;
-            rec.frame_id = req.frame_id;
-            rec.e1_deg = req.e1_deg;
-            rec.received_ns = queued_ns;
-            rec.start_ns = stamps.start_ns;
-            const LayerPlan plan = net::layerPlanOf(req);
-            if (!planFits(config.profile, plan)) {
-                std::lock_guard lock(mutex);
-                ++stats.requests_invalid;
+        while (next(id, state, req, queued_ns))
+            serve(*renderer, images, id, *state, req, queued_ns, stamps);
+    }
+
+    // Renders, encodes and sends every layer of one request.
+    void serve(Renderer& r, Images& images, net::ClientId id, ClientState& state,
+               const net::FrameRequest& req, int64_t queued_ns, ServerFrameStamps& stamps) {
+        stamps.client = id;
+        stamps.frame_id = req.frame_id;
+        stamps.client_send_ns = req.client_send_ns;
+        stamps.queued_ns = queued_ns;
+        stamps.start_ns = clock->nowNs();
+        stamps.layers.clear();
+        Work w;
+        w.id = id;
+        w.state = &state;
+        w.req = &req;
+        w.rec.client = id;
+        w.rec.frame_id = req.frame_id;
+        w.rec.e1_deg = req.e1_deg;
+        w.rec.received_ns = queued_ns;
+        w.rec.start_ns = stamps.start_ns;
+        const LayerPlan plan = net::layerPlanOf(req);
+        if (!planFits(config.profile, plan)) {
+            std::lock_guard lock(mutex);
+            ++stats.requests_invalid;
+            return;
+        }
+        w.key_mask = state.key_frame_mask.exchange(0);
+        for (int eye = 0; eye < 2; ++eye) {
+            const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
+            if (config.one_pass_periphery && onePassPays(layers))
+                renderEyeInOnePass(r, images, plan, eye, w, stamps);
+            else
+                renderEyeByLayer(r, images, plan, eye, layers, w, stamps);
+        }
+        if (config.on_frame) {
+            stamps.end_ns = clock->nowNs();
+            config.on_frame(stamps);
+        }
+        w.rec.done_ns = clock->nowNs();
+        record(w);
+    }
+
+    // An eye's middle and outer layers from one geometry pass.
+    void renderEyeInOnePass(Renderer& r, Images& images, const LayerPlan& plan, int eye, Work& w,
+                            ServerFrameStamps& stamps) {
+        w.render_start_ns = clock->nowNs();
+        auto rs = renderPeriphery(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye),
+                                  images.image, images.outer, images.scratch);
+        w.render_end_ns = clock->nowNs();
+        w.delta.render_ms_total += double(w.render_end_ns - w.render_start_ns) * 1e-6;
+        if (!rs) {
+            w.delta.render_failures += 2;
+            return;
+        }
+        const uint8_t mid = net::streamId(eye, net::Layer::kMiddle);
+        w.rec.render_ms[mid] += rs->render_ms;
+        w.rec.readback_ms[mid] += rs->readback_ms;
+        w.rec.triangles[mid] += rs->primitives_generated;
+        w.delta.readback_ms_total += rs->readback_ms;
+        w.delta.layers_rendered += 2;
+        ++w.delta.periphery_passes;
+        send(w, stamps, net::streamId(eye, net::Layer::kMiddle), images.image);
+        send(w, stamps, net::streamId(eye, net::Layer::kOuter), images.outer);
+    }
+
+    // An eye's middle and outer layers, each from its own sub-frustum.
+    void renderEyeByLayer(Renderer& r, Images& images, const LayerPlan& plan, int eye,
+                          const EyeLayers& layers, Work& w, ServerFrameStamps& stamps) {
+        for (net::Layer layer : {net::Layer::kMiddle, net::Layer::kOuter}) {
+            const LayerKind kind =
+                layer == net::Layer::kMiddle ? LayerKind::kMiddle : LayerKind::kOuter;
+            if (layerOf(layers, kind).empty())
+                continue;
+            w.render_start_ns = clock->nowNs();
+            auto rs = renderLayer(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye), kind,
+                                  images.image, CameraOptions{}, config.holes);
+            w.render_end_ns = clock->nowNs();
+            w.delta.render_ms_total += double(w.render_end_ns - w.render_start_ns) * 1e-6;
+            if (!rs) {
+                ++w.delta.render_failures;
                 continue;
             }
-            const uint8_t key_mask = state->key_frame_mask.exchange(0);
-            RenderServerStats delta;
-            auto send = [&](uint8_t sid, const ImageRgba8& layer_image) {
-                auto& enc = state->encoders[sid];
-                if (!enc) {
-                    auto made = makeVideoEncoder(config.codec);
-                    if (!made) {
-                        ++delta.encode_failures;
-                        return;
-                    }
-                    enc = std::move(*made);
-                }
-                if (key_mask & (1u << sid))
-                    enc->requestKeyframe();
-                auto encoded = enc->encode(layer_image);
-                if (!encoded) {
-                    ++delta.encode_failures;
-                    return;
-                }
-                delta.encode_ms_total += encoded->encode_ms;
-                rec.encode_ms[sid] += encoded->encode_ms;
-                rec.bytes[sid] += static_cast<int64_t>(encoded->bytes.size());
-                const int64_t encode_end_ns = steadyNs();
-                const bool key = encoded->is_keyframe;
-                if (config.on_frame)  // stamped before the transport can deliver it
-                    stamps.layers.push_back(
-                        {sid, render_start_ns, render_end_ns, encode_end_ns, steadyNs()});
-                const int64_t send_start_ns = steadyNs();
-                if (server->sendStream(id, req.frame_id, sid, key, std::move(encoded->bytes)))
-                    ++delta.streams_sent;
-                else
-                    ++delta.stream_send_failures;
-                const double send_ms = double(steadyNs() - send_start_ns) * 1e-6;
-                rec.send_ms[sid] += send_ms;
-                delta.send_ms_total += send_ms;
-            };
-            for (int eye = 0; eye < 2; ++eye) {
-                const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
-                if (config.one_pass_periphery && onePassPays(layers)) {
-                    const auto t0 = std::chrono::steady_clock::now();
-                    render_start_ns = steadyNs();
-                    auto rs = renderPeriphery(r, config.profile, plan, req.pose,
-                                              static_cast<Eye>(eye), image, outer_image, scratch);
-                    delta.render_ms_total += msSince(t0);
-                    render_end_ns = steadyNs();
-                    if (!rs) {
-                        delta.render_failures += 2;
-                        continue;
-                    }
-                    const uint8_t mid = net::streamId(eye, net::Layer::kMiddle);
-                    rec.render_ms[mid] += rs->render_ms;
-                    rec.readback_ms[mid] += rs->readback_ms;
-                    rec.triangles[mid] += rs->primitives_generated;
-                    delta.readback_ms_total += rs->readback_ms;
-                    delta.layers_rendered += 2;
-                    ++delta.periphery_passes;
-                    send(net::streamId(eye, net::Layer::kMiddle), image);
-                    send(net::streamId(eye, net::Layer::kOuter), outer_image);
-                    continue;
-                }
-                for (net::Layer layer : {net::Layer::kMiddle, net::Layer::kOuter}) {
-                    const LayerKind kind =
-                        layer == net::Layer::kMiddle ? LayerKind::kMiddle : LayerKind::kOuter;
-                    if (layerOf(layers, kind).empty())
-                        continue;
-                    const auto t0 = std::chrono::steady_clock::now();
-                    render_start_ns = steadyNs();
-                    auto rs = renderLayer(r, config.profile, plan, req.pose, static_cast<Eye>(eye),
-                                          kind, image, CameraOptions{}, config.holes);
-                    delta.render_ms_total += msSince(t0);
-                    render_end_ns = steadyNs();
-                    if (!rs) {
-                        ++delta.render_failures;
-                        continue;
-                    }
-                    const uint8_t sid = net::streamId(eye, layer);
-                    rec.render_ms[sid] += rs->render_ms;
-                    rec.readback_ms[sid] += rs->readback_ms;
-                    rec.triangles[sid] += rs->primitives_generated;
-                    rec.pixels[sid] = int64_t(image.width()) * image.height();
-                    delta.readback_ms_total += rs->readback_ms;
-                    ++delta.layers_rendered;
-                    send(sid, image);
-                }
-            }
-            if (config.on_frame) {
-                stamps.end_ns = steadyNs();
-                config.on_frame(stamps);
-            }
-            rec.done_ns = steadyNs();
-            std::lock_guard lock(mutex);
-            if (config.max_frame_records > 0)
-                records.push_back(rec);
-            while (records.size() > config.max_frame_records)
-                records.pop_front();
-            ++stats.frames_rendered;
-            stats.layers_rendered += delta.layers_rendered;
-            stats.periphery_passes += delta.periphery_passes;
-            stats.streams_sent += delta.streams_sent;
-            stats.stream_send_failures += delta.stream_send_failures;
-            stats.render_failures += delta.render_failures;
-            stats.encode_failures += delta.encode_failures;
-            stats.render_ms_total += delta.render_ms_total;
-            stats.encode_ms_total += delta.encode_ms_total;
-            stats.readback_ms_total += delta.readback_ms_total;
-            stats.send_ms_total += delta.send_ms_total;
+            const uint8_t sid = net::streamId(eye, layer);
+            w.rec.render_ms[sid] += rs->render_ms;
+            w.rec.readback_ms[sid] += rs->readback_ms;
+            w.rec.triangles[sid] += rs->primitives_generated;
+            w.rec.pixels[sid] = int64_t(images.image.width()) * images.image.height();
+            w.delta.readback_ms_total += rs->readback_ms;
+            ++w.delta.layers_rendered;
+            send(w, stamps, sid, images.image);
         }
+    }
+
+    // Encodes one layer with its stream's encoder and hands it to the transport.
+    void send(Work& w, ServerFrameStamps& stamps, uint8_t sid, const ImageRgba8& layer_image) {
+        auto& enc = w.state->encoders[sid];
+        if (!enc) {
+            auto made = makeVideoEncoder(config.codec);
+            if (!made) {
+                ++w.delta.encode_failures;
+                return;
+            }
+            enc = std::move(*made);
+        }
+        if (w.key_mask & (1u << sid))
+            enc->requestKeyframe();
+        auto encoded = enc->encode(layer_image);
+        if (!encoded) {
+            ++w.delta.encode_failures;
+            return;
+        }
+        w.delta.encode_ms_total += encoded->encode_ms;
+        w.rec.encode_ms[sid] += encoded->encode_ms;
+        w.rec.bytes[sid] += static_cast<int64_t>(encoded->bytes.size());
+        const int64_t encode_end_ns = clock->nowNs();
+        const bool key = encoded->is_keyframe;
+        if (config.on_frame)  // stamped before the transport can deliver it
+            stamps.layers.push_back(
+                {sid, w.render_start_ns, w.render_end_ns, encode_end_ns, clock->nowNs()});
+        const int64_t send_start_ns = clock->nowNs();
+        if (server->sendStream(w.id, w.req->frame_id, sid, key, std::move(encoded->bytes)))
+            ++w.delta.streams_sent;
+        else
+            ++w.delta.stream_send_failures;
+        const double send_ms = double(clock->nowNs() - send_start_ns) * 1e-6;
+        w.rec.send_ms[sid] += send_ms;
+        w.delta.send_ms_total += send_ms;
+    }
+
+    // Keeps the frame's record and adds its counts to the server's.
+    void record(const Work& w) {
+        const RenderServerStats& delta = w.delta;
+        std::lock_guard lock(mutex);
+        if (config.max_frame_records > 0)
+            records.push_back(w.rec);
+        while (records.size() > config.max_frame_records)
+            records.pop_front();
+        ++stats.frames_rendered;
+        stats.layers_rendered += delta.layers_rendered;
+        stats.periphery_passes += delta.periphery_passes;
+        stats.streams_sent += delta.streams_sent;
+        stats.stream_send_failures += delta.stream_send_failures;
+        stats.render_failures += delta.render_failures;
+        stats.encode_failures += delta.encode_failures;
+        stats.render_ms_total += delta.render_ms_total;
+        stats.encode_ms_total += delta.encode_ms_total;
+        stats.readback_ms_total += delta.readback_ms_total;
+        stats.send_ms_total += delta.send_ms_total;
     }
 };
 
@@ -311,6 +345,8 @@ Expected<std::unique_ptr<RenderServer>> RenderServer::start(RenderServerConfig c
         return makeError("render server: " + st.error());
     auto impl = std::make_unique<Impl>();
     impl->config = std::move(config);
+    if (impl->config.clock)
+        impl->clock = impl->config.clock;
     // Clients must stream with our codec at our display profile (refused in the handshake).
     const HmdProfile& hp = impl->config.profile;
     impl->config.net.settings = net::makeSessionSettings(impl->config.codec.backend, hp.name,

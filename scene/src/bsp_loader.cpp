@@ -22,6 +22,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "append_batch.h"
 #include "image_decode.h"
 #include "shader_script.h"
 
@@ -482,17 +483,10 @@ Status BspParser::readFaces(Scene& scene) {
         if (idx.empty())
             continue;
         SceneBatch b;
-        b.first_index = static_cast<uint32_t>(scene.indices.size());
-        b.index_count = static_cast<uint32_t>(idx.size());
         b.texture = textureFor(std::get<0>(key), scene);
         b.lightmap = std::get<1>(key);
         b.is_patch = std::get<2>(key);
-        for (uint32_t i : idx)
-            b.bounds.extend(scene.vertices[i].position);
-        scene.bounds.extend(b.bounds.min);
-        scene.bounds.extend(b.bounds.max);
-        scene.indices.insert(scene.indices.end(), idx.begin(), idx.end());
-        scene.batches.push_back(b);
+        detail::appendBatch(scene, b, idx);
     }
     return Status::success();
 }

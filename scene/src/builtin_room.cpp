@@ -12,6 +12,8 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "append_batch.h"
+
 namespace qvr {
 
 namespace {
@@ -220,15 +222,8 @@ public:
             if (idx.empty())
                 continue;
             SceneBatch b;
-            b.first_index = static_cast<uint32_t>(m_scene.indices.size());
-            b.index_count = static_cast<uint32_t>(idx.size());
             b.texture = m;
-            for (uint32_t i : idx)
-                b.bounds.extend(m_scene.vertices[i].position);
-            m_scene.bounds.extend(b.bounds.min);
-            m_scene.bounds.extend(b.bounds.max);
-            m_scene.indices.insert(m_scene.indices.end(), idx.begin(), idx.end());
-            m_scene.batches.push_back(b);
+            detail::appendBatch(m_scene, b, idx);
         }
     }
 

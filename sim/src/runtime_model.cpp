@@ -206,405 +206,492 @@ void logSpan(std::vector<BusySpan>& spans, double start, double end) {
 constexpr double kCoRunSettledMs = 0.01;
 constexpr int kCoRunMaxPasses = 24;
 
-RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig& config,
-                              Link& link, const CoRunLog* previous, CoRunLog* log) {
-    const WorkloadHeader& header = trace.header;
-    const RuntimeCosts& c = config.costs;
-    const DesignTraits& traits = traitsOf(config.design);
-    const bool local_only = traits.split == Split::LocalOnly;
-    const bool whole_frame = traits.split == Split::RemoteOnly;
-    const bool liwc = traits.policy == "liwc";
-    const LayerPlanner planner(header.profile);
-    const double eye_px = double(header.profile.width_px) * double(header.profile.height_px);
-    const double period_ms = 1000.0 / std::max(1.0, header.profile.refresh_hz);
-    const int n_frames = std::clamp<int>(config.frames, 0, static_cast<int>(trace.frames.size()));
-    const size_t depth =
-        local_only ? 1 : static_cast<size_t>(std::clamp(config.pipeline_depth, 1, 4));
-    const size_t queue_cap = static_cast<size_t>(std::max(config.server_queue, 1));
-
-    // The runtime's policies (runtime/src/headset_client.cpp liwcConfig): qvr is LIWC with the
-    // frame-period objective, sw the same model fed reactively.
-    auto runtimeLiwc = [&](bool reactive) {
-        LiwcConfig lc;
-        lc.learn_remote_base = config.liwc_learn_remote_base;
-        lc.frame_period_objective = config.liwc_frame_period_objective;
-        lc.reactive = reactive;
-        return std::make_unique<LiwcPolicy>(header, lc);
-    };
-    const bool sw = traits.policy == "sw";
-    const bool sw_liwc = sw && config.sw_uses_liwc;
-    LiwcPolicy* link_aware = nullptr;  // the policy that reads the acks at decision time
-    std::unique_ptr<FoveaPolicy> policy;
-    if (liwc) {
-        auto p = runtimeLiwc(false);
-        link_aware = p.get();
-        policy = std::move(p);
-    } else if (sw_liwc) {
-        policy = runtimeLiwc(true);
-    } else if (sw) {
-        policy = makeSoftwareReactivePolicy(header);
-    } else if (traits.policy == "fixed") {
-        policy = std::make_unique<FixedPolicy>(config.fixed_e1_deg);
+// One pass of the replay: the headset's core, the server's render thread and the link as
+// events, the headset running the runtime's loop and the server advanced lazily to its clock.
+class PassReplay {
+public:
+    PassReplay(const WorkloadTrace& trace, const RuntimeSimConfig& config, Link& link,
+               const CoRunLog* previous, CoRunLog* log)
+        : m_trace(trace),
+          m_header(trace.header),
+          m_config(config),
+          m_costs(config.costs),
+          m_traits(traitsOf(config.design)),
+          m_link(link),
+          m_log(log),
+          m_local_only(m_traits.split == Split::LocalOnly),
+          m_whole_frame(m_traits.split == Split::RemoteOnly),
+          m_liwc(m_traits.policy == "liwc"),
+          m_sw(m_traits.policy == "sw"),
+          m_sw_liwc(m_sw && config.sw_uses_liwc),
+          m_planner(m_header.profile),
+          m_eye_px(double(m_header.profile.width_px) * double(m_header.profile.height_px)),
+          m_period_ms(1000.0 / std::max(1.0, m_header.profile.refresh_hz)),
+          m_n_frames(std::clamp<int>(config.frames, 0, static_cast<int>(trace.frames.size()))),
+          m_depth(m_local_only ? 1 : static_cast<size_t>(std::clamp(config.pipeline_depth, 1, 4))),
+          m_queue_cap(static_cast<size_t>(std::max(config.server_queue, 1))),
+          // Work on one side runs slower where the previous pass had the other side busy.
+          m_headset_slowdown(previous ? config.costs.headsetCoRun() : 1.0),
+          m_server_slowdown(previous ? config.costs.serverCoRun() : 1.0),
+          m_server_spans(previous ? previous->server : kNoSpans),
+          m_headset_spans(previous ? previous->headset : kNoSpans),
+          m_codecs(config.costs) {
+        makePolicy();
+        m_result.frames.resize(static_cast<size_t>(m_n_frames));
+        m_state.resize(static_cast<size_t>(m_n_frames));
     }
 
-    RuntimeRunResult result;
-    result.frames.resize(static_cast<size_t>(n_frames));
-    std::vector<FrameState> state(static_cast<size_t>(n_frames));
-    std::vector<Stream> streams;  // every stream sent, in rx order (the link keeps order)
+    RuntimeRunResult run();
 
-    // Headset core.
-    double hs = 0.0;
-    double busy = 0.0;  // busy time since the previous frame finished
-    double last_e1_deg = 5.0;
-    double last_complete_rx_ms = 0.0;
-    // The streams the headset took from the transport (the session's start, 0 ms, before any):
-    // a server silent for a whole wait limit (or twice its spacing, if longer) makes the runtime
-    // wait one refresh instead.
-    SilenceDetector silence;
-    int64_t last_slot = -1;  // the newest scan-out's vsync slot index
-    double ack_goodput_bps = 0.0;
-    // Server and link.
+private:
     struct Request {
         int64_t frame;
         double arrive_ms;
     };
-    std::deque<Request> queue;
-    double server_free = 0.0, link_free = 0.0, server_busy_total = 0.0;
-    int served_frames = 0;
-    size_t next_undecoded = 0;
+    static inline const std::vector<BusySpan> kNoSpans;
 
-    // Work on one side runs slower where the previous pass had the other side busy.
-    const double headset_slowdown = previous ? c.headsetCoRun() : 1.0;
-    const double server_slowdown = previous ? c.serverCoRun() : 1.0;
-    static const std::vector<BusySpan> kNone;
-    const std::vector<BusySpan>& server_spans = previous ? previous->server : kNone;
-    const std::vector<BusySpan>& headset_spans = previous ? previous->headset : kNone;
-    auto work = [&](double ms) {
-        const double end = coRunEnd(hs, ms, server_spans, headset_slowdown);
-        if (log)
-            logSpan(log->headset, hs, end);
-        busy += end - hs;
-        hs = end;
-    };
-    auto serverWork = [&](double start, double ms) {
-        const double end = coRunEnd(start, ms, headset_spans, server_slowdown);
-        if (log)
-            logSpan(log->server, start, end);
-        return end;
-    };
+    void makePolicy();
+    void work(double ms);
+    double serverWork(double start, double ms);
+    double bitsPerPx(const WorkloadFrame& wf, double scale, bool outer) const;
+    double drawn(int64_t j, const LayerPlan& plan, int eye, int kind, double rings_both_eyes,
+                 double scale) const;
+    std::vector<LayerJob> layerJobs(int64_t j, const FrameState& fs, const WorkloadFrame& wf) const;
+    double sendLayer(int64_t j, FrameState& fs, LayerJob& job, double t);
+    void serve(int64_t j, double start);
+    void advanceServer(double until);
+    void decodeNext();
+    void pump();
+    void decideLayers(FrameState& fs, RuntimeFrame& rf, const WorkloadFrame& wf);
+    void prepare(int64_t i);
+    void renderFovea(int64_t i);
+    bool waitForStreams(int64_t i);
+    void composeAndScanOut(int64_t i, bool have_current);
+    void learn(int64_t i);
+    void finish(int64_t i);
 
-    // Bits per layer pixel at scale s: the calibration's law when it has one, else the trace's.
-    auto bitsPerPx = [&](const WorkloadFrame& wf, double scale, bool outer) {
-        if (c.bits_per_px_at_1 > 0.0)
-            return c.bitsPerPx(scale, outer);
-        return bitsPerPixelAt(header, wf, scale);
-    };
-    // Pixels UCA reads (every layer of both eyes at its own resolution).
-    auto layerPixels = [](const LayerPlan& plan) {
-        double px = 0.0;
-        for (const EyeLayers& e : plan.eyes)
-            px += double(e.fovea.pixels() + e.middle.pixels() + e.outer.pixels());
-        return px;
-    };
-
-    // Triangles a layer draws (kind 0 fovea, 1 middle, 2 outer; eye 0/1): the caller's count of
-    // what the renderer submits when it has one, else the BVH rings of the trace.
-    auto drawn = [&](int64_t j, const LayerPlan& plan, int eye, int kind, double rings_both_eyes,
-                     double scale) {
-        if (config.layer_triangles)
-            return config.layer_triangles(j, plan, eye, kind);
-        return kind == 0 ? rings_both_eyes / 2.0 : serverLayerTriangles(rings_both_eyes, scale);
-    };
-
+    const WorkloadTrace& m_trace;
+    const WorkloadHeader& m_header;
+    const RuntimeSimConfig& m_config;
+    const RuntimeCosts& m_costs;
+    const DesignTraits& m_traits;
+    Link& m_link;
+    CoRunLog* m_log;
+    const bool m_local_only, m_whole_frame, m_liwc, m_sw, m_sw_liwc;
+    const LayerPlanner m_planner;
+    const double m_eye_px;
+    const double m_period_ms;
+    const int m_n_frames;
+    const size_t m_depth;
+    const size_t m_queue_cap;
+    const double m_headset_slowdown, m_server_slowdown;
+    const std::vector<BusySpan>& m_server_spans;
+    const std::vector<BusySpan>& m_headset_spans;
     // Each stream's encoder, its canvas and key frames (docs/MODEL.md §8).
-    StreamCodecModel codecs(c);
+    StreamCodecModel m_codecs;
 
-    // Renders, encodes and sends frame j's layers from `start`.
-    auto serve = [&](int64_t j, double start) {
-        FrameState& fs = state[static_cast<size_t>(j)];
-        const WorkloadFrame& wf = trace.frames[static_cast<size_t>(j)];
-        fs.served = true;
-        ++served_frames;
-        double t = serverWork(start, c.server_frame_ms);
-        const double total_tris = sumTotal(wf.triangles_per_ring);
-        std::vector<LayerJob> jobs;
-        if (whole_frame) {
-            const double bpp = c.bits_per_px_at_1 > 0.0 && c.bits_full_frame_per_px > 0.0
-                                   ? c.bits_full_frame_per_px
-                                   : bitsPerPx(wf, 1.0, false);
-            const double bytes = bpp * eye_px / 8.0;
-            // The whole frame at scale 1 is the all-local plan's fovea view, no hole.
-            for (int eye = 0; eye < 2; ++eye)
-                jobs.push_back({eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true,
-                                eye * 2, header.profile.width_px, header.profile.height_px});
-        } else {
-            // The calibration's own frame j, where this frame's head pose is the one it coded: its
-            // bits over the law (RuntimeCosts::bitsFrameFactor).
-            const uint32_t key = c.bits_frame_key.empty() ? 0u : frameContentKey(wf.head);
-            const double f_mid =
-                c.bits_per_px_at_1 > 0.0 ? c.bitsFrameFactor(size_t(j), key, false) : 1.0;
-            const double f_out =
-                c.bits_per_px_at_1 > 0.0 ? c.bitsFrameFactor(size_t(j), key, true) : 1.0;
-            const PeripheryBytes pb = {
-                2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1, false) * f_mid /
-                    8.0,
-                2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2, true) * f_out / 8.0};
-            const double mid_tris =
-                sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e2_deg);
-            for (int eye = 0; eye < 2; ++eye) {
-                const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
-                if (!e.middle.empty())
-                    jobs.push_back({double(e.middle.pixels()),
-                                    drawn(j, fs.plan, eye, 1, mid_tris, e.middle.scale),
-                                    pb.middle / 2.0, true, eye * 2, e.middle.width_px,
-                                    e.middle.height_px});
-                if (!e.outer.empty())
-                    jobs.push_back({double(e.outer.pixels()),
-                                    drawn(j, fs.plan, eye, 2, total_tris, e.outer.scale),
-                                    pb.outer / 2.0, false, eye * 2 + 1, e.outer.width_px,
-                                    e.outer.height_px});
-            }
-        }
-        for (LayerJob& job : jobs) {
-            job.bytes = codecs.bytes(job.stream, job.width, job.height, job.bytes);
-            // The codec works on the whole canvas, and its encode and decode laws are per canvas
-            // pixel: the calibration times each against its encoder's canvas. (Versions 7-16 of
-            // the model charged the layer's pixels times canvas/snug, which left out the snug
-            // canvas's own headroom and alignment, 1.2-1.4x a layer's pixels: a run's layers
-            // encoded 25-60% over the prediction.) Without the canvas model, the layer.
-            const double coded_px =
-                codecs.lastCanvasPx() > 0.0 ? codecs.lastCanvasPx() : job.pixels;
-            const double render = whole_frame
-                                      ? c.server_render.atFullFrame(job.pixels, job.triangles)
-                                      : c.server_render.at(job.pixels, job.triangles);
-            // remote's whole frame: the encode's own scale, measured on whole frames (version
-            // 17), as the render's.
-            const double encode =
-                whole_frame ? c.encode.atFullFrame(coded_px, 0.0) : c.encode.at(coded_px, 0.0);
-            fs.server_render_ms += render;
-            fs.server_encode_ms += encode;
-            fs.key_frames += codecs.lastWasKey() ? 1 : 0;
-            const double layer_start = t;
-            t = serverWork(t, render + encode);
-            server_busy_total += t - layer_start;
-            const double send = std::max(link_free, t);
-            const LinkTransfer tr = link.transfer(send, job.bytes / c.payloadShare());
-            link_free = send + tr.duration_ms;
-            Stream s;
-            s.frame = j;
-            s.rx_ms = link_free + c.link_delay_ms;
-            s.payload_bytes = job.bytes;
-            s.pixels = coded_px;
-            s.goodput_bps = tr.duration_ms > 0 ? job.bytes * 8.0 / (tr.duration_ms * 1e-3) : 0.0;
-            streams.push_back(s);
-            if (job.middle)
-                fs.middle_bytes += job.bytes;
-            else
-                fs.outer_bytes += job.bytes;
-        }
-        server_free = t;
+    LiwcPolicy* m_link_aware = nullptr;  // the policy that reads the acks at decision time
+    std::unique_ptr<FoveaPolicy> m_policy;
+    RuntimeRunResult m_result;
+    std::vector<FrameState> m_state;
+    std::vector<Stream> m_streams;  // every stream sent, in rx order (the link keeps order)
+
+    // Headset core.
+    double m_hs = 0.0;
+    double m_busy = 0.0;  // busy time since the previous frame finished
+    double m_last_e1_deg = 5.0;
+    double m_last_complete_rx_ms = 0.0;
+    // The streams the headset took from the transport (the session's start, 0 ms, before any):
+    // a server silent for a whole wait limit (or twice its spacing, if longer) makes the runtime
+    // wait one refresh instead.
+    SilenceDetector m_silence;
+    int64_t m_last_slot = -1;  // the newest scan-out's vsync slot index
+    double m_ack_goodput_bps = 0.0;
+    // Server and link.
+    std::deque<Request> m_queue;
+    double m_server_free = 0.0, m_link_free = 0.0, m_server_busy_total = 0.0;
+    int m_served_frames = 0;
+    size_t m_next_undecoded = 0;
+};
+
+// The runtime's policies (runtime/src/headset_client.cpp liwcConfig): qvr is LIWC with the
+// frame-period objective, sw the same model fed reactively.
+void PassReplay::makePolicy() {
+    auto runtimeLiwc = [&](bool reactive) {
+        LiwcConfig lc;
+        lc.learn_remote_base = m_config.liwc_learn_remote_base;
+        lc.frame_period_objective = m_config.liwc_frame_period_objective;
+        lc.reactive = reactive;
+        return std::make_unique<LiwcPolicy>(m_header, lc);
     };
+    if (m_liwc) {
+        auto p = runtimeLiwc(false);
+        m_link_aware = p.get();
+        m_policy = std::move(p);
+    } else if (m_sw_liwc) {
+        m_policy = runtimeLiwc(true);
+    } else if (m_sw) {
+        m_policy = makeSoftwareReactivePolicy(m_header);
+    } else if (m_traits.policy == "fixed") {
+        m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
+    }
+}
 
-    // Starts every queued request the server would have started by `until`.
-    auto advanceServer = [&](double until) {
-        while (!queue.empty()) {
-            const double start = std::max(server_free, queue.front().arrive_ms);
-            if (start > until)
-                break;
-            const int64_t j = queue.front().frame;
-            queue.pop_front();
-            serve(j, start);
-        }
-    };
+void PassReplay::work(double ms) {
+    const double end = coRunEnd(m_hs, ms, m_server_spans, m_headset_slowdown);
+    if (m_log)
+        logSpan(m_log->headset, m_hs, end);
+    m_busy += end - m_hs;
+    m_hs = end;
+}
 
-    // Decodes the next received stream (the transport hands them over in arrival order).
-    auto decodeNext = [&]() {
-        Stream& s = streams[next_undecoded++];
-        hs = std::max(hs, s.rx_ms);
-        work(c.decode.at(s.pixels, 0.0));
-        s.decoded = true;
-        ack_goodput_bps = s.goodput_bps;
-        FrameState& fs = state[static_cast<size_t>(s.frame)];
-        RuntimeFrame& rf = result.frames[static_cast<size_t>(s.frame)];
-        fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
-        silence.onStream(hs);
-        // A frame's bytes are what arrived for it, whenever (the runtime counts a late
-        // frame's streams too, until the frame is retired). What LIWC observes is only what
-        // came while the frame held its pending entry: until the frame after it was shown.
-        rf.bytes += s.payload_bytes;
-        if (!fs.closed)
-            fs.received_bytes += s.payload_bytes;
-        if (++fs.decoded == fs.expected) {
-            rf.remote_done_ms = hs;
-            last_complete_rx_ms = std::max(last_complete_rx_ms, fs.last_rx_ms);
-        }
-    };
+double PassReplay::serverWork(double start, double ms) {
+    const double end = coRunEnd(start, ms, m_headset_spans, m_server_slowdown);
+    if (m_log)
+        logSpan(m_log->server, start, end);
+    return end;
+}
 
-    // Takes what has arrived by now (pumpNetwork(0)).
-    auto pump = [&]() {
-        for (;;) {
-            advanceServer(hs);
-            if (next_undecoded >= streams.size() || streams[next_undecoded].rx_ms > hs)
-                break;
-            decodeNext();
-        }
-    };
+// Bits per layer pixel at scale s: the calibration's law when it has one, else the trace's.
+double PassReplay::bitsPerPx(const WorkloadFrame& wf, double scale, bool outer) const {
+    if (m_costs.bits_per_px_at_1 > 0.0)
+        return m_costs.bitsPerPx(scale, outer);
+    return bitsPerPixelAt(m_header, wf, scale);
+}
 
-    // Steps 1–3.
-    auto prepare = [&](int64_t i) {
-        RuntimeFrame& rf = result.frames[static_cast<size_t>(i)];
-        FrameState& fs = state[static_cast<size_t>(i)];
-        const WorkloadFrame& wf = trace.frames[static_cast<size_t>(i)];
-        rf.index = wf.index;
-        rf.pose_ms = hs;
-        if (!local_only)
-            pump();
-        const double decision_start = hs;
-        if (liwc || sw_liwc) {
-            // The ring counts (the runtime probes for qvr and sw): the draw clusters' cost the
-            // same at every e1 (a calibration fits no triangle slope); the BVH's reach e1 + 6°.
-            const double counted = sumWithinDeg(wf.triangles_per_ring, header.ring_deg,
-                                                last_e1_deg + 6.0 + header.ring_deg);
-            work(c.decision.at(0.0, counted));
-        }
-        if (local_only) {
-            fs.plan = planner.plan(wf.gaze, 180.0);
-            rf.e1_deg = fs.plan.cover_deg;
-        } else if (whole_frame) {
-            fs.plan = planner.plan(wf.gaze, 180.0);
-            fs.expected = 2;
-            rf.e1_deg = 0.0;
-        } else {
-            if (link_aware)
-                link_aware->setLinkEstimate(ack_goodput_bps);
-            const Decision d = policy->decide(wf);
-            last_e1_deg = d.e1_deg;
-            fs.plan = planner.plan(wf.gaze, d.e1_deg);
-            rf.e1_deg = fs.plan.e1_deg;
-            for (const EyeLayers& e : fs.plan.eyes)
-                fs.expected += (e.middle.empty() ? 0 : 1) + (e.outer.empty() ? 0 : 1);
-        }
-        rf.decision_ms = hs - decision_start;
-        if (fs.expected > 0) {
-            rf.requested = true;
-            rf.request_ms = hs;
-            advanceServer(hs);
-            queue.push_back({i, hs});
-            while (queue.size() > queue_cap) {
-                queue.pop_front();
-                ++result.summary.requests_dropped;
-            }
-        }
-    };
+// Pixels UCA reads (every layer of both eyes at its own resolution).
+double layerPixels(const LayerPlan& plan) {
+    double px = 0.0;
+    for (const EyeLayers& e : plan.eyes)
+        px += double(e.fovea.pixels() + e.middle.pixels() + e.outer.pixels());
+    return px;
+}
 
-    // Steps 4–8.
-    auto finish = [&](int64_t i) {
-        RuntimeFrame& rf = result.frames[static_cast<size_t>(i)];
-        FrameState& fs = state[static_cast<size_t>(i)];
-        const WorkloadFrame& wf = trace.frames[static_cast<size_t>(i)];
-        // 4. The fovea (the whole frame for local), one pass per eye.
-        rf.local_start_ms = hs;
-        if (!whole_frame) {
-            const double tris =
-                local_only ? sumTotal(wf.triangles_per_ring)
-                           : sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e1_deg);
-            for (int eye = 0; eye < 2; ++eye) {
-                const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
-                if (e.fovea.empty())
-                    continue;
-                const double px = double(e.fovea.pixels());
-                const double drawn_tris = drawn(i, fs.plan, eye, 0, tris, 1.0);
-                const double frags =
-                    config.fovea_fragments ? config.fovea_fragments(i, fs.plan, eye) : -1.0;
-                work(local_only ? c.fovea.atFullFrame(px, drawn_tris, frags)
-                                : c.fovea.at(px, drawn_tris, frags));
-            }
-        }
-        rf.local_end_ms = hs;
-        rf.t_local_ms = rf.local_end_ms - rf.local_start_ms;
+// Triangles a layer draws (kind 0 fovea, 1 middle, 2 outer; eye 0/1): the caller's count of what
+// the renderer submits when it has one, else the BVH rings of the trace.
+double PassReplay::drawn(int64_t j, const LayerPlan& plan, int eye, int kind,
+                         double rings_both_eyes, double scale) const {
+    if (m_config.layer_triangles)
+        return m_config.layer_triangles(j, plan, eye, kind);
+    return kind == 0 ? rings_both_eyes / 2.0 : serverLayerTriangles(rings_both_eyes, scale);
+}
 
-        // 5. Wait for this frame's streams, decoding whatever arrives.
-        bool have_current = fs.expected == 0;
-        if (fs.expected > 0) {
-            const double service_start = std::max(rf.request_ms, last_complete_rx_ms);
-            // A server that has delivered no stream for a whole wait limit: wait one refresh
-            // (the runtime's silent_server_frames, docs/RUNTIME.md step 5).
-            const bool silent = silence.silent(rf.local_end_ms, config.wait_limit_ms);
-            const double deadline =
-                silent
-                    ? std::max(rf.local_end_ms, rf.pose_ms) + period_ms
-                    : std::max({rf.local_end_ms, rf.pose_ms, service_start}) + config.wait_limit_ms;
-            for (;;) {
-                advanceServer(deadline);  // no request is sent while the headset waits
-                if (fs.decoded == fs.expected || hs >= deadline)
-                    break;
-                if (next_undecoded >= streams.size() || streams[next_undecoded].rx_ms >= deadline) {
-                    hs = std::max(hs, deadline);
-                    break;
-                }
-                decodeNext();
-            }
-            have_current = fs.decoded == fs.expected;
-            // To the last packet's arrival, as the runtime measures it (not to the decode, which
-            // waits behind the headset's own work); censored at the wait for a late frame.
-            const double end =
-                have_current ? (config.t_remote_to_decode ? rf.remote_done_ms : fs.last_rx_ms) : hs;
-            rf.t_remote_ms = std::max(0.0, end - service_start);
-        }
-        // 6. UCA with the newest pose; a late frame re-warps older layers.
-        rf.reused = !have_current;
-        // The runtime drops the pending entries of frames shown before this one.
-        for (int64_t k = i - 1; k >= 0 && !state[static_cast<size_t>(k)].closed; --k)
-            state[static_cast<size_t>(k)].closed = true;
-        rf.uca_start_ms = hs;
-        // What UCA reads: this frame's layers, or for a reused frame the older ones it re-warps
-        // (same plan shape).
-        const double uca_px = whole_frame ? 2.0 * eye_px : layerPixels(fs.plan);
-        work(c.uca.at(uca_px, 0.0) + c.frame_overhead_ms);
-        rf.uca_end_ms = hs;
-        rf.mtp_ms = rf.uca_end_ms - rf.pose_ms;
-        // 7. Scan-out at the next free vsync slot. The runtime queues the image for its slot (two
-        // images: the headset sleeps only while the previous frame still holds the other one,
-        // VsyncPacer::queueForScanout); with wait_for_vsync it blocks until the slot.
-        // Slots by index: a slot recomputed from a time is not bit-equal to the one stored.
-        int64_t slot_k = static_cast<int64_t>(std::ceil(rf.uca_end_ms / period_ms - 1e-9));
-        if (slot_k <= last_slot)
-            slot_k = last_slot + 1;
-        last_slot = slot_k;
-        const double slot = double(slot_k) * period_ms;
-        rf.display_ms = slot;
-        hs = config.wait_for_vsync ? slot : std::max(hs, slot - period_ms);
-        rf.headset_busy_ms = i > 0 ? busy : 0.0;
-        busy = 0.0;
-        if (config.record_scanout)
-            work(c.scanout_record_ms);
-        rf.served = fs.served;
-        // 8. The policy learns what the frame measured.
-        if (policy && !local_only && !whole_frame) {
-            FrameMeasurement m;
-            m.index = wf.index;
-            m.e1_deg = fs.plan.e1_deg;
-            m.t_local_ms =
-                depth > 1 && rf.headset_busy_ms > 0.0 ? rf.headset_busy_ms : rf.t_local_ms;
-            m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
-            m.triangles_local =
-                sumWithinDeg(wf.triangles_per_ring, header.ring_deg, fs.plan.e1_deg);
-            m.pixels_local = sumWithinDeg(wf.pixels_per_ring, header.ring_deg, fs.plan.e1_deg);
-            m.middle_bytes = fs.middle_bytes > 0 && fs.received_bytes > 0 ? fs.middle_bytes : 0;
-            m.outer_bytes = fs.outer_bytes > 0 && fs.received_bytes > 0 ? fs.outer_bytes : 0;
-            m.middle_pixels = 2.0 * double(fs.plan.middle_pixels);
-            m.outer_pixels = 2.0 * double(fs.plan.outer_pixels);
-            m.s1 = fs.plan.s1;
-            m.s2 = fs.plan.s2;
-            m.throughput_bps = ack_goodput_bps;
-            policy->observe(m);
-        }
-    };
+// The layers the server renders and sends for frame j, their bytes before the codec model.
+std::vector<LayerJob> PassReplay::layerJobs(int64_t j, const FrameState& fs,
+                                            const WorkloadFrame& wf) const {
+    const double total_tris = sumTotal(wf.triangles_per_ring);
+    std::vector<LayerJob> jobs;
+    if (m_whole_frame) {
+        const double bpp = m_costs.bits_per_px_at_1 > 0.0 && m_costs.bits_full_frame_per_px > 0.0
+                               ? m_costs.bits_full_frame_per_px
+                               : bitsPerPx(wf, 1.0, false);
+        const double bytes = bpp * m_eye_px / 8.0;
+        // The whole frame at scale 1 is the all-local plan's fovea view, no hole.
+        for (int eye = 0; eye < 2; ++eye)
+            jobs.push_back({m_eye_px, drawn(j, fs.plan, eye, 0, total_tris, 1.0), bytes, true,
+                            eye * 2, m_header.profile.width_px, m_header.profile.height_px});
+        return jobs;
+    }
+    // The calibration's own frame j, where this frame's head pose is the one it coded: its bits
+    // over the law (RuntimeCosts::bitsFrameFactor).
+    const uint32_t key = m_costs.bits_frame_key.empty() ? 0u : frameContentKey(wf.head);
+    const double f_mid =
+        m_costs.bits_per_px_at_1 > 0.0 ? m_costs.bitsFrameFactor(size_t(j), key, false) : 1.0;
+    const double f_out =
+        m_costs.bits_per_px_at_1 > 0.0 ? m_costs.bitsFrameFactor(size_t(j), key, true) : 1.0;
+    const PeripheryBytes pb = {
+        2.0 * double(fs.plan.middle_pixels) * bitsPerPx(wf, fs.plan.s1, false) * f_mid / 8.0,
+        2.0 * double(fs.plan.outer_pixels) * bitsPerPx(wf, fs.plan.s2, true) * f_out / 8.0};
+    const double mid_tris = sumWithinDeg(wf.triangles_per_ring, m_header.ring_deg, fs.plan.e2_deg);
+    for (int eye = 0; eye < 2; ++eye) {
+        const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
+        if (!e.middle.empty())
+            jobs.push_back({double(e.middle.pixels()),
+                            drawn(j, fs.plan, eye, 1, mid_tris, e.middle.scale), pb.middle / 2.0,
+                            true, eye * 2, e.middle.width_px, e.middle.height_px});
+        if (!e.outer.empty())
+            jobs.push_back({double(e.outer.pixels()),
+                            drawn(j, fs.plan, eye, 2, total_tris, e.outer.scale), pb.outer / 2.0,
+                            false, eye * 2 + 1, e.outer.width_px, e.outer.height_px});
+    }
+    return jobs;
+}
 
+// Renders and encodes one layer from t on the server and sends it; returns the server's time
+// after it.
+double PassReplay::sendLayer(int64_t j, FrameState& fs, LayerJob& job, double t) {
+    job.bytes = m_codecs.bytes(job.stream, job.width, job.height, job.bytes);
+    // The codec works on the whole canvas, and its encode and decode laws are per canvas pixel:
+    // the calibration times each against its encoder's canvas (the snug canvas's own headroom
+    // and alignment make it 1.2-1.4x a layer's pixels). Without the canvas model, the layer.
+    const double coded_px = m_codecs.lastCanvasPx() > 0.0 ? m_codecs.lastCanvasPx() : job.pixels;
+    const double render = m_whole_frame
+                              ? m_costs.server_render.atFullFrame(job.pixels, job.triangles)
+                              : m_costs.server_render.at(job.pixels, job.triangles);
+    // remote's whole frame: the encode's own scale, measured on whole frames, as the render's.
+    const double encode = m_whole_frame ? m_costs.encode.atFullFrame(coded_px, 0.0)
+                                        : m_costs.encode.at(coded_px, 0.0);
+    fs.server_render_ms += render;
+    fs.server_encode_ms += encode;
+    fs.key_frames += m_codecs.lastWasKey() ? 1 : 0;
+    const double layer_start = t;
+    t = serverWork(t, render + encode);
+    m_server_busy_total += t - layer_start;
+    const double send = std::max(m_link_free, t);
+    const LinkTransfer tr = m_link.transfer(send, job.bytes / m_costs.payloadShare());
+    m_link_free = send + tr.duration_ms;
+    Stream s;
+    s.frame = j;
+    s.rx_ms = m_link_free + m_costs.link_delay_ms;
+    s.payload_bytes = job.bytes;
+    s.pixels = coded_px;
+    s.goodput_bps = tr.duration_ms > 0 ? job.bytes * 8.0 / (tr.duration_ms * 1e-3) : 0.0;
+    m_streams.push_back(s);
+    if (job.middle)
+        fs.middle_bytes += job.bytes;
+    else
+        fs.outer_bytes += job.bytes;
+    return t;
+}
+
+// Renders, encodes and sends frame j's layers from `start`.
+void PassReplay::serve(int64_t j, double start) {
+    FrameState& fs = m_state[static_cast<size_t>(j)];
+    const WorkloadFrame& wf = m_trace.frames[static_cast<size_t>(j)];
+    fs.served = true;
+    ++m_served_frames;
+    double t = serverWork(start, m_costs.server_frame_ms);
+    std::vector<LayerJob> jobs = layerJobs(j, fs, wf);
+    for (LayerJob& job : jobs)
+        t = sendLayer(j, fs, job, t);
+    m_server_free = t;
+}
+
+// Starts every queued request the server would have started by `until`.
+void PassReplay::advanceServer(double until) {
+    while (!m_queue.empty()) {
+        const double start = std::max(m_server_free, m_queue.front().arrive_ms);
+        if (start > until)
+            break;
+        const int64_t j = m_queue.front().frame;
+        m_queue.pop_front();
+        serve(j, start);
+    }
+}
+
+// Decodes the next received stream (the transport hands them over in arrival order).
+void PassReplay::decodeNext() {
+    Stream& s = m_streams[m_next_undecoded++];
+    m_hs = std::max(m_hs, s.rx_ms);
+    work(m_costs.decode.at(s.pixels, 0.0));
+    s.decoded = true;
+    m_ack_goodput_bps = s.goodput_bps;
+    FrameState& fs = m_state[static_cast<size_t>(s.frame)];
+    RuntimeFrame& rf = m_result.frames[static_cast<size_t>(s.frame)];
+    fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
+    m_silence.onStream(m_hs);
+    // A frame's bytes are what arrived for it, whenever (the runtime counts a late frame's
+    // streams too, until the frame is retired). What LIWC observes is only what came while the
+    // frame held its pending entry: until the frame after it was shown.
+    rf.bytes += s.payload_bytes;
+    if (!fs.closed)
+        fs.received_bytes += s.payload_bytes;
+    if (++fs.decoded == fs.expected) {
+        rf.remote_done_ms = m_hs;
+        m_last_complete_rx_ms = std::max(m_last_complete_rx_ms, fs.last_rx_ms);
+    }
+}
+
+// Takes what has arrived by now (pumpNetwork(0)).
+void PassReplay::pump() {
+    for (;;) {
+        advanceServer(m_hs);
+        if (m_next_undecoded >= m_streams.size() || m_streams[m_next_undecoded].rx_ms > m_hs)
+            break;
+        decodeNext();
+    }
+}
+
+// Step 2: the frame's plan and the streams it waits for.
+void PassReplay::decideLayers(FrameState& fs, RuntimeFrame& rf, const WorkloadFrame& wf) {
+    if (m_local_only) {
+        fs.plan = m_planner.plan(wf.gaze, 180.0);
+        rf.e1_deg = fs.plan.cover_deg;
+    } else if (m_whole_frame) {
+        fs.plan = m_planner.plan(wf.gaze, 180.0);
+        fs.expected = 2;
+        rf.e1_deg = 0.0;
+    } else {
+        if (m_link_aware)
+            m_link_aware->setLinkEstimate(m_ack_goodput_bps);
+        const Decision d = m_policy->decide(wf);
+        m_last_e1_deg = d.e1_deg;
+        fs.plan = m_planner.plan(wf.gaze, d.e1_deg);
+        rf.e1_deg = fs.plan.e1_deg;
+        for (const EyeLayers& e : fs.plan.eyes)
+            fs.expected += (e.middle.empty() ? 0 : 1) + (e.outer.empty() ? 0 : 1);
+    }
+}
+
+// Steps 1–3.
+void PassReplay::prepare(int64_t i) {
+    RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
+    FrameState& fs = m_state[static_cast<size_t>(i)];
+    const WorkloadFrame& wf = m_trace.frames[static_cast<size_t>(i)];
+    rf.index = wf.index;
+    rf.pose_ms = m_hs;
+    if (!m_local_only)
+        pump();
+    const double decision_start = m_hs;
+    if (m_liwc || m_sw_liwc) {
+        // The ring counts (the runtime probes for qvr and sw): the draw clusters' cost the same
+        // at every e1 (a calibration fits no triangle slope); the BVH's reach e1 + 6°.
+        const double counted = sumWithinDeg(wf.triangles_per_ring, m_header.ring_deg,
+                                            m_last_e1_deg + 6.0 + m_header.ring_deg);
+        work(m_costs.decision.at(0.0, counted));
+    }
+    decideLayers(fs, rf, wf);
+    rf.decision_ms = m_hs - decision_start;
+    if (fs.expected > 0) {
+        rf.requested = true;
+        rf.request_ms = m_hs;
+        advanceServer(m_hs);
+        m_queue.push_back({i, m_hs});
+        while (m_queue.size() > m_queue_cap) {
+            m_queue.pop_front();
+            ++m_result.summary.requests_dropped;
+        }
+    }
+}
+
+// 4. The fovea (the whole frame for local), one pass per eye.
+void PassReplay::renderFovea(int64_t i) {
+    RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
+    const FrameState& fs = m_state[static_cast<size_t>(i)];
+    const WorkloadFrame& wf = m_trace.frames[static_cast<size_t>(i)];
+    rf.local_start_ms = m_hs;
+    if (!m_whole_frame) {
+        const double tris =
+            m_local_only ? sumTotal(wf.triangles_per_ring)
+                         : sumWithinDeg(wf.triangles_per_ring, m_header.ring_deg, fs.plan.e1_deg);
+        for (int eye = 0; eye < 2; ++eye) {
+            const EyeLayers& e = fs.plan.eyes[static_cast<size_t>(eye)];
+            if (e.fovea.empty())
+                continue;
+            const double px = double(e.fovea.pixels());
+            const double drawn_tris = drawn(i, fs.plan, eye, 0, tris, 1.0);
+            const double frags =
+                m_config.fovea_fragments ? m_config.fovea_fragments(i, fs.plan, eye) : -1.0;
+            work(m_local_only ? m_costs.fovea.atFullFrame(px, drawn_tris, frags)
+                              : m_costs.fovea.at(px, drawn_tris, frags));
+        }
+    }
+    rf.local_end_ms = m_hs;
+    rf.t_local_ms = rf.local_end_ms - rf.local_start_ms;
+}
+
+// 5. Waits for this frame's streams, decoding whatever arrives; whether they all came.
+bool PassReplay::waitForStreams(int64_t i) {
+    RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
+    FrameState& fs = m_state[static_cast<size_t>(i)];
+    const double service_start = std::max(rf.request_ms, m_last_complete_rx_ms);
+    // A server that has delivered no stream for a whole wait limit: wait one refresh (the
+    // runtime's silent_server_frames, docs/RUNTIME.md step 5).
+    const bool silent = m_silence.silent(rf.local_end_ms, m_config.wait_limit_ms);
+    const double deadline =
+        silent ? std::max(rf.local_end_ms, rf.pose_ms) + m_period_ms
+               : std::max({rf.local_end_ms, rf.pose_ms, service_start}) + m_config.wait_limit_ms;
+    for (;;) {
+        advanceServer(deadline);  // no request is sent while the headset waits
+        if (fs.decoded == fs.expected || m_hs >= deadline)
+            break;
+        if (m_next_undecoded >= m_streams.size() || m_streams[m_next_undecoded].rx_ms >= deadline) {
+            m_hs = std::max(m_hs, deadline);
+            break;
+        }
+        decodeNext();
+    }
+    const bool have_current = fs.decoded == fs.expected;
+    // To the last packet's arrival, as the runtime measures it (not to the decode, which waits
+    // behind the headset's own work); censored at the wait for a late frame.
+    const double end =
+        have_current ? (m_config.t_remote_to_decode ? rf.remote_done_ms : fs.last_rx_ms) : m_hs;
+    rf.t_remote_ms = std::max(0.0, end - service_start);
+    return have_current;
+}
+
+// 6–7. UCA with the newest pose (a late frame re-warps older layers), then scan-out.
+void PassReplay::composeAndScanOut(int64_t i, bool have_current) {
+    RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
+    const FrameState& fs = m_state[static_cast<size_t>(i)];
+    rf.reused = !have_current;
+    // The runtime drops the pending entries of frames shown before this one.
+    for (int64_t k = i - 1; k >= 0 && !m_state[static_cast<size_t>(k)].closed; --k)
+        m_state[static_cast<size_t>(k)].closed = true;
+    rf.uca_start_ms = m_hs;
+    // What UCA reads: this frame's layers, or for a reused frame the older ones it re-warps
+    // (same plan shape).
+    const double uca_px = m_whole_frame ? 2.0 * m_eye_px : layerPixels(fs.plan);
+    work(m_costs.uca.at(uca_px, 0.0) + m_costs.frame_overhead_ms);
+    rf.uca_end_ms = m_hs;
+    rf.mtp_ms = rf.uca_end_ms - rf.pose_ms;
+    // 7. Scan-out at the next free vsync slot. The runtime queues the image for its slot (two
+    // images: the headset sleeps only while the previous frame still holds the other one,
+    // VsyncPacer::queueForScanout); with wait_for_vsync it blocks until the slot.
+    // Slots by index: a slot recomputed from a time is not bit-equal to the one stored.
+    int64_t slot_k = static_cast<int64_t>(std::ceil(rf.uca_end_ms / m_period_ms - 1e-9));
+    if (slot_k <= m_last_slot)
+        slot_k = m_last_slot + 1;
+    m_last_slot = slot_k;
+    const double slot = double(slot_k) * m_period_ms;
+    rf.display_ms = slot;
+    m_hs = m_config.wait_for_vsync ? slot : std::max(m_hs, slot - m_period_ms);
+    rf.headset_busy_ms = i > 0 ? m_busy : 0.0;
+    m_busy = 0.0;
+    if (m_config.record_scanout)
+        work(m_costs.scanout_record_ms);
+    rf.served = fs.served;
+}
+
+// 8. The policy learns what the frame measured.
+void PassReplay::learn(int64_t i) {
+    const RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
+    const FrameState& fs = m_state[static_cast<size_t>(i)];
+    const WorkloadFrame& wf = m_trace.frames[static_cast<size_t>(i)];
+    FrameMeasurement m;
+    m.index = wf.index;
+    m.e1_deg = fs.plan.e1_deg;
+    m.t_local_ms = m_depth > 1 && rf.headset_busy_ms > 0.0 ? rf.headset_busy_ms : rf.t_local_ms;
+    m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
+    m.triangles_local = sumWithinDeg(wf.triangles_per_ring, m_header.ring_deg, fs.plan.e1_deg);
+    m.pixels_local = sumWithinDeg(wf.pixels_per_ring, m_header.ring_deg, fs.plan.e1_deg);
+    m.middle_bytes = fs.middle_bytes > 0 && fs.received_bytes > 0 ? fs.middle_bytes : 0;
+    m.outer_bytes = fs.outer_bytes > 0 && fs.received_bytes > 0 ? fs.outer_bytes : 0;
+    m.middle_pixels = 2.0 * double(fs.plan.middle_pixels);
+    m.outer_pixels = 2.0 * double(fs.plan.outer_pixels);
+    m.s1 = fs.plan.s1;
+    m.s2 = fs.plan.s2;
+    m.throughput_bps = m_ack_goodput_bps;
+    m_policy->observe(m);
+}
+
+// Steps 4–8.
+void PassReplay::finish(int64_t i) {
+    renderFovea(i);
+    const bool have_current = m_state[static_cast<size_t>(i)].expected == 0 || waitForStreams(i);
+    composeAndScanOut(i, have_current);
+    if (m_policy && !m_local_only && !m_whole_frame)
+        learn(i);
+}
+
+RuntimeRunResult summarizePass(RuntimeRunResult result, const RuntimeSimConfig& config,
+                               int served_frames, double server_busy_total);
+
+RuntimeRunResult PassReplay::run() {
     std::deque<int64_t> ahead;
     int64_t next = 0;
-    for (int64_t i = 0; i < n_frames; ++i) {
-        while (ahead.size() < depth && next < n_frames) {
+    for (int64_t i = 0; i < m_n_frames; ++i) {
+        while (ahead.size() < m_depth && next < m_n_frames) {
             prepare(next);
             ahead.push_back(next++);
         }
@@ -612,21 +699,30 @@ RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig
         ahead.pop_front();
     }
     // A frame the server rendered after the headset had shown it (reused) was still served.
-    for (int64_t i = 0; i < n_frames; ++i) {
-        RuntimeFrame& rf = result.frames[static_cast<size_t>(i)];
-        const FrameState& fs = state[static_cast<size_t>(i)];
+    for (int64_t i = 0; i < m_n_frames; ++i) {
+        RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
+        const FrameState& fs = m_state[static_cast<size_t>(i)];
         rf.served = fs.served;
         rf.server_render_ms = fs.server_render_ms;
         rf.server_encode_ms = fs.server_encode_ms;
         rf.key_frames = fs.key_frames;
     }
+    return summarizePass(std::move(m_result), m_config, m_served_frames, m_server_busy_total);
+}
 
+RuntimeRunResult summarizePass(RuntimeRunResult result, const RuntimeSimConfig& config,
+                               int served_frames, double server_busy_total) {
     const int requests_dropped = result.summary.requests_dropped;
     result.summary = summarizeRuntimeFrames(result.frames, config);
     result.summary.requests_dropped = requests_dropped;
     if (served_frames > 0)
         result.summary.server_busy_ms_mean = server_busy_total / served_frames;
     return result;
+}
+
+RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig& config,
+                              Link& link, const CoRunLog* previous, CoRunLog* log) {
+    return PassReplay(trace, config, link, previous, log).run();
 }
 
 }  // namespace

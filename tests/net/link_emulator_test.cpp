@@ -9,8 +9,8 @@
 #include <cstring>
 #include <fstream>
 
+#include "qvr/core/clock.h"
 #include "qvr/core/mahimahi.h"
-#include "qvr/net/clock.h"
 
 namespace qvr::net {
 namespace {

@@ -19,7 +19,7 @@ int64_t slot(int64_t k) {
 }
 
 TEST(VsyncPacerQueue, ReturnsTheFirstSlotAtOrAfterReadyWithoutWaitingForIt) {
-    FakePacingClock clock(kStartNs);
+    FakeClock clock(kStartNs);
     VsyncPacer pacer(clock, 100.0);
     ASSERT_EQ(pacer.periodNs(), kPeriodNs);
     // Ready 3 ms in: slot 1 at 10 ms, and no sleep (slot 1 − one period = slot 0 has passed).
@@ -39,7 +39,7 @@ TEST(VsyncPacerQueue, ReturnsTheFirstSlotAtOrAfterReadyWithoutWaitingForIt) {
 }
 
 TEST(VsyncPacerQueue, NeverGivesTheSameSlotTwiceAndWaitsOnlyForTheOtherImage) {
-    FakePacingClock clock(kStartNs);
+    FakeClock clock(kStartNs);
     VsyncPacer pacer(clock, 100.0);
     clock.advanceNs(2'000'000);
     // Three frames composed back to back at 2 ms: slots 1, 2, 3. The second may start on the
@@ -58,7 +58,7 @@ TEST(VsyncPacerQueue, NeverGivesTheSameSlotTwiceAndWaitsOnlyForTheOtherImage) {
 // On random ready times: slots strictly increase, each the first at or after its frame's ready
 // time unless that one was taken, and the clock never runs past one period before the slot.
 TEST(VsyncPacerQueue, KeepsItsPromisesOnRandomReadyTimes) {
-    FakePacingClock clock(kStartNs);
+    FakeClock clock(kStartNs);
     VsyncPacer pacer(clock, 100.0);
     std::mt19937 rng(2);
     std::uniform_int_distribution<int64_t> work(0, 25'000'000);

@@ -107,7 +107,7 @@ bool glAvailable() {
 }
 
 TEST(VsyncPacer, ScansOutAtTheFirstSlotAfterReadyAndNeverTwiceInOne) {
-    FakePacingClock clock(1'000);
+    FakeClock clock(1'000);
     VsyncPacer pacer(clock, 100.0);  // 10 ms slots from t = 1000 ns
     EXPECT_EQ(pacer.waitForScanout(1'000 + 3'000'000), 1'000 + 10'000'000);
     EXPECT_EQ(clock.nowNs(), 1'000 + 10'000'000);
@@ -151,6 +151,38 @@ TEST(Runtime, QvrFramesComeFromTheServerOnACleanLink) {
     }
     EXPECT_GE(remote, 25);
     EXPECT_GE((*server)->stats().streams_sent, 100u);
+}
+
+TEST(RenderServer, StampsItsFramesOnTheInjectedClock) {
+    // A clock that never moves: every stamp the server takes is its reading.
+    FakeClock clock(7'000'000'000);
+    RenderServerConfig sc = serverConfig("none", "raw");
+    sc.clock = &clock;
+    std::atomic<int> stamped{0};
+    std::atomic<int> off_clock{0};
+    sc.on_frame = [&](const ServerFrameStamps& s) {
+        ++stamped;
+        bool ok = s.queued_ns == clock.nowNs() && s.start_ns == clock.nowNs() &&
+                  s.end_ns == clock.nowNs();
+        for (const auto& l : s.layers)
+            ok = ok && l.render_start_ns == clock.nowNs() && l.sent_ns == clock.nowNs();
+        off_clock += ok ? 0 : 1;
+    };
+    auto server = RenderServer::start(sc, world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    runOn(headsetConfig(Design::Ffr, (*server)->port(), "raw", 10));
+    (*server)->stop();
+    EXPECT_GT(stamped.load(), 0);
+    EXPECT_EQ(off_clock.load(), 0);
+    const std::vector<ServerFrameRecord> records = (*server)->frameRecords();
+    ASSERT_FALSE(records.empty());
+    for (const ServerFrameRecord& r : records) {
+        EXPECT_EQ(r.received_ns, 7'000'000'000);
+        EXPECT_EQ(r.done_ns, 7'000'000'000);
+        for (double ms : r.send_ms)
+            EXPECT_EQ(ms, 0.0);
+    }
+    EXPECT_EQ((*server)->stats().render_ms_total, 0.0);
 }
 
 TEST(Runtime, WrongKeyIsRefusedAndTheHeadsetRendersLocally) {

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string_view>
+#include <type_traits>
+#include <variant>
 
 #include "qvr/sim/hardware.h"
 
@@ -207,6 +211,100 @@ TEST(HardwareConfig, RuntimeSectionRoundTripsAndRejectsBadValues) {
         if (!r.ok()) {
             EXPECT_NE(r.error().find("bad.toml"), std::string::npos) << r.error();
         }
+    }
+}
+
+}  // namespace
+}  // namespace qvr
+
+namespace qvr {
+namespace {
+
+// A value inside the field's range that no default holds, so a key the writer drops or the reader
+// ignores shows as a difference.
+void setInRange(HardwareField::Ref ref, const HardwareField& f, int k) {
+    const double mid = f.min_value + (f.max_value - f.min_value) * (0.25 + 0.5 / (k + 3));
+    // Keys written with six significant digits get a value that has no more.
+    const bool exact = f.format == "{}";
+    const double short_mid =
+        f.max_value - f.min_value > 100.0 ? std::round(mid) : std::round(mid * 8.0) / 8.0;
+    if (double* const* v = std::get_if<double*>(&ref))
+        **v = exact ? mid : short_mid;
+    else if (int* const* i = std::get_if<int*>(&ref))
+        **i = (static_cast<int>(mid) / 2) * 2 + 2;  // even, above the minimum
+    else if (bool* const* b = std::get_if<bool*>(&ref))
+        **b = true;
+    else if (std::string* const* s = std::get_if<std::string*>(&ref))
+        **s = "key" + std::to_string(k);
+}
+
+TEST(HardwareFields, EveryFieldRoundTripsThroughTheWriterAndTheReader) {
+    HardwareConfig hw = defaultHardware(500.0);
+    int k = 0;
+    for (const HardwareField& f : hardwareFields())
+        setInRange(f.at(hw), f, k++);
+    hw.runtime.bits_frame_key = {3.0, 4294967295.0};
+    hw.runtime.bits_frame_middle = {1.25, 0.5};
+    hw.runtime.bits_frame_outer = {19.5, 0.0625};
+    hw.runtime.speed_reference_headset_ms = 9.5;  // both > 0: the speed reference is written
+    hw.runtime.speed_reference_server_ms = 21.25;
+    const std::string text = hardwareToml(hw);
+    auto back = parseHardwareConfig(text, "all.toml", 500.0);
+    ASSERT_TRUE(back.ok()) << back.error() << "\n" << text;
+    for (const HardwareField& f : hardwareFields()) {
+        HardwareConfig a = hw;
+        const HardwareField::Ref want = f.at(a), got = f.at(*back);
+        std::visit(
+            [&](auto* w) {
+                using T = std::remove_pointer_t<decltype(w)>;
+                EXPECT_EQ(*w, *std::get<T*>(got)) << f.path;
+            },
+            want);
+    }
+    // The [runtime] section alone is what the calibration writes.
+    const std::string runtime_only = hardwareToml(hw, "runtime");
+    EXPECT_EQ(runtime_only.rfind("[runtime]\npipeline = \"runtime\"\n", 0), 0u) << runtime_only;
+    EXPECT_EQ(runtime_only.find("[gpu]"), std::string::npos);
+    EXPECT_EQ(runtime_only, runtimeCostsToml(hw.runtime));
+}
+
+TEST(HardwareFields, ABadValueOfEachKindNamesItsKey) {
+    const struct {
+        const char* toml;
+        const char* key;
+    } cases[] = {
+        {"[gpu]\nv0 = 3\n", "gpu.v0"},                                    // number out of range
+        {"[uca]\ntile_px = 2.5\n", "uca.tile_px"},                        // integer not integral
+        {"[uca]\nunits = 65\n", "uca.units"},                             // integer out of range
+        {"[runtime]\ncanvas_align_px = 9\n", "runtime.canvas_align_px"},  // not even
+        {"[runtime]\npipeline = \"warp\"\n", "runtime.pipeline"},         // not a choice
+        {"[runtime]\nspeed_reference_key = 7\n", "runtime.speed_reference_key"},  // not a string
+        {"[runtime]\nbits_frame_outer = [1.0, 30.0]\n", "runtime.bits_frame_outer"},  // element
+        {"[runtime]\nbits_frame_key = [0.5]\nbits_frame_middle = [1.0]\n"
+         "bits_frame_outer = [1.0]\n",
+         "runtime.bits_frame_key"},  // not integers
+    };
+    for (const auto& c : cases) {
+        auto r = parseHardwareConfig(c.toml, "bad.toml", 500.0);
+        ASSERT_FALSE(r.ok()) << c.toml;
+        EXPECT_NE(r.error().find(c.key), std::string::npos) << r.error();
+        EXPECT_NE(r.error().find("bad.toml"), std::string::npos) << r.error();
+    }
+}
+
+TEST(HardwareFields, PathsAreUniqueAndEachReferenceIsInsideTheConfig) {
+    HardwareConfig hw;
+    const char* lo = reinterpret_cast<const char*>(&hw);
+    const char* hi = lo + sizeof(hw);
+    std::set<std::string_view> seen;
+    for (const HardwareField& f : hardwareFields()) {
+        EXPECT_TRUE(seen.insert(f.path).second) << f.path;
+        std::visit(
+            [&](auto* p) {
+                const char* c = reinterpret_cast<const char*>(p);
+                EXPECT_TRUE(c >= lo && c < hi) << f.path;
+            },
+            f.at(hw));
     }
 }
 

@@ -82,23 +82,26 @@ bool parseNumber(std::string_view s, double& out) {
     return r.ec == std::errc() && r.ptr == end && std::isfinite(out);
 }
 
+// The next space- or tab-separated token of row from position i (moved past it); empty at the
+// end of the row.
+std::string_view nextToken(std::string_view row, size_t& i) {
+    while (i < row.size() && (row[i] == ' ' || row[i] == '\t'))
+        ++i;
+    const size_t start = i;
+    while (i < row.size() && row[i] != ' ' && row[i] != '\t')
+        ++i;
+    return row.substr(start, i - start);
+}
+
 // Whitespace-separated numbers in a line, or -1 if any token is not a number.
 int countNumbers(std::string_view row) {
     int n = 0;
     size_t i = 0;
-    while (i < row.size()) {
-        while (i < row.size() && (row[i] == ' ' || row[i] == '\t'))
-            ++i;
-        if (i >= row.size())
-            break;
-        size_t j = i;
-        while (j < row.size() && row[j] != ' ' && row[j] != '\t')
-            ++j;
+    for (std::string_view token = nextToken(row, i); !token.empty(); token = nextToken(row, i)) {
         double v = 0;
-        if (!parseNumber(row.substr(i, j - i), v))
+        if (!parseNumber(token, v))
             return -1;
         ++n;
-        i = j;
     }
     return n;
 }
@@ -316,27 +319,19 @@ private:
                                               m_out.frame_count, f));
             int n = 0;
             size_t i = 0;
-            while (i < row.size()) {
-                while (i < row.size() && (row[i] == ' ' || row[i] == '\t'))
-                    ++i;
-                if (i >= row.size())
-                    break;
-                size_t j = i;
-                while (j < row.size() && row[j] != ' ' && row[j] != '\t')
-                    ++j;
+            for (std::string_view token = nextToken(row, i); !token.empty();
+                 token = nextToken(row, i)) {
                 double v = 0;
-                if (!parseNumber(row.substr(i, j - i), v) || std::fabs(v) > m_limits.max_abs_value)
+                if (!parseNumber(token, v) || std::fabs(v) > m_limits.max_abs_value)
                     return fail(line, fmt::format("frame {}: value {} '{}' is not a number within "
                                                   "±{}",
-                                                  f, n + 1, clip(row.substr(i, j - i)),
-                                                  m_limits.max_abs_value));
+                                                  f, n + 1, clip(token), m_limits.max_abs_value));
                 if (n >= m_out.channel_count)
                     return fail(line, fmt::format("frame {}: more than the {} values the "
                                                   "hierarchy's CHANNELS declare",
                                                   f, m_out.channel_count));
                 m_out.values.push_back(v);
                 ++n;
-                i = j;
             }
             if (n != m_out.channel_count)
                 return fail(line, fmt::format("frame {}: {} values, the hierarchy's CHANNELS "

@@ -72,6 +72,24 @@ Status csvRows(std::string_view text, std::string_view source, std::string_view 
     return Status::success();
 }
 
+Status forEachTimedRow(
+    std::string_view text, std::string_view source, std::string_view header, size_t columns,
+    size_t max_rows,
+    const std::function<Status(const std::vector<double>& row, int line)>& on_row) {
+    std::vector<std::vector<double>> rows;
+    std::vector<int> lines;
+    if (Status s = csvRows(text, source, header, columns, max_rows, rows, lines); !s)
+        return s;
+    for (size_t i = 0; i < rows.size(); ++i) {
+        if (i > 0 && !(rows[i][0] > rows[i - 1][0]))
+            return makeError(
+                fmt::format("{}:{}: t_ms {} does not increase", source, lines[i], rows[i][0]));
+        if (Status s = on_row(rows[i], lines[i]); !s)
+            return s;
+    }
+    return {};
+}
+
 Status writeCsvFile(const std::string& text, const std::string& path) {
     std::ofstream f(path, std::ios::binary);
     if (!f)

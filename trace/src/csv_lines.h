@@ -2,6 +2,7 @@
 // untrusted files: every field checked, every error with its line).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,12 @@ namespace qvr::detail {
 Status csvRows(std::string_view text, std::string_view source, std::string_view header,
                size_t columns, size_t max_rows, std::vector<std::vector<double>>& rows,
                std::vector<int>& lines);
+
+// csvRows, then each row in file order to `on_row` once its first column, t_ms, is checked to
+// increase from the row before; the first error stops the walk.
+Status forEachTimedRow(
+    std::string_view text, std::string_view source, std::string_view header, size_t columns,
+    size_t max_rows, const std::function<Status(const std::vector<double>& row, int line)>& on_row);
 
 // Writes a whole trace's text to path, with errors that name the file.
 Status writeCsvFile(const std::string& text, const std::string& path);

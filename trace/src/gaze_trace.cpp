@@ -29,22 +29,16 @@ Status writeGazeCsv(const GazeTrace& trace, const std::string& path) {
 }
 
 Expected<GazeTrace> parseGazeCsv(std::string_view text, std::string_view source) {
-    std::vector<std::vector<double>> rows;
-    std::vector<int> lines;
-    if (Status s = detail::csvRows(text, source, kGazeHeader, 3, kMaxRows, rows, lines); !s)
-        return makeError(s.error());
     GazeTrace trace;
-    trace.samples.reserve(rows.size());
-    for (size_t i = 0; i < rows.size(); ++i) {
-        const auto& r = rows[i];
-        if (!trace.samples.empty() && !(r[0] > trace.samples.back().t_ms))
-            return makeError(
-                fmt::format("{}:{}: t_ms {} does not increase", source, lines[i], r[0]));
+    const auto sample = [&](const std::vector<double>& r, int line) -> Status {
         if (std::fabs(r[1]) > 90.0 || std::fabs(r[2]) > 90.0)
             return makeError(
-                fmt::format("{}:{}: gaze ({}, {}) deg beyond ±90", source, lines[i], r[1], r[2]));
+                fmt::format("{}:{}: gaze ({}, {}) deg beyond ±90", source, line, r[1], r[2]));
         trace.samples.push_back({r[0], Gaze{r[1], r[2]}});
-    }
+        return {};
+    };
+    if (Status s = detail::forEachTimedRow(text, source, kGazeHeader, 3, kMaxRows, sample); !s)
+        return makeError(s.error());
     if (trace.samples.empty())
         return makeError(fmt::format("{}: no samples after the header", source));
     return trace;

@@ -129,24 +129,14 @@ Status writePoseCsv(const PoseTrace& trace, const std::string& path) {
 }
 
 Expected<PoseTrace> parsePoseCsv(std::string_view text, std::string_view source) {
-    std::vector<std::vector<double>> rows;
-    std::vector<int> lines;
-    if (Status s = detail::csvRows(text, source, kPoseHeader, 8, kMaxRows, rows, lines); !s)
-        return makeError(s.error());
     PoseTrace trace;
-    trace.samples.reserve(rows.size());
-    for (size_t i = 0; i < rows.size(); ++i) {
-        const auto& r = rows[i];
-        if (!trace.samples.empty() && !(r[0] > trace.samples.back().t_ms))
-            return makeError(
-                fmt::format("{}:{}: t_ms {} does not increase", source, lines[i], r[0]));
+    const auto sample = [&](const std::vector<double>& r, int line) -> Status {
         const double norm = std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3] + r[4] * r[4]);
         if (std::fabs(norm - 1.0) > 1e-3)
-            return makeError(
-                fmt::format("{}:{}: quaternion norm {} is not 1", source, lines[i], norm));
+            return makeError(fmt::format("{}:{}: quaternion norm {} is not 1", source, line, norm));
         for (int c = 5; c < 8; ++c) {
             if (std::fabs(r[static_cast<size_t>(c)]) > 1e6)
-                return makeError(fmt::format("{}:{}: position beyond ±1e6 m", source, lines[i]));
+                return makeError(fmt::format("{}:{}: position beyond ±1e6 m", source, line));
         }
         PoseSample s;
         s.t_ms = r[0];
@@ -156,7 +146,10 @@ Expected<PoseTrace> parsePoseCsv(std::string_view text, std::string_view source)
         s.pose.position_m =
             glm::vec3(static_cast<float>(r[5]), static_cast<float>(r[6]), static_cast<float>(r[7]));
         trace.samples.push_back(s);
-    }
+        return {};
+    };
+    if (Status s = detail::forEachTimedRow(text, source, kPoseHeader, 8, kMaxRows, sample); !s)
+        return makeError(s.error());
     if (trace.samples.empty())
         return makeError(fmt::format("{}: no poses after the header", source));
     return trace;

@@ -105,6 +105,8 @@ private:
     double remoteMs(const Gaze& gaze, double e1_deg) const;
     // frame_period_objective: the server's part and the transmission, separately.
     double transmissionMs(const Gaze& gaze, double e1_deg) const;
+    // Both eyes' middle and outer layers' bits at e1 (0 once the fovea covers the frame).
+    double peripheryBits(const Gaze& gaze, double e1_deg) const;
     double peripheryTriangles(double e1_deg) const;
     double peripheryPixels(const Gaze& gaze, double e1_deg) const;
     Decision decidePeriod(const WorkloadFrame& frame, double lo, double hi);

@@ -168,6 +168,13 @@ private:
     static constexpr size_t kMaxHeldPerStream = 16;
 
     void accept(const MediaPacketView& packet, int64_t now_ns);
+    bool trackSequence(Stream& s, const MediaHeader& h, int64_t now_ns);
+    void onGap(Stream& s, const MediaHeader& h, uint32_t d, int64_t now_ns);
+    void sampleLossWindow();
+    void sweepPartials(Stream& s, const MediaHeader& h, int64_t now_ns);
+    std::map<uint32_t, Partial>::iterator partialFor(Stream& s, const MediaHeader& h,
+                                                     int64_t now_ns);
+    bool store(Partial& p, const MediaPacketView& packet);
     void finish(uint8_t stream_id, uint32_t frame_id, const Partial& p);
     void complete(uint8_t stream_id, std::map<uint32_t, Partial>::iterator it);
     void tryFec(Partial& p, int block);

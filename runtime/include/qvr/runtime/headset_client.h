@@ -82,7 +82,7 @@ struct HeadsetConfig {
     // LIWC's triangle rings from the draw clusters at that level of detail (cheap, what is
     // drawn) or, when false, from the scene's BVH (every triangle, cost growing with e1).
     bool cluster_ring_counts = true;
-    PacingClock* clock = nullptr;  // steady clock when null
+    Clock* clock = nullptr;  // steady clock when null
     DisplaySink* display = nullptr;
     WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set
     std::function<void(int64_t frame)> before_frame;  // test hook, called at each frame start

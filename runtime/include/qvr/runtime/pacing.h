@@ -1,45 +1,18 @@
 // The display clock of the headset (paper Fig. 4: UCA runs once per refresh with the newest
-// pose): a clock seam with a steady and a fake implementation, and the vsync pacer built on it.
+// pose): the vsync pacer on the clock seam (qvr/core/clock.h).
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 
+#include "qvr/core/clock.h"
+
 namespace qvr::runtime {
-
-class PacingClock {
-public:
-    virtual ~PacingClock() = default;
-    virtual int64_t nowNs() const = 0;
-    // Returns at or after deadline_ns (at once if it has passed).
-    virtual void sleepUntilNs(int64_t deadline_ns) = 0;
-};
-
-// std::chrono::steady_clock, the one clock of all telemetry in a process.
-class SteadyPacingClock final : public PacingClock {
-public:
-    int64_t nowNs() const override;
-    void sleepUntilNs(int64_t deadline_ns) override;
-    static SteadyPacingClock& instance();
-};
-
-// Time moves only when told to, or when someone sleeps: tests of pacing are exact.
-class FakePacingClock final : public PacingClock {
-public:
-    explicit FakePacingClock(int64_t start_ns = 0) : m_now_ns(start_ns) {}
-    int64_t nowNs() const override { return m_now_ns.load(); }
-    void sleepUntilNs(int64_t deadline_ns) override;
-    void advanceNs(int64_t dt_ns) { m_now_ns += dt_ns; }
-
-private:
-    std::atomic<int64_t> m_now_ns;
-};
 
 // Vsync slots at origin + k·period. A frame whose composition finished at t is scanned out at
 // the first slot at or after t; a frame that missed its slot waits for the next (no tearing).
 class VsyncPacer {
 public:
-    VsyncPacer(PacingClock& clock, double refresh_hz);
+    VsyncPacer(Clock& clock, double refresh_hz);
     // Starts the slot grid at the clock's now.
     void reset();
     int64_t periodNs() const { return m_period_ns; }
@@ -55,7 +28,7 @@ public:
     int64_t lastScanoutNs() const { return m_last_scanout_ns; }
 
 private:
-    PacingClock& m_clock;
+    Clock& m_clock;
     int64_t m_period_ns;
     int64_t m_origin_ns = 0;
     int64_t m_last_scanout_ns = -1;

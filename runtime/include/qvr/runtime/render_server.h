@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "qvr/codec/video_codec.h"
+#include "qvr/core/clock.h"
 #include "qvr/core/expected.h"
 #include "qvr/foveation/hmd_profile.h"
 #include "qvr/net/server.h"
@@ -50,6 +51,8 @@ struct RenderServerConfig {
     CodecConfig codec;
     RendererFactory renderer = glRendererFactory();
     int core = -1;  // pin the render thread to this core (-1: no pinning)
+    // The clock of the server's stamps and times (steady clock when null; tests pass a fake).
+    Clock* clock = nullptr;
     // Requests waiting per headset; a newer request pushes the oldest out (it would be late).
     size_t max_pending_requests = 2;
     // Render an eye's middle and outer layers in one geometry pass (render/periphery_pass.h)

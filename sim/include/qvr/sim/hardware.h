@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "qvr/core/expected.h"
@@ -270,46 +271,48 @@ struct HardwareConfig {
 // The defaults of docs/MODEL.md at a given GPU clock.
 HardwareConfig defaultHardware(double gpu_mhz = 500.0);
 
+// One key of the hardware file: its dotted path, where it lives in HardwareConfig, the values it
+// accepts and how and when the writer writes it. hardwareFields() is the file's grammar, in the
+// order the writer writes it: parseHardwareConfig and hardwareToml both walk it, so a key is
+// added in one place.
+struct HardwareField {
+    // runtime.pipeline is the one bool: "paper" (false) or "runtime" (true).
+    using Ref = std::variant<double*, int*, bool*, std::string*, std::vector<double>*>;
+    // When hardwareToml writes the key: always; when the value is > 0 (0: not measured, and the
+    // reader refuses it); with the frame-by-frame bits (bits_frame_key not empty); with a speed
+    // reference (both probe times > 0).
+    enum class Written { kAlways, kWhenPositive, kWithFrameBits, kWithSpeedReference };
+    // A check beyond the range: an even integer, an array of integers.
+    enum class Check { kNone, kEven, kIntegers };
+
+    std::string_view path;                    // "section.key"
+    double min_value = 0.0, max_value = 0.0;  // numbers, integers and array elements
+    Ref (*at)(HardwareConfig&) = nullptr;
+    std::string_view format = "{}";  // fmt format of one value (of each element of an array)
+    Written written = Written::kAlways;
+    Check check = Check::kNone;
+    double max_count = 0.0;  // arrays: at most this many values
+};
+const std::vector<HardwareField>& hardwareFields();
+
 // Overrides of the defaults from TOML, so a researcher can ask about another headset without
-// recompiling. Every key is optional; unknown keys and out-of-range values are errors. The clock
-// stays a command-line choice (`--gpu-mhz`), since `qvr eval` sweeps it. Grammar:
-//   [gpu]     triangles_per_ms_at_500, pixels_per_ms_at_500 (1…1e9), setup_ms (0…100),
-//             texture_units (1…1024), samples_per_unit_per_cycle (0.01…64),
-//             pass_overhead_ms, preempt_overhead_ms (0…100), atw_samples_per_px,
-//             comp_samples_per_px, static_comp_samples_per_px (0…16),
-//             dynamic_power_w_at_500, static_power_w_at_500 (0…100), v0 (0…2), v_per_mhz (0…0.01)
-//   [uca]     units (1…64), freq_mhz (1…10000),
-//             cycles_per_tile (1…1e6), tile_px (4…256), power_w (0…100)
-//   [liwc]    decision_ms (0…100), power_w (0…100)
-//   [remote]  server_speedup (0.01…1e6), encoder_px_per_ms, decoder_px_per_ms (1…1e9),
-//             decode_overhead_ms (0…100)
-//   [cpu]     control_logic_ms, local_setup_ms, software_control_ms (0…1000)
-//   [latency] sensor_ms, display_ms (0…1000)
-//   [runtime] pipeline ("paper" or "runtime"); every cost in ms, 0…10000:
-//             decision_base_ms, decision_ms_per_ktri, fovea_base_ms, fovea_ms_per_mpx,
-//             fovea_ms_per_ktri, fovea_power_coef_ms, fovea_px_exponent, fovea_tri_exponent
-//             (−4…4), fovea_full_frame_scale (0.01…100), decode_base_ms, decode_ms_per_mpx,
-//             uca_base_ms, uca_ms_per_mpx, frame_overhead_ms, scanout_record_ms,
-//             bits_per_px_at_1 (0…100),
-//             bits_scale_exponent (−4…4), bits_outer_per_px_at_1 (0…100),
-//             bits_outer_scale_exponent (−4…4), bits_full_frame_per_px (0…100),
-//             server_render_base_ms, server_render_ms_per_mpx, server_render_ms_per_ktri,
-//             server_render_power_coef_ms, server_render_px_exponent, server_render_tri_exponent
-//             (−4…4), server_render_full_frame_scale (0.01…100), encode_base_ms, encode_ms_per_mpx,
-//             encode_full_frame_scale (0.01…100), server_frame_ms, link_delay_ms;
-//             packet_payload_bytes (1…65536), packet_overhead_bytes (0…65536); canvas_align_px
-//             (2…256, even), canvas_headroom (0…1), canvas_shrink_ratio (0…1),
-//             canvas_shrink_after_frames (1…100000), keyint_frames (0…100000), keyframe_bits_ratio,
-//             keyframe_outer_bits_ratio, keyframe_periodic_bits_ratio (0…1000), padding_bits_ratio
-//             (0…10), corun_slowdown, corun_headset_slowdown, corun_server_slowdown (1…4);
-//             bits_frame_key (arrays of integers 0…2^32−1), bits_frame_middle, bits_frame_outer
-//             (arrays of 0.05…20), as long as one another, at most 100000
+// recompiling. Every key is optional; unknown keys and out-of-range values are errors naming the
+// key. The clock stays a command-line choice (`--gpu-mhz`), since `qvr eval` sweeps it. The
+// sections are [gpu], [uca], [liwc], [remote], [cpu], [latency] (the paper's hardware, keys named
+// as HardwareConfig's members) and [runtime] (pipeline = "paper" or "runtime", and RuntimeCosts:
+// every cost in ms within 0…10000, a PartCost's key its part and member, e.g. fovea_ms_per_mpx;
+// canvas_align_px even; bits_frame_key integers, as long as bits_frame_middle and
+// bits_frame_outer). Each key's range is its row in hardwareFields() (hardware.cpp).
 Expected<HardwareConfig> parseHardwareConfig(std::string_view toml_text,
                                              std::string_view source_name, double gpu_mhz);
 Expected<HardwareConfig> loadHardwareConfig(const std::string& path, double gpu_mhz);
 
-// The [runtime] section for these costs (pipeline = "runtime"), in the grammar above; what
-// `qvr calibrate` writes.
+// The hardware file for `hw`, every key hardwareFields() writes, or only those of one section
+// ("runtime"); parseHardwareConfig reads it back to `hw` (calibrated costs kept to six
+// significant digits).
+std::string hardwareToml(const HardwareConfig& hw, std::string_view only_section = {});
+
+// The [runtime] section for these costs (pipeline = "runtime"): what `qvr calibrate` writes.
 std::string runtimeCostsToml(const RuntimeCosts& costs);
 
 }  // namespace qvr
