@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reads claim_matrix.sh's runs and writes matrix.md / matrix.json: per condition the median
 (and min-max) over three runs of displayed FPS and MTP p99 for ffr, sw, qvr and the best fixed
-e1 (chosen from run 1's sweep), and the ratios issue 15 asks for."""
+e1 (chosen from run 1's sweep), and the ratios."""
 import json
 import os
 import statistics

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The fault matrix (issue 12): `qvr server` and `qvr client` on loopback under one fault each,
+"""The fault matrix: `qvr server` and `qvr client` on loopback under one fault each,
 measured from the client's own telemetry.
 
 For every case a fresh server (the link emulator on its media egress set by the case's --net

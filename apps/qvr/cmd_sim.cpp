@@ -214,8 +214,15 @@ static Registered registerSim(CLI::App& app) {
     cmd->add_option("--bench", o->bench,
                     "Synthetic suite workload: " + suiteBenchNamesList() +
                         " (the 'synthetic-' prefix may be left out)");
+    // --bench is parsed first, so with both given the one message says which to drop.
     cmd->add_option("--trace", o->trace, "Workload trace file (JSON lines) instead of --bench")
-        ->check(readableFile());
+        ->check(CLI::Validator(
+            [o](std::string& path) -> std::string {
+                if (!o->bench.empty())
+                    return "give exactly one of --bench NAME or --trace FILE";
+                return readableFile()(path);
+            },
+            "FILE", "FILE"));
     cmd->add_option("--design", o->design,
                     "System design: " + designNamesList() +
                         " (local baseline, remote-only, static collaborative, fixed 5-deg fovea, "

@@ -1,4 +1,4 @@
-// The OpenCV two-pass anchor (issue 4): composition with cv::remap + cv::blendLinear into a
+// The OpenCV two-pass anchor: composition with cv::remap + cv::blendLinear into a
 // full-resolution eye buffer, then the lens + timewarp map and one more cv::remap.
 #include "qvr/compose/opencv_two_pass.h"
 

@@ -1,4 +1,4 @@
-// PSNR and SSIM over the fovea and the periphery of a display image (issue 4's quality measure
+// PSNR and SSIM over the fovea and the periphery of a display image (the quality measure
 // for UCA, paper §4.2). SSIM uses 7×7 box windows kept as running sums, so memory stays O(width).
 #include "qvr/compose/quality.h"
 

@@ -1,4 +1,4 @@
-// The analytic test pattern, its layers and the double-precision ground-truth warp (issue 4's
+// The analytic test pattern, its layers and the double-precision ground-truth warp (the
 // quality measure for UCA, paper §4.2).
 #include "qvr/compose/test_pattern.h"
 

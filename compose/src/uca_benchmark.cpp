@@ -1,4 +1,4 @@
-// `qvr bench uca`'s measurement (issue 4): medians of UCA, the two-pass reference and the OpenCV
+// `qvr bench uca`'s measurement: medians of UCA, the two-pass reference and the OpenCV
 // anchor interleaved in one run, the copy-bandwidth floor for UCA's bytes, and image quality.
 #include "qvr/compose/uca_benchmark.h"
 

@@ -31,7 +31,7 @@ inline double msSince(CalibrationClock::time_point t0) {
 // (150 frames at 90 Hz, 1.7 s). In an enclosed level the BVH counts almost the whole scene in
 // every view, so what a layer costs depends on what it sees at its level of detail, which the
 // cost's features do not capture: other seconds of the motion mispredict the room's periphery
-// layers by 2x (docs/MODEL.md §8).
+// layers by 2x (docs/MODEL.md §9).
 inline double poseTimeMs(int k) {
     return 50.0 + 290.0 * k;
 }

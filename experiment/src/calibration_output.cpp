@@ -141,7 +141,7 @@ std::string bitsByFrameText(const RuntimeCosts& c) {
 
 std::string Calibration::toToml() const {
     std::string s = fmt::format(
-        "# qvr calibrate: this machine's runtime costs (docs/MODEL.md §8).\n# {}\n# {}, {:.0f} s, "
+        "# qvr calibrate: this machine's runtime costs (docs/MODEL.md §9).\n# {}\n# {}, {:.0f} s, "
         "load average {:.2f} before\n",
         command, date, seconds, load_avg_before);
     s += "# machine: " + machine + "\n";

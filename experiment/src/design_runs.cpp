@@ -268,8 +268,8 @@ std::optional<RunError> DesignRunner::start(const RuntimeCosts& calibrated) {
     // The machine's speed before each design and after the last, on the headset's core while
     // the server waits between sessions: the run reports how far the probes moved, warns when
     // they moved much, and predicts each design a second time with its costs at the ratio of the
-    // probes around it to the calibration's reference (docs/MODEL.md §8 "The machine's speed at
-    // the run" says why it is not the prediction).
+    // probes around it to the calibration's reference (docs/MODEL.md §11 says why
+    // it is not the prediction).
     m_speed_probe = makeSpeedProbe(m_plan, calibrated, m_m.speed_note);
     m_m.recorder =
         std::make_unique<ScanoutRecorder>(m_profile, m_plan.video_max_frames, m_plan.fovea_border);

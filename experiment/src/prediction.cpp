@@ -241,7 +241,7 @@ LayerTrianglesFn makeLayerTriangles(const RunOptions& plan, const HmdProfile& pr
 
 // The fragments a design's fovea pass shaded at frame k, as its own run's headset counted them
 // (FrameTelemetry::fovea_fragments, both eyes): the overdraw the fovea law charges (docs/
-// MODEL.md §8, "Fragments"). A count of the content at that pose and e1, as the triangles are,
+// MODEL.md §9). A count of the content at that pose and e1, as the triangles are,
 // not a time. Where the model's e1 differs from the run's (LIWC's choices), the run's fragments
 // per fovea pixel times the model's pixels; none counted: −1, the law's mean.
 FoveaFragmentsFn foveaFragmentsOf(const DesignRun& run, const HmdProfile& profile,
@@ -329,7 +329,7 @@ PredictionWorkload predictionWorkload(const RunOptions& plan, const HmdProfile& 
         "per pixel from the calibration ({} of {} frames their own, coded by the calibration "
         "on the same head pose; the rest its law); layer triangles drawn (LOD, holes) counted "
         "off the clock; the fovea's shaded fragments as each design's own passes counted them "
-        "(a count, not a time: its overdraw, docs/MODEL.md §8 \"Fragments\")",
+        "(a count, not a time: its overdraw, docs/MODEL.md §9)",
         plan.ring_counts,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
         w.bits_frames_own, predict_frames);

@@ -375,7 +375,7 @@ std::string validationHtml(const RunOutcome& o) {
     std::string h =
         "<h2>Measured against the simulator</h2>\n<p>Prediction for this run's frames. "
         "<b>calibrated</b>: the runtime pipeline model "
-        "(docs/MODEL.md §8) with this machine's costs, " +
+        "(docs/MODEL.md §8–12) with this machine's costs, " +
         report::htmlEscape(calibrationNote(o)) +
         ". <b>paper hardware</b>: the paper's pipeline on its modelled mobile GPU and server "
         "(the default of <code>qvr eval</code>), for reference, not this machine. <b>at the "

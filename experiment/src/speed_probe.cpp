@@ -47,8 +47,8 @@ SpeedProbe::~SpeedProbe() = default;
 Expected<std::unique_ptr<SpeedProbe>> SpeedProbe::make(const CalibrateOptions& o) {
     // A process of its own, pinned to o.core, the same at the calibration and at the run: in
     // the calibrating process's renderer the probe read the headset frame up to 8% slower than
-    // in the run's process, where the run's stages were not faster (docs/MODEL.md §8 "The
-    // machine's speed at the run").
+    // in the run's process, where the run's stages were not faster (docs/MODEL.md
+    // §11).
     auto child = CoRunLoad::start(o, std::max(o.core, 0), "probe");
     if (!child)
         return makeError("speed probe: " + child.error());

@@ -287,7 +287,7 @@ private:
     const double m_headset_slowdown, m_server_slowdown;
     const std::vector<BusySpan>& m_server_spans;
     const std::vector<BusySpan>& m_headset_spans;
-    // Each stream's encoder, its canvas and key frames (docs/MODEL.md §8).
+    // Each stream's encoder, its canvas and key frames (docs/MODEL.md §10).
     StreamCodecModel m_codecs;
 
     LiwcPolicy* m_link_aware = nullptr;  // the policy that reads the acks at decision time

@@ -119,7 +119,7 @@ grep -q "remote never showed a layer from the server" "$tmp/never_err.txt" || {
 python3 -c "import json,sys; d=json.load(open(sys.argv[1])); assert d['designs']['remote']['startup_unfinished'] is True" \
     "$tmp/never/summary.json" || { echo "FAIL: startup_unfinished not set"; exit 1; }
 echo "PASS: a run whose server never reached the screen exits 1 and says so"
-# The machine's speed at the run (docs/MODEL.md §8): a calibration holds the speed probe's
+# The machine's speed at the run (docs/MODEL.md §11): a calibration holds the speed probe's
 # reference; a run on the same key probes before and after each design and puts beside the
 # prediction a second one with that design's costs at the ratio. A file without a reference, or
 # with another machine's, gets no probes and says why.

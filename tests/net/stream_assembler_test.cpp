@@ -282,7 +282,7 @@ TEST(NetStreamAssembler, RetransmitModeDeclaresLossByTime) {
 // A frame larger than the link carries in the loss timeout is not lost while it keeps coming:
 // a 40-packet key frame at one packet per 20 ms (0.8 s, ~2 Mbit/s) completes. Counted from its
 // first packet, it was lost at 100 ms, and so was every key frame asked for in its place: no
-// remote frame at all arrived on the ATT trace (docs/MODEL.md §8, the remote-on-ATT cell).
+// remote frame at all arrived on the ATT trace (docs/MODEL.md §13, the remote-on-ATT cell).
 TEST(NetStreamAssembler, RetransmitModeKeepsAFrameThatIsStillArriving) {
     AssemblerLimits limits;
     limits.retransmit = true;

@@ -1,4 +1,4 @@
-// The external anchor of issue 4: the two-pass path (compose, then timewarp) as a user would
+// The external anchor: the two-pass path (compose, then timewarp) as a user would
 // write it with OpenCV's cv::remap and cv::blendLinear. Bench-only; built with QVR_WITH_OPENCV.
 #pragma once
 

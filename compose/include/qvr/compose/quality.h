@@ -1,4 +1,4 @@
-// Image quality of a display image against its ground truth (issue 4's measure of UCA, paper
+// Image quality of a display image against its ground truth (the measure of UCA, paper
 // §4.2): PSNR and SSIM, separately over the fovea (eccentricity ≤ e1) and the periphery.
 #pragma once
 

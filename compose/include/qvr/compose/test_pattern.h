@@ -1,4 +1,4 @@
-// The analytic test pattern that judges UCA against the two-pass path (issue 4, paper §4.2):
+// The analytic test pattern that judges UCA against the two-pass path (paper §4.2):
 // sharp edges, text-like strokes one or two pixels wide, and gradients, defined on the
 // full-resolution eye image so that every layer and the ground truth derive from one function.
 #pragma once

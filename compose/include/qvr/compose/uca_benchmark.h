@@ -1,4 +1,4 @@
-// The measurement behind `qvr bench uca` (issue 4, paper §4.2): UCA, the two-pass reference and
+// The measurement behind `qvr bench uca` (paper §4.2): UCA, the two-pass reference and
 // the OpenCV anchor on one frame of the test pattern, timed in the same run, against the memory
 // bandwidth floor for UCA's bytes and against the double-precision ground truth.
 #pragma once

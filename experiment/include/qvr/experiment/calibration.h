@@ -92,7 +92,7 @@ int runCoRunLoad(const CalibrateOptions& options, const std::string& mix);
 // thread's core, their medians. `qvr calibrate` takes it three times over its measurement and
 // keeps the mean as the hardware file's speed reference; `qvr run` takes it before and after
 // each design, reports how far it moved, and predicts each design a second time with its costs
-// at the ratio (docs/MODEL.md §8 "The machine's speed at the run"). Nothing in it is a run's
+// at the ratio (docs/MODEL.md §11). Nothing in it is a run's
 // measurement.
 class SpeedProbe {
 public:

@@ -1,5 +1,5 @@
 // The display video's recorder (`qvr run --video`), shared by `qvr run` and `qvr calibrate`,
-// which times its per-frame copy as a part of the headset (scanout_record_ms, docs/MODEL.md §8).
+// which times its per-frame copy as a part of the headset (scanout_record_ms, docs/MODEL.md §9).
 #pragma once
 
 #include <algorithm>

@@ -2,7 +2,7 @@
 // calibrate`, apart from every run), then `qvr run` runs every design under each condition —
 // links × scenes × pipeline depths, a few repetitions — and predicts it with its repetition's
 // calibration; the sheet tabulates the signed prediction errors with their mean absolute and
-// worst values (docs/MODEL.md §8).
+// worst values (docs/MODEL.md §12).
 //
 // A plan in (planValidation), its steps taken through a ChildRunner (executeValidation), a
 // result out (ValidationResult), the sheet from the result (validationMarkdown,

@@ -78,7 +78,7 @@ Expected<RenderStats> renderLayer(Renderer& renderer, const HmdProfile& profile,
 // the OpenGL renderer's primitives-generated query counts), without a device: the draw list's
 // selection for the layer's view, level of detail and hole. `list` is buildDrawList() of the
 // uploaded scene, with buildLods() when lod_error_px > 0, as the renderer makes it. The
-// calibration fits render costs on it and the runtime model charges it (docs/MODEL.md §8).
+// calibration fits render costs on it and the runtime model charges it (docs/MODEL.md §9).
 uint64_t layerTriangles(const DrawList& list, const HmdProfile& profile, const LayerPlan& plan,
                         const Pose& head, Eye eye, LayerKind kind, float lod_error_px,
                         const CameraOptions& options = {}, const LayerHoles& holes = {});

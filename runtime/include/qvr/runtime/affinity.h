@@ -1,5 +1,5 @@
-// Pinning the headset and the server each to its own core (issue 6: the headset's budget is not
-// the server's). Threads a pinned thread creates (llvmpipe's rasterizers, x264) inherit the mask.
+// Pinning the headset and the server each to its own core (the headset's budget is not the
+// server's). Threads a pinned thread creates (llvmpipe's rasterizers, x264) inherit the mask.
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// The headset's compute share (issue 15): the paper's server is far stronger than its headset
+// The headset's compute share: the paper's server is far stronger than its headset
 // (Table 4 runs the headset GPU at 500, 400 and 300 MHz); here both sides get one identical
 // core, so the headset's process is given a fraction of its core through the kernel's CFS
 // bandwidth control — a cgroup's quota per period. A short period (10 ms) spreads the

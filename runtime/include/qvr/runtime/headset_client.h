@@ -73,8 +73,8 @@ struct HeadsetConfig {
     // pipeline_depth frames, requested before any completed, never reach the policy's fits.)
     int warmup_frames = 0;
     // Scan-out: false queues the composed frame for its vsync slot and goes on with the next
-    // (a two-image swapchain, VsyncPacer::queueForScanout); true waits for the slot first, as
-    // until 2026-11-23 (one frame's composition never overlaps the previous one's scan-out).
+    // (a two-image swapchain, VsyncPacer::queueForScanout); true waits for the slot first
+    // (one frame's composition never overlaps the previous one's scan-out).
     bool wait_for_vsync = false;
     // The level of detail the fovea is drawn at (its renderer's lod_error_px): LIWC's triangle
     // rings count what that level draws.

@@ -1,4 +1,4 @@
-// Per-frame telemetry of the headset, every stage on one clock (issue 6, paper Fig. 4): pose
+// Per-frame telemetry of the headset, every stage on one clock (paper Fig. 4): pose
 // sample, decision, local render, request, each stream received and decoded, UCA, scan-out.
 #pragma once
 
@@ -46,7 +46,7 @@ struct FrameTelemetry {
     double t_remote_pred_ms = 0.0;
     double probe_ms = 0.0;  // the pre-render triangle-ring count (LIWC's input)
     // The headset's decodes of this frame's streams, the calls alone (the picture out of the
-    // decoder, in RGBA): what the model charges as decode (docs/MODEL.md §8).
+    // decoder, in RGBA): what the model charges as decode (docs/MODEL.md §9).
     double decode_ms = 0.0;
     double uca_ms = 0.0;
     // The headset's busy time for this frame (its decision, fovea, decodes, UCA, bookkeeping:
@@ -59,7 +59,7 @@ struct FrameTelemetry {
     double warp_deg = 0.0;
     // The fragments its fovea (or whole-frame) passes shaded, both eyes (RenderStats::
     // fragment_invocations; 0 where the driver does not count them): the workload's overdraw,
-    // which the calibrated model charges the fovea by (docs/MODEL.md §8, "Fragments").
+    // which the calibrated model charges the fovea by (docs/MODEL.md §9).
     double fovea_fragments = 0.0;
 };
 

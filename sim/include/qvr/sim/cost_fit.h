@@ -1,5 +1,5 @@
 // Fitting one part's cost (hardware.h PartCost) to timed micro-benchmark samples: what
-// `qvr calibrate` does for every part of the runtime (docs/MODEL.md §8).
+// `qvr calibrate` does for every part of the runtime (docs/MODEL.md §9).
 #pragma once
 
 #include <vector>

@@ -91,7 +91,7 @@ struct FixedLatencies {
 
 // One part's cost in ms for a pass over `pixels` drawing `triangles`: the linear law
 // a + b·Mpx + c·ktri, or, when power_coef_ms > 0, the power law k·Mpx^p·ktri^q (llvmpipe's
-// fovea pass is not linear in either over 3 kpx … 4 Mpx: MODEL.md §8). A whole frame (local's
+// fovea pass is not linear in either over 3 kpx … 4 Mpx: MODEL.md §9). A whole frame (local's
 // pass, remote's layer) costs full_frame_scale × the law: the law is fitted to the fovea and
 // periphery layers, the whole frame is measured on its own. `qvr calibrate` fits all of it.
 struct PartCost {
@@ -103,7 +103,7 @@ struct PartCost {
     double tri_exponent = 0.0;
     double full_frame_scale = 1.0;
     // > 0: the linear law also charges the fragments the pass shades (its overdraw), per million
-    // (calibration version 16, docs/MODEL.md §8 "Fragments"). A pass whose fragments are not
+    // (docs/MODEL.md §9). A pass whose fragments are not
     // known (< 0) is charged frag_per_px of them per pixel, the calibration samples' mean.
     double ms_per_mfrag = 0.0;
     double frag_per_px = 0.0;
@@ -140,7 +140,7 @@ struct RuntimeCosts {
     double bits_per_px_at_1 = 0.0;
     double bits_scale_exponent = 0.0;
     // The outer layer's own law (bits_outer_per_px_at_1 > 0); 0: the one above for both. At the
-    // same scale the outer layer takes ~0.6× the middle's bits per pixel (measured, MODEL.md §8).
+    // same scale the outer layer takes ~0.6× the middle's bits per pixel (measured, MODEL.md §9).
     double bits_outer_per_px_at_1 = 0.0;
     double bits_outer_scale_exponent = 0.0;
     // remote's whole frame (one layer per eye at scale 1), measured on its own (> 0); 0: the
@@ -159,7 +159,7 @@ struct RuntimeCosts {
     // Frame by frame, on the calibration's own motion: bits_frame_key[k] is frame k's content
     // key (frameContentKey of its head pose, 0: none measured) and
     // bits_frame_middle[k] / bits_frame_outer[k] what its periphery layers spent over the law
-    // (calibration version 15, docs/MODEL.md §8 "Bits frame by frame"). Empty: the law alone.
+    // (docs/MODEL.md §10). Empty: the law alone.
     std::vector<double> bits_frame_key;
     std::vector<double> bits_frame_middle;
     std::vector<double> bits_frame_outer;
@@ -205,12 +205,12 @@ struct RuntimeCosts {
     // The two cores at once: work on one side while the other side is busy takes this many
     // times as long as alone (both sides slow alike; measured by `qvr calibrate` as a layer
     // render's median with a second core rendering without pause over its median alone). 1: the
-    // sides do not disturb each other. docs/MODEL.md §8 "Co-running".
+    // sides do not disturb each other. docs/MODEL.md §11.
     double corun_slowdown = 1.0;
     // Per side (0: corun_slowdown for that side): the headset's work (fovea, decodes, UCA) while
     // the server works, and the server's (layer renders, read-back, encodes) while the headset
     // works. Their mixes differ in what they ask of the memory both cores share, so each is
-    // measured beside the other's mix (calibration version 12; docs/MODEL.md §8 "Co-running").
+    // measured beside the other's mix (docs/MODEL.md §11).
     double corun_headset_slowdown = 0.0;
     double corun_server_slowdown = 0.0;
     double headsetCoRun() const {
@@ -222,12 +222,12 @@ struct RuntimeCosts {
     double payloadShare() const {
         return packet_payload_bytes / (packet_payload_bytes + packet_overhead_bytes);
     }
-    // The machine's speed when the costs above were measured (calibration version 14): the
+    // The machine's speed when the costs above were measured: the
     // median of a fixed headset frame and a fixed server frame (a speed probe, `qvr calibrate`
     // SpeedProbe) over the calibration, 0: not measured. speed_reference_key names what the
     // probe ran (scene, profile, codec, level of detail): a probe at run time on the same key
     // says how much faster or slower the machine is than when it was calibrated
-    // (docs/MODEL.md §8 "The machine's speed at the run").
+    // (docs/MODEL.md §11).
     double speed_reference_headset_ms = 0.0;
     double speed_reference_server_ms = 0.0;
     std::string speed_reference_key;

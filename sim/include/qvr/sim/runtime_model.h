@@ -64,7 +64,7 @@ struct RuntimeSimConfig {
     // The fragments one eye's fovea (or whole-frame) pass shades for frame `frame` under `plan`
     // (RenderStats::fragment_invocations), < 0 where not known: the fovea law then charges its
     // pixels at the calibration's fragments per pixel. Empty: none known. `qvr run` gives the
-    // counts its headset's own passes made (docs/MODEL.md §8, "Fragments").
+    // counts its headset's own passes made (docs/MODEL.md §9).
     std::function<double(int64_t frame, const LayerPlan& plan, int eye)> fovea_fragments;
 };
 
@@ -159,7 +159,7 @@ RuntimeSummary summarizeRuntimeFrames(const std::vector<RuntimeFrame>& frames,
 // (costs.headsetCoRun(), costs.serverCoRun()) the replay runs more than once: each pass slows the
 // headset's work where the previous pass had the server busy, by the headset's factor, and the
 // server's where it had the headset busy, by the server's (a fixed point of the two cores' mutual
-// slowdown, docs/MODEL.md §8 "Co-running"); `link` must then time every transfer from its start
+// slowdown, docs/MODEL.md §11); `link` must then time every transfer from its start
 // alone, as makeRuntimeLink's do.
 RuntimeRunResult simulateRuntime(const WorkloadTrace& trace, const RuntimeSimConfig& config,
                                  Link& link);
