@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "qvr/core/shell_quote.h"
+
 #include "qvr/experiment/validation.h"
 #include "qvr/runtime/server_process.h"
 
@@ -13,13 +15,6 @@ namespace qvr::experiment {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string shellQuote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s)
-        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-}
 
 // A scene or link as a file name: its last 40 characters, [A-Za-z0-9-] kept, the rest '_'.
 std::string safeName(const std::string& s) {

@@ -6,18 +6,13 @@
 
 #include <fmt/format.h>
 
+#include "qvr/core/shell_quote.h"
+
 namespace qvr::report {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string shellQuote(const std::string& s) {
-    std::string out = "'";
-    for (char c : s)
-        out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return out + "'";
-}
 
 // gnuplot string literal in single quotes: a quote is doubled.
 std::string gnuplotQuote(const std::string& s) {
