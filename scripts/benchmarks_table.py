@@ -111,12 +111,15 @@ def run_table(summary):
 
 
 def eval_headlines(eval_dir):
-    """(metric, paper, ours) of `qvr eval`: summary.json's "headlines" if it has them, else the
-    "Headline figures" table of report.html."""
+    """(metric, paper, faithful, fitted) of `qvr eval`: summary.json's "headlines" if it has them,
+    else the "Headline figures" table of report.html (fitted is "" where the report has no
+    fitted column; a column after fitted, the mechanism behind a fitted figure, is left out)."""
     summary = read_json(Path(eval_dir) / "summary.json")
     if isinstance(summary.get("headlines"), list):
         return [
-            (h["metric"], f"{h['paper']:.2f}{h.get('unit', '')}", f"{h['ours']:.2f}{h.get('unit', '')}")
+            (h["metric"], f"{h['paper']:.2f}{h.get('unit', '')}",
+             f"{h['ours']:.2f}{h.get('unit', '')}",
+             f"{h['fitted']:.2f}{h.get('unit', '')}" if "fitted" in h else "")
             for h in summary["headlines"]
         ]
     report = Path(eval_dir) / "report.html"
@@ -132,7 +135,9 @@ def eval_headlines(eval_dir):
         cells = [html.unescape(re.sub(r"<[^>]+>", "", c)).strip()
                  for c in re.findall(r"<td[^>]*>(.*?)</td>", row, re.S)]
         if len(cells) == 3:
-            out.append(tuple(cells))
+            out.append((*cells, ""))
+        elif len(cells) >= 4:  # paper, faithful, fitted, then the mechanism of a fitted figure
+            out.append(tuple(cells[:4]))
     if not out:
         fail(f"{report}'s headline table has no rows")
     return out
@@ -187,9 +192,10 @@ def block(run_dir, eval_dir, note):
                          f"{100 * ratios['qvr_bytes_saved_vs_remote']:.1f}%")
         lines += ["", "; ".join(parts) + "."]
     lines += ["", f"`{eval_command(eval_dir)}` — the simulator on the paper's hardware, "
-              "the paper's headline figures beside ours:", "",
-              "| headline | paper | ours |", "|---|---|---|"]
-    lines += [f"| {m} | {p} | {o} |" for m, p, o in eval_headlines(eval_dir)]
+              "the paper's headline figures beside the faithful model's and the fitted variant's "
+              "(docs/EVAL.md):", "",
+              "| headline | paper | faithful | fitted |", "|---|---|---|---|"]
+    lines += [f"| {m} | {p} | {o} | {f} |" for m, p, o, f in eval_headlines(eval_dir)]
     lines += ["", MARK_END]
     return "\n".join(lines)
 
