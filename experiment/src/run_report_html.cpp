@@ -132,10 +132,11 @@ std::string validationRows(const DesignResult& d) {
         const bool e1 = r.metric == Metric::kE1;
         const std::string err_cell = e1 ? fmtCell(d.error->e1_deg_abs, "{:+.1f}°")
                                         : fmtCell(d.error->pctOf(r.metric), "{:+.1f}%");
-        const std::optional<double> at_speed_err =
-            !at_speed ? std::nullopt
-            : e1      ? std::optional(d.error_at_probe_speed->e1_deg_abs)
-                      : d.error_at_probe_speed->pctOf(r.metric);
+        std::optional<double> at_speed_err;
+        if (at_speed && e1)
+            at_speed_err = d.error_at_probe_speed->e1_deg_abs;
+        else if (at_speed)
+            at_speed_err = d.error_at_probe_speed->pctOf(r.metric);
         h += fmt::format(
             "<tr>{}<td style='text-align:left'>{}</td><td>{}</td><td>{}</td><td>{}</td>"
             "<td>{}</td><td>{}</td><td>{}</td></tr>\n",
