@@ -133,7 +133,7 @@ for name, x in d["designs"].items():
     assert "headset_factor" not in x["speed"] and "predicted_at_probe_speed" not in x, name
 print("PASS: a calibration without a speed reference gets no probes, and says so")
 PY
-if ! timeout 120 "$QVR" calibrate --quick --profile small --out "$tmp/small.toml" >"$tmp/cal.txt" 2>&1; then
+if ! timeout 300 "$QVR" calibrate --quick --profile small --out "$tmp/small.toml" >"$tmp/cal.txt" 2>&1; then
     echo "FAIL: qvr calibrate --quick --profile small: $(tail -c 600 "$tmp/cal.txt")"
     exit 1
 fi
@@ -155,7 +155,7 @@ print("PASS: the calibration keeps its bits frame by frame (middle %.3f-%.3f of 
 PY
 # A probe that cannot start (its core does not exist) leaves the file without a reference, and
 # the calibration says why; the costs are still measured.
-if ! timeout 120 "$QVR" calibrate --quick --profile small --core 4095 --out "$tmp/noprobe.toml" \
+if ! timeout 300 "$QVR" calibrate --quick --profile small --core 4095 --out "$tmp/noprobe.toml" \
     >"$tmp/noprobe.txt" 2>&1; then
     echo "FAIL: calibrate with a probe that cannot start: $(tail -c 600 "$tmp/noprobe.txt")"
     exit 1
