@@ -21,7 +21,7 @@ else
     ctest --preset "$preset" -j "$(nproc)"
 fi
 # The sanitizer suite (docs/FUZZING.md §Sanitizers): after the default one, so a plain failure
-# is reported before the ~25 minutes the asan build and suite take. Soaks stay out of it.
+# is reported before the asan build and suite. Soaks stay out of it.
 if [ "$preset" = dev ] && [ "${QVR_SANITIZERS:-1}" != 0 ]; then
     cmake --preset asan
     cmake --build --preset asan -j "$(nproc)"
