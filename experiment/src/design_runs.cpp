@@ -233,10 +233,12 @@ private:
 };
 
 std::optional<RunError> DesignRunner::start(const RuntimeCosts& calibrated) {
-    // Two cores: the headset on core 0, the server's render thread on the last core.
-    m_m.cores = onlineCores();
-    m_m.client_core = 0;
-    m_m.server_core = m_m.cores > 1 ? m_m.cores - 1 : -1;
+    // Two cores: the headset on the first core this process may use, the server's render thread
+    // on the last one (the mask, not 0…N−1: under taskset or a cpuset those cores differ).
+    const std::vector<int> cores = allowedCores();
+    m_m.cores = static_cast<int>(cores.size());
+    m_m.client_core = cores.front();
+    m_m.server_core = cores.size() > 1 ? cores.back() : -1;
     auto server = startServer(m_plan, m_key, m_m.server_core);
     if (auto* error = std::get_if<RunError>(&server))
         return *error;

@@ -11,6 +11,7 @@
 #include <sched.h>
 #include <sys/types.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -91,6 +92,20 @@ TEST(Affinity, APinToACoreThatDoesNotExistSaysWhyAndChangesNothing) {
         EXPECT_EQ(cpusOf(0), before);
     }
     EXPECT_EQ(cpusOf(0), before);
+}
+
+TEST(Affinity, AllowedCoresFollowTheMaskNotTheOnlineCount) {
+    const std::set<int> before = cpusOf(0);
+    const std::vector<int> all = allowedCores();
+    EXPECT_EQ(std::set<int>(all.begin(), all.end()), before);
+    EXPECT_TRUE(std::is_sorted(all.begin(), all.end()));
+    const int last = *before.rbegin();
+    {
+        ScopedThreadPin pin(last);
+        ASSERT_TRUE(pin.error().empty()) << pin.error();
+        EXPECT_EQ(allowedCores(), std::vector<int>{last});
+    }
+    EXPECT_EQ(allowedCores(), all);
 }
 
 }  // namespace
