@@ -79,26 +79,35 @@ BENCHMARK(BM_Uca)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-void BM_TwoPass(benchmark::State& state) {
+// The two-pass baselines' common loop: a Composer made from the profile and the thread count,
+// then `pass(composer, scene, out)` once an iteration, which reports a status.
+template <typename Composer, typename Pass>
+void benchTwoPass(benchmark::State& state, Pass pass) {
     const Scene& s = scene();
     ComposeOptions o;
     o.threads = static_cast<int>(state.range(0));
-    Compositor c(s.profile, o);
+    Composer composer(s.profile, o);
     std::array<ImageRgba8, 2> out;
     for (auto _ : state) {
-        auto r = c.composeTwoPass(s.frame, s.display, out);
+        const auto status = pass(composer, s, out);
         benchmark::DoNotOptimize(out[0].data());
-        if (!r)
-            state.SkipWithError(r.error().c_str());
+        if (!status)
+            state.SkipWithError(status.error().c_str());
     }
     report(state, s);
 }
-BENCHMARK(BM_TwoPass)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+
+// One and two threads, in milliseconds of wall-clock time.
+void threadCounts(benchmark::internal::Benchmark* b) {
+    b->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+void BM_TwoPass(benchmark::State& state) {
+    benchTwoPass<Compositor>(state, [](Compositor& c, const Scene& s, auto& out) {
+        return c.composeTwoPass(s.frame, s.display, out);
+    });
+}
+BENCHMARK(BM_TwoPass)->Apply(threadCounts);
 
 // The bandwidth floor's yardstick: a copy far larger than the caches on one thread; bytes are
 // read + written, so UCA's floor is its bytes divided by this rate.
@@ -117,25 +126,11 @@ BENCHMARK(BM_CopyBandwidth)->Unit(benchmark::kMillisecond);
 
 #if defined(QVR_COMPOSE_HAVE_OPENCV)
 void BM_OpenCvTwoPass(benchmark::State& state) {
-    const Scene& s = scene();
-    ComposeOptions o;
-    o.threads = static_cast<int>(state.range(0));
-    OpenCvTwoPass anchor(s.profile, o);
-    std::array<ImageRgba8, 2> out;
-    for (auto _ : state) {
-        Status st = anchor.run(s.frame, s.display, out);
-        benchmark::DoNotOptimize(out[0].data());
-        if (!st)
-            state.SkipWithError(st.error().c_str());
-    }
-    report(state, s);
+    benchTwoPass<OpenCvTwoPass>(state, [](OpenCvTwoPass& anchor, const Scene& s, auto& out) {
+        return anchor.run(s.frame, s.display, out);
+    });
 }
-BENCHMARK(BM_OpenCvTwoPass)
-    ->ArgName("threads")
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+BENCHMARK(BM_OpenCvTwoPass)->Apply(threadCounts);
 #endif
 
 }  // namespace

@@ -76,34 +76,47 @@ bool ConfigReader::has(std::string_view path) const {
     return static_cast<bool>(m_table.at_path(path).node());
 }
 
-double ConfigReader::number(std::string_view path, double default_value, double min_value,
-                            double max_value) {
+const toml::node* ConfigReader::present(std::string_view path, TypeTest is_type,
+                                        const char* type_name) {
     markUsed(path);
-    const auto node = m_table.at_path(path);
-    if (!node)
-        return default_value;
-    std::optional<double> v = node.value<double>();
-    if (!v || !(node.is_floating_point() || node.is_integer())) {
-        fail(fmt::format("'{}' must be a number", path));
-        return default_value;
+    const toml::node* node = m_table.at_path(path).node();
+    if (node == nullptr)
+        return nullptr;
+    if (!(node->*is_type)()) {
+        fail(fmt::format("'{}' must be {}", path, type_name));
+        return nullptr;
+    }
+    return node;
+}
+
+std::optional<double> ConfigReader::rangedNumber(const toml::node& node, const std::string& label,
+                                                 double min_value, double max_value) {
+    const std::optional<double> v = node.value<double>();
+    if (!v || !node.is_number()) {
+        fail(fmt::format("{} must be a number", label));
+        return std::nullopt;
     }
     if (!std::isfinite(*v) || *v < min_value || *v > max_value) {
-        fail(fmt::format("'{}' = {} is outside [{}, {}]", path, *v, min_value, max_value));
-        return default_value;
+        fail(fmt::format("{} = {} is outside [{}, {}]", label, *v, min_value, max_value));
+        return std::nullopt;
     }
-    return *v;
+    return v;
+}
+
+double ConfigReader::number(std::string_view path, double default_value, double min_value,
+                            double max_value) {
+    const toml::node* node = present(path, &toml::node::is_number, "a number");
+    if (node == nullptr)
+        return default_value;
+    return rangedNumber(*node, fmt::format("'{}'", path), min_value, max_value)
+        .value_or(default_value);
 }
 
 int ConfigReader::integer(std::string_view path, int default_value, int min_value, int max_value) {
-    markUsed(path);
-    const auto node = m_table.at_path(path);
-    if (!node)
+    const toml::node* node = present(path, &toml::node::is_integer, "an integer");
+    if (node == nullptr)
         return default_value;
-    if (!node.is_integer()) {
-        fail(fmt::format("'{}' must be an integer", path));
-        return default_value;
-    }
-    const int64_t v = *node.value<int64_t>();
+    const int64_t v = *node->value<int64_t>();
     if (v < min_value || v > max_value) {
         fail(fmt::format("'{}' = {} is outside [{}, {}]", path, v, min_value, max_value));
         return default_value;
@@ -112,46 +125,27 @@ int ConfigReader::integer(std::string_view path, int default_value, int min_valu
 }
 
 std::string ConfigReader::string(std::string_view path, std::string default_value) {
-    markUsed(path);
-    const auto node = m_table.at_path(path);
-    if (!node)
-        return default_value;
-    if (!node.is_string()) {
-        fail(fmt::format("'{}' must be a string", path));
-        return default_value;
-    }
-    return *node.value<std::string>();
+    const toml::node* node = present(path, &toml::node::is_string, "a string");
+    return node != nullptr ? *node->value<std::string>() : default_value;
 }
 
 std::vector<double> ConfigReader::numbers(std::string_view path, double min_value, double max_value,
                                           size_t max_count) {
-    markUsed(path);
-    const auto node = m_table.at_path(path);
-    if (!node)
+    const toml::node* node = present(path, &toml::node::is_array, "an array of numbers");
+    if (node == nullptr)
         return {};
-    const toml::array* arr = node.as_array();
-    if (!arr) {
-        fail(fmt::format("'{}' must be an array of numbers", path));
-        return {};
-    }
-    if (arr->size() > max_count) {
-        fail(fmt::format("'{}' has {} values, more than {}", path, arr->size(), max_count));
+    const toml::array& arr = *node->as_array();
+    if (arr.size() > max_count) {
+        fail(fmt::format("'{}' has {} values, more than {}", path, arr.size(), max_count));
         return {};
     }
     std::vector<double> out;
-    out.reserve(arr->size());
-    for (size_t i = 0; i < arr->size(); ++i) {
-        const toml::node& e = *arr->get(i);
-        std::optional<double> v = e.value<double>();
-        if (!v || !(e.is_floating_point() || e.is_integer())) {
-            fail(fmt::format("'{}'[{}] must be a number", path, i));
+    out.reserve(arr.size());
+    for (size_t i = 0; i < arr.size(); ++i) {
+        const auto v =
+            rangedNumber(*arr.get(i), fmt::format("'{}'[{}]", path, i), min_value, max_value);
+        if (!v)
             return {};
-        }
-        if (!std::isfinite(*v) || *v < min_value || *v > max_value) {
-            fail(fmt::format("'{}'[{}] = {} is outside [{}, {}]", path, i, *v, min_value,
-                             max_value));
-            return {};
-        }
         out.push_back(*v);
     }
     return out;

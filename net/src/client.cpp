@@ -44,31 +44,6 @@ void add(AssemblerStats& a, const AssemblerStats& b) {
     a.fec_failures += b.fec_failures;
 }
 
-const char* byeText(ByeReason r) {
-    switch (r) {
-        case ByeReason::kNormal:
-            return "closed the session";
-        case ByeReason::kAuthFailed:
-            return "refused the pre-shared key";
-        case ByeReason::kProtocolError:
-            return "reported a protocol error";
-        case ByeReason::kServerFull:
-            return "is full";
-        case ByeReason::kTimeout:
-            return "timed out the handshake";
-        case ByeReason::kVersionMismatch:
-            return "refused our protocol version";
-        case ByeReason::kCodecMismatch:
-            return "refused our codec (codec mismatch)";
-        case ByeReason::kProfileMismatch:
-            return "refused our display profile (profile mismatch)";
-        case ByeReason::kRouteUnverified:
-            return "could not verify that we receive media at our UDP port (no probe arrived or "
-                   "none was answered: a firewall or NAT in the way?)";
-    }
-    return "said bye";
-}
-
 AssemblerLimits limitsOf(const ClientOptions& o) {
     AssemblerLimits limits = o.assembler;
     limits.retransmit = o.retransmit;
@@ -168,7 +143,7 @@ struct Client::Impl::Handshake {
 
     // Why the server said bye; a refusal of our version or settings is counted as permanent.
     Error byeError(ByeReason reason) {
-        std::string text = "the server " + std::string(byeText(reason));
+        std::string text = "the server " + std::string(byeReasonClientText(reason));
         if (reason == ByeReason::kVersionMismatch || reason == ByeReason::kCodecMismatch ||
             reason == ByeReason::kProfileMismatch) {
             countIncompatible();
@@ -445,7 +420,7 @@ void Client::Impl::readControl(Connection& c) {
             std::lock_guard lock(mutex);
             throughput_bps = static_cast<double>(report->throughput_bps);
         } else if (const auto* bye = std::get_if<Bye>(&r.message)) {
-            fail(c, makeError(std::string("the server ") + byeText(bye->reason)));
+            fail(c, makeError("the server " + std::string(byeReasonClientText(bye->reason))));
             return;
         }
         readControl(c);

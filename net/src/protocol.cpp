@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 
 #include <sodium.h>
 
 #include "bytes.h"
 #include "qvr/core/check.h"
+#include "qvr/core/enum_table.h"
 #include "qvr/net/fec.h"
 
 namespace qvr::net {
@@ -270,58 +272,58 @@ std::string profileTextOf(const SessionSettings& s) {
     return (name.empty() ? std::string("(unspecified)") : name) + numbers;
 }
 
+namespace {
+
+// A bye reason's name (logs, summaries) and what the server did, as the client tells its user
+// after "the server ".
+struct ByeReasonRow {
+    ByeReason value;
+    const char* name;
+    const char* client_text;
+};
+
+constexpr ByeReasonRow kByeReasons[] = {
+    {ByeReason::kNormal, "normal", "closed the session"},
+    {ByeReason::kAuthFailed, "auth failed", "refused the pre-shared key"},
+    {ByeReason::kProtocolError, "protocol error", "reported a protocol error"},
+    {ByeReason::kServerFull, "server full", "is full"},
+    {ByeReason::kTimeout, "handshake timeout", "timed out the handshake"},
+    {ByeReason::kVersionMismatch, "protocol version mismatch", "refused our protocol version"},
+    {ByeReason::kCodecMismatch, "codec mismatch", "refused our codec (codec mismatch)"},
+    {ByeReason::kProfileMismatch, "display profile mismatch",
+     "refused our display profile (profile mismatch)"},
+    {ByeReason::kRouteUnverified, "media port not verified",
+     "could not verify that we receive media at our UDP port (no probe arrived or none was "
+     "answered: a firewall or NAT in the way?)"}};
+static_assert(std::size(kByeReasons) == kMaxByeReason + 1u);
+
+constexpr EnumName<WireError> kWireErrors[] = {{WireError::kNone, "none"},
+                                               {WireError::kTruncated, "truncated"},
+                                               {WireError::kOversized, "oversized"},
+                                               {WireError::kBadMagic, "bad magic"},
+                                               {WireError::kWrongVersion, "wrong version"},
+                                               {WireError::kUnknownType, "unknown type"},
+                                               {WireError::kBadField, "field out of range"},
+                                               {WireError::kTrailingBytes, "trailing bytes"},
+                                               {WireError::kBadMac, "bad MAC"},
+                                               {WireError::kWrongSession, "wrong session"},
+                                               {WireError::kReplayed, "replayed"},
+                                               {WireError::kUnsealed, "unsealed"}};
+static_assert(std::size(kWireErrors) == kWireErrorCount);
+
+}  // namespace
+
 std::string_view byeReasonName(ByeReason r) {
-    switch (r) {
-        case ByeReason::kNormal:
-            return "normal";
-        case ByeReason::kAuthFailed:
-            return "auth failed";
-        case ByeReason::kProtocolError:
-            return "protocol error";
-        case ByeReason::kServerFull:
-            return "server full";
-        case ByeReason::kTimeout:
-            return "handshake timeout";
-        case ByeReason::kVersionMismatch:
-            return "protocol version mismatch";
-        case ByeReason::kCodecMismatch:
-            return "codec mismatch";
-        case ByeReason::kProfileMismatch:
-            return "display profile mismatch";
-        case ByeReason::kRouteUnverified:
-            return "media port not verified";
-    }
-    return "?";
+    return enumName(kByeReasons, r);
+}
+
+std::string_view byeReasonClientText(ByeReason r) {
+    const ByeReasonRow* row = enumRow(kByeReasons, r);
+    return row != nullptr ? row->client_text : "said bye";
 }
 
 std::string_view wireErrorName(WireError e) {
-    switch (e) {
-        case WireError::kNone:
-            return "none";
-        case WireError::kTruncated:
-            return "truncated";
-        case WireError::kOversized:
-            return "oversized";
-        case WireError::kBadMagic:
-            return "bad magic";
-        case WireError::kWrongVersion:
-            return "wrong version";
-        case WireError::kUnknownType:
-            return "unknown type";
-        case WireError::kBadField:
-            return "field out of range";
-        case WireError::kTrailingBytes:
-            return "trailing bytes";
-        case WireError::kBadMac:
-            return "bad MAC";
-        case WireError::kWrongSession:
-            return "wrong session";
-        case WireError::kReplayed:
-            return "replayed";
-        case WireError::kUnsealed:
-            return "unsealed";
-    }
-    return "?";
+    return enumName(kWireErrors, e);
 }
 
 uint64_t DropCounters::total() const {

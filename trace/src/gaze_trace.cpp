@@ -37,18 +37,15 @@ Expected<GazeTrace> parseGazeCsv(std::string_view text, std::string_view source)
         trace.samples.push_back({r[0], Gaze{r[1], r[2]}});
         return {};
     };
-    if (Status s = detail::forEachTimedRow(text, source, kGazeHeader, 3, kMaxRows, sample); !s)
+    if (Status s =
+            detail::forEachTimedRow(text, source, kGazeHeader, 3, kMaxRows, "samples", sample);
+        !s)
         return makeError(s.error());
-    if (trace.samples.empty())
-        return makeError(fmt::format("{}: no samples after the header", source));
     return trace;
 }
 
 Expected<GazeTrace> loadGazeCsv(const std::string& path) {
-    auto text = readTextFile(path, kMaxBytes);
-    if (!text)
-        return makeError(text.error());
-    return parseGazeCsv(*text, path);
+    return detail::loadCsvFile(path, kMaxBytes, parseGazeCsv);
 }
 
 }  // namespace qvr

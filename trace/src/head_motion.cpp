@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "qvr/core/enum_table.h"
+
 namespace qvr {
 
 namespace {
@@ -18,46 +20,32 @@ const glm::dquat kBvhToQvr = glm::angleAxis(3.14159265358979323846, glm::dvec3(0
 
 constexpr double kTypicalHeight_m = 1.75;
 
+struct BvhUnitRow {
+    BvhUnit value;
+    const char* name;
+    double metres;  // 0 for kAuto, which is no length
+};
+
+constexpr BvhUnitRow kBvhUnits[] = {{BvhUnit::kAuto, "auto", 0.0},
+                                    {BvhUnit::kMetre, "m", 1.0},
+                                    {BvhUnit::kCentimetre, "cm", 0.01},
+                                    {BvhUnit::kInch, "inch", 0.0254},
+                                    {BvhUnit::kCmuAsf, "cmu", 0.0254 / 0.45}};
+
 }  // namespace
 
 double bvhUnitMetres(BvhUnit unit) {
-    switch (unit) {
-        case BvhUnit::kMetre:
-            return 1.0;
-        case BvhUnit::kCentimetre:
-            return 0.01;
-        case BvhUnit::kInch:
-            return 0.0254;
-        case BvhUnit::kCmuAsf:
-            return 0.0254 / 0.45;
-        case BvhUnit::kAuto:
-            break;
-    }
-    return 0.0;
+    const BvhUnitRow* row = enumRow(kBvhUnits, unit);
+    return row != nullptr ? row->metres : 0.0;
 }
 
 const char* bvhUnitName(BvhUnit unit) {
-    switch (unit) {
-        case BvhUnit::kAuto:
-            return "auto";
-        case BvhUnit::kMetre:
-            return "m";
-        case BvhUnit::kCentimetre:
-            return "cm";
-        case BvhUnit::kInch:
-            return "inch";
-        case BvhUnit::kCmuAsf:
-            return "cmu";
-    }
-    return "?";
+    return enumName(kBvhUnits, unit);
 }
 
 Expected<BvhUnit> bvhUnitFromName(const std::string& name) {
-    for (BvhUnit u : {BvhUnit::kAuto, BvhUnit::kMetre, BvhUnit::kCentimetre, BvhUnit::kInch,
-                      BvhUnit::kCmuAsf}) {
-        if (name == bvhUnitName(u))
-            return u;
-    }
+    if (const auto unit = enumFromName(kBvhUnits, name))
+        return *unit;
     return makeError(fmt::format("unit '{}': expected auto, m, cm, inch or cmu", name));
 }
 
@@ -77,11 +65,13 @@ BvhUnit detectBvhUnit(const BvhMotion& motion) {
     const double height = hi - lo;
     BvhUnit best = BvhUnit::kCentimetre;
     double best_err = std::numeric_limits<double>::infinity();
-    for (BvhUnit u : {BvhUnit::kMetre, BvhUnit::kCentimetre, BvhUnit::kInch, BvhUnit::kCmuAsf}) {
-        const double err = std::fabs(std::log(height * bvhUnitMetres(u) / kTypicalHeight_m));
+    for (const BvhUnitRow& unit : kBvhUnits) {
+        if (unit.metres <= 0.0)
+            continue;
+        const double err = std::fabs(std::log(height * unit.metres / kTypicalHeight_m));
         if (height > 0 && err < best_err) {
             best_err = err;
-            best = u;
+            best = unit.value;
         }
     }
     return best;

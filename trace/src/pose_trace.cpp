@@ -148,18 +148,14 @@ Expected<PoseTrace> parsePoseCsv(std::string_view text, std::string_view source)
         trace.samples.push_back(s);
         return {};
     };
-    if (Status s = detail::forEachTimedRow(text, source, kPoseHeader, 8, kMaxRows, sample); !s)
+    if (Status s = detail::forEachTimedRow(text, source, kPoseHeader, 8, kMaxRows, "poses", sample);
+        !s)
         return makeError(s.error());
-    if (trace.samples.empty())
-        return makeError(fmt::format("{}: no poses after the header", source));
     return trace;
 }
 
 Expected<PoseTrace> loadPoseCsv(const std::string& path) {
-    auto text = readTextFile(path, kMaxBytes);
-    if (!text)
-        return makeError(text.error());
-    return parsePoseCsv(*text, path);
+    return detail::loadCsvFile(path, kMaxBytes, parsePoseCsv);
 }
 
 }  // namespace qvr

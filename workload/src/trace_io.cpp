@@ -8,6 +8,7 @@
 #include <istream>
 #include <limits>
 #include <ostream>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -26,45 +27,38 @@ constexpr size_t kMaxLineBytes = size_t{4} << 20;
 struct FieldReader {
     std::string error;
 
-    bool number(const json& obj, const char* key, double& out, double lo, double hi,
-                bool required = true) {
+    // A number in [lo, hi] (an integer when T is one); absent is an error only when required.
+    template <typename T>
+    bool ranged(const json& obj, const char* key, T& out, T lo, T hi, bool required) {
+        constexpr bool kInteger = std::is_integral_v<T>;
         const auto it = obj.find(key);
         if (it == obj.end()) {
             if (required)
                 error = fmt::format("missing '{}'", key);
             return !required;
         }
-        if (!it->is_number()) {
-            error = fmt::format("'{}' must be a number", key);
+        if (kInteger ? !it->is_number_integer() : !it->is_number()) {
+            error = fmt::format("'{}' must be {}", key, kInteger ? "an integer" : "a number");
             return false;
         }
-        const double v = it->get<double>();
-        if (!std::isfinite(v) || v < lo || v > hi) {
+        const T v = it->get<T>();
+        bool finite = true;
+        if constexpr (!kInteger)
+            finite = std::isfinite(v);
+        if (!finite || v < lo || v > hi) {
             error = fmt::format("'{}' = {} is outside [{}, {}]", key, v, lo, hi);
             return false;
         }
         out = v;
         return true;
     }
+    bool number(const json& obj, const char* key, double& out, double lo, double hi,
+                bool required = true) {
+        return ranged(obj, key, out, lo, hi, required);
+    }
     bool integer(const json& obj, const char* key, int64_t& out, int64_t lo, int64_t hi,
                  bool required = true) {
-        const auto it = obj.find(key);
-        if (it == obj.end()) {
-            if (required)
-                error = fmt::format("missing '{}'", key);
-            return !required;
-        }
-        if (!it->is_number_integer()) {
-            error = fmt::format("'{}' must be an integer", key);
-            return false;
-        }
-        const int64_t v = it->get<int64_t>();
-        if (v < lo || v > hi) {
-            error = fmt::format("'{}' = {} is outside [{}, {}]", key, v, lo, hi);
-            return false;
-        }
-        out = v;
-        return true;
+        return ranged(obj, key, out, lo, hi, required);
     }
     bool string(const json& obj, const char* key, std::string& out) {
         const auto it = obj.find(key);

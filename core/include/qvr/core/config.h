@@ -40,8 +40,15 @@ public:
     Status finish();
 
 private:
+    using TypeTest = bool (toml::node::*)() const noexcept;
     void fail(std::string message);
     void markUsed(std::string_view path);
+    // The node at path when present and of the type `is_type` tests for; nullptr when absent, and
+    // an error "'path' must be <type_name>" too when of another type. The key counts as used.
+    const toml::node* present(std::string_view path, TypeTest is_type, const char* type_name);
+    // The node's value when a finite number in [min, max]; else an error naming it by label.
+    std::optional<double> rangedNumber(const toml::node& node, const std::string& label,
+                                       double min_value, double max_value);
 
     const toml::table& m_table;
     std::string m_source;

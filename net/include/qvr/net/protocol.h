@@ -218,6 +218,8 @@ enum class ByeReason : uint8_t {
 };
 inline constexpr uint8_t kMaxByeReason = 8;
 std::string_view byeReasonName(ByeReason r);
+// What the server did, for the client to tell its user after "the server ": "is full", ….
+std::string_view byeReasonClientText(ByeReason r);
 struct Bye {
     ByeReason reason = ByeReason::kNormal;
 };
