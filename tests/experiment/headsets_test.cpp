@@ -66,7 +66,8 @@ TEST(HeadsetWorkloads, IdenticalAreAllThePlans) {
         EXPECT_EQ(h, (HeadsetWorkload{"default", "model", 3}));
 }
 
-runtime::ServerFrameStamps stamp(int64_t start_ns, std::vector<std::pair<int64_t, int64_t>> layers) {
+runtime::ServerFrameStamps stamp(int64_t start_ns,
+                                 std::vector<std::pair<int64_t, int64_t>> layers) {
     runtime::ServerFrameStamps s;
     s.start_ns = start_ns;
     for (const auto& [render_start, encode_end] : layers) {
@@ -80,7 +81,7 @@ runtime::ServerFrameStamps stamp(int64_t start_ns, std::vector<std::pair<int64_t
 
 TEST(ServerShare, CountsFramesInTheWindowAndTheirLayers) {
     const std::vector<runtime::ServerFrameStamps> stamps = {
-        stamp(500, {{500, 1'000'500}}),                           // before the window
+        stamp(500, {{500, 1'000'500}}),                            // before the window
         stamp(1000, {{1000, 2'001'000}, {3'000'000, 4'000'000}}),  // 2 ms + 1 ms
         stamp(5000, {{5000, 4'005'000}}),                          // 4 ms
         stamp(9000, {{9000, 9000 + 50'000'000}}),                  // after the window
@@ -103,9 +104,9 @@ HeadsetOutcome outcome(int index, double fps, std::string error = "") {
 }
 
 TEST(AggregateHeadsets, OrdersByIndexAndLeavesFailedOutOfFairness) {
-    const HeadsetsResult r = aggregateHeadsets(
-        "qvr", {outcome(2, 20.0), outcome(0, 20.0), outcome(1, 0.0, "refused")},
-        ServerShare{10, 50.0});
+    const HeadsetsResult r =
+        aggregateHeadsets("qvr", {outcome(2, 20.0), outcome(0, 20.0), outcome(1, 0.0, "refused")},
+                          ServerShare{10, 50.0});
     ASSERT_EQ(r.headsets.size(), 3u);
     EXPECT_EQ(r.headsets[0].index, 0);
     EXPECT_EQ(r.headsets[2].index, 2);
