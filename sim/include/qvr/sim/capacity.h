@@ -31,6 +31,7 @@ struct CapacityOptions {
     double wait_limit_ms = 250.0;
     int frames = 300;
     int warmup_frames = 10;
+    bool every_count = false;  // predict every count up to max_headsets (else stop below target)
 };
 
 // The factors on the headset's and the server's times with `headsets` headsets.
@@ -59,8 +60,19 @@ struct CapacityResult {
 int headsetsAtTarget(const std::vector<CapacityPoint>& points, double target_fps);
 
 // Every headset count from 1 to max_headsets predicted on `trace` with `costs` (a calibration's
-// [runtime]); stops after the first two counts below the target.
+// [runtime]); stops after the first two counts below the target unless every_count.
 Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const RuntimeCosts& costs,
                                          const CapacityOptions& options);
+
+// predictCapacity with a calibration file (qvr calibrate --out; its [runtime] pipeline) and a
+// workload trace file (a qvr run's workload.jsonl, data/workloads/*.jsonl).
+Expected<CapacityResult> planCapacity(const std::string& hardware_path,
+                                      const std::string& trace_path,
+                                      const CapacityOptions& options);
+
+// The result for the console: a line per count and the count at the target.
+std::string capacityText(const CapacityResult& result, const CapacityOptions& options);
+// The result as JSON text: the options, every point and the count at the target.
+std::string capacityJson(const CapacityResult& result, const CapacityOptions& options);
 
 }  // namespace qvr
