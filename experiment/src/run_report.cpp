@@ -404,8 +404,11 @@ nlohmann::json ratiosJson(const HeadlineRatios& r) {
 
 namespace {
 
-// The headsets of the headline design (qvr when run) at the top level, every design's besides.
+// With more than one headset: the headsets of the headline design (qvr when run) at the top
+// level, every design's besides. One headset's run keeps the keys it always had.
 void headsetsSummaryJson(const RunOutcome& o, nlohmann::json& j) {
+    if (o.headsets <= 1)
+        return;
     j["headsets_requested"] = o.headsets;
     j["identical_workloads"] = o.identical_workloads;
     nlohmann::json by_design = nlohmann::json::object();
