@@ -120,6 +120,13 @@ static Registered registerRun(CLI::App& app) {
                   "Measure the calibration again even when a cached one exists");
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
     cmd->add_flag("--quiet", o->quiet, "No progress line on a terminal");
+    cmd->add_option("--headsets", o->headsets,
+                    "Headsets on the one server, each design run with all at once (each its own "
+                    "motion recording and gaze seed; the others in processes of their own)")
+        ->check(CLI::Range(kMinHeadsets, kMaxHeadsets))
+        ->capture_default_str();
+    cmd->add_flag("--identical-workloads", o->identical_workloads,
+                  "Every headset the same motion and gaze (--motion, --gaze, --seed)");
     cmd->add_option("--quality-every", o->quality_every,
                     "Measure every Nth displayed frame against a full-resolution render after "
                     "each design's run (0: off)")
@@ -132,15 +139,27 @@ static Registered registerRun(CLI::App& app) {
             o->command_line = fmt::format(
                 "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
                 "--profile {} --codec {} --seed {} --lod-px {} --pipeline {} --headset-share {} "
-                "--ring-counts {}{}{}",
+                "--ring-counts {}{}{}{}",
                 o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile, o->codec,
                 o->seed, o->lod_px, o->pipeline_depth, o->headset_share, o->ring_counts,
                 o->one_pass_periphery ? " --one-pass-periphery" : "",
-                o->no_holes ? " --no-holes" : "");
+                o->no_holes ? " --no-holes" : "",
+                o->headsets > 1
+                    ? fmt::format(" --headsets {}{}", o->headsets,
+                                  o->identical_workloads ? " --identical-workloads" : "")
+                    : "");
             return runRun(*o);
         }};
 }
 
 QVR_REGISTER_COMMAND(90, registerRun);
+
+static Registered registerRunHeadset(CLI::App& app) {
+    CLI::App* cmd = app.add_subcommand(
+        "run-headset", "qvr run --headsets' other headsets (internal: settings on stdin)");
+    cmd->group("");  // not listed: qvr run starts it
+    return {cmd, [] { return runHeadsetChild(); }};
+}
+QVR_REGISTER_COMMAND(93, registerRunHeadset);
 
 }  // namespace qvr::cli

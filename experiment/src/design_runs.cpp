@@ -14,6 +14,7 @@
 
 #include <fmt/format.h>
 
+#include "headset_child.h"
 #include "qvr/compose/quality.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/render/camera.h"
@@ -214,6 +215,9 @@ private:
     void keepRun(const DesignSpec& spec, HeadsetResult result,
                  std::optional<SpeedSample> speed_before);
     void measureQuality(const std::string& label, const QualitySampler& sampler);
+    std::optional<RunError> startOtherHeadsets();
+    void keepHeadsets(const std::string& label, const DesignSummary* own, int64_t start_ns,
+                      bool stopped);
     void finish(size_t designs_requested, const RuntimeCosts& calibrated);
     void writeTrace();
 
@@ -226,6 +230,15 @@ private:
     std::optional<ServerProcess> m_server;
     std::optional<ScopedThreadPin> m_main_pin;
     std::unique_ptr<SpeedProbe> m_speed_probe;
+    std::vector<HeadsetWorkload> m_workloads;  // by headset; [0] is this process's
+    std::unique_ptr<OtherHeadsets> m_others;   // headsets 1…N−1 (none when N is 1)
+    // Each design's headsets and the span of time they ran in, for the server's share.
+    struct HeadsetsWindow {
+        std::string design;
+        std::vector<HeadsetOutcome> headsets;
+        int64_t start_ns = 0, end_ns = 0;
+    };
+    std::vector<HeadsetsWindow> m_windows;
     ScanoutRecorder m_stand_in;
     std::vector<ImageRgba8> m_quality_pool;  // allocated (and touched) once, before any run
     std::unique_ptr<Renderer> m_quality_renderer;
@@ -255,6 +268,10 @@ std::optional<RunError> DesignRunner::start(const RuntimeCosts& calibrated) {
                             2};
         }
         m_m.share_group = std::move(*g);
+    }
+    if (auto error = startOtherHeadsets()) {
+        m_server->stop();
+        return error;
     }
     printSetup();
     // This thread, and every thread made while the designs run, on the headset's core: the
@@ -299,6 +316,68 @@ void DesignRunner::printSetup() const {
                           "{:.1f} ms per 10 ms, {})",
                           100.0 * m_plan.headset_share, 10.0 * m_plan.headset_share, share->path())
             : std::string());
+}
+
+int64_t steadyNowNs() {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
+        .count();
+}
+
+// The headsets' workloads, and headsets 1…N−1 ready to start (each its own CPU share group).
+std::optional<RunError> DesignRunner::startOtherHeadsets() {
+    std::vector<std::string> recordings;
+    for (const std::string& r : defaultMotionRecordings())
+        if (fs::exists(r))
+            recordings.push_back(r);
+    m_workloads = headsetWorkloads(m_plan.headsets, m_plan.motion, m_plan.gaze, m_plan.seed,
+                                   m_plan.identical_workloads, recordings);
+    if (m_plan.headsets <= 1)
+        return std::nullopt;
+    auto others = OtherHeadsets::make(m_plan, m_workloads, m_m.client_core);
+    if (!others)
+        return RunError{
+            fmt::format("--headset-share {:g} refused: {}", m_plan.headset_share, others.error()),
+            2};
+    m_others = std::move(*others);
+    return std::nullopt;
+}
+
+// The design's headsets once headset 0 (`own`, none when it failed) has ended: the others'
+// outcomes, their lines, and the span they ran in.
+void DesignRunner::keepHeadsets(const std::string& label, const DesignSummary* own,
+                                int64_t start_ns, bool stopped) {
+    HeadsetsWindow w{label, {}, start_ns, 0};
+    HeadsetOutcome first{0, m_workloads.front(), {}, own ? "" : "its session failed"};
+    if (own)
+        first.summary = *own;
+    w.headsets.push_back(std::move(first));
+    if (m_others)
+        for (HeadsetOutcome& h : m_others->collect(stopped || !own))
+            w.headsets.push_back(std::move(h));
+    w.end_ns = steadyNowNs();
+    m_windows.push_back(std::move(w));
+}
+
+// Headsets 1…N−1's lines below headset 0's, and the design's fairness.
+void printHeadsets(const std::vector<HeadsetOutcome>& headsets, const std::string& label) {
+    for (const HeadsetOutcome& h : headsets) {
+        const DesignSummary& s = h.summary;
+        if (h.index == 0)
+            continue;
+        if (h.error.empty())
+            fmt::print(
+                "    headset {:2} fps {:6.1f}  mtp {:6.1f} ms (p99 {:6.1f})  {:8.0f} B/frame  e1 "
+                "{:5.1f} deg  ({}, seed {})\n",
+                h.index, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
+                s.e1_deg_mean, fs::path(h.workload.motion).stem().string(), h.workload.seed);
+        else
+            fmt::print("    headset {:2} failed: {}\n", h.index, h.error);
+    }
+    const HeadsetsResult r = aggregateHeadsets(label, headsets, std::nullopt);
+    fmt::print("    {} headsets: FPS mean {:.1f}, min {:.1f}, Jain's index {:.3f}\n",
+               headsets.size(), r.fps_mean, r.fps_min, r.jain_fairness_fps);
+    std::fflush(stdout);
 }
 
 std::optional<SpeedSample> DesignRunner::probeSpeedNow() {
@@ -370,14 +449,27 @@ Expected<bool> DesignRunner::runDesign(const DesignSpec& spec, size_t designs_re
     const std::optional<SpeedSample> speed_before = probeSpeedNow();
     if (!m_m.runs.empty())
         m_m.runs.back().speed_after = speed_before;  // the last design's "after"
+    if (m_others)
+        if (auto st = m_others->start(label, m_server->port(), m_key.toHex()); !st)
+            return makeError(label + ": " + st.error());
+    // Every headset's first frame together: the others wait for headset 0's.
+    int64_t start_ns = 0;
+    hc.before_frame = [&](int64_t frame) {
+        if (frame != 0)
+            return;
+        if (m_others)
+            m_others->release();
+        start_ns = steadyNowNs();
+    };
     Expected<HeadsetResult> result = makeError("not run");
     std::thread headset(
         [&] { result = runHeadset(hc, m_inputs.scene, m_inputs.bvh, m_inputs.traces); });
     headset.join();
     progress.reset();  // clears the progress line
+    const bool stopped = g_run_stop.load();
+    keepHeadsets(label, result ? &result->summary : nullptr, start_ns, stopped);
     if (!result)
         return makeError(label + ": " + result.error());
-    const bool stopped = g_run_stop.load();
     if (stopped) {
         m_m.interrupted_note =
             fmt::format("interrupted during {} after {} of {} frames; {} of {} designs run", label,
@@ -387,6 +479,8 @@ Expected<bool> DesignRunner::runDesign(const DesignSpec& spec, size_t designs_re
             return false;  // nothing measured for this design
     }
     keepRun(spec, std::move(*result), speed_before);
+    if (m_others)
+        printHeadsets(m_windows.back().headsets, label);
     if (stopped) {
         // No quality pass: the user asked to stop.
         if (m_m.quality.empty() && m_m.quality_note.empty())
@@ -501,10 +595,15 @@ void DesignRunner::finish(size_t designs_requested, const RuntimeCosts& calibrat
 // trace.json: every design's headset stages and the server's, on the headset's clock.
 void DesignRunner::writeTrace() {
     std::vector<ServerFrameStamps> stamps;
-    if (auto read = readServerStamps((m_out / "server_stamps.csv").string()))
+    auto read = readServerStamps((m_out / "server_stamps.csv").string());
+    if (read)
         stamps = std::move(*read);
     else
         m_m.trace_note = "no server stages: " + read.error();
+    for (HeadsetsWindow& w : m_windows)
+        m_m.headsets.push_back(aggregateHeadsets(
+            w.design, std::move(w.headsets),
+            read ? std::optional(serverShare(stamps, w.start_ns, w.end_ns)) : std::nullopt));
     std::vector<TraceDesign> tds;
     for (const DesignRun& r : m_m.runs)
         tds.push_back({r.label(), r.result.origin_ns, m_profile.refresh_hz, &r.result.frames});

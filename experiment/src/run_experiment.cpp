@@ -84,6 +84,12 @@ void printRunSummary(const RunOutcome& o, const std::string& out) {
             over[0], over[1], o.calibration.path);
     if (!o.sim_note.empty())
         fmt::print("  {}\n", o.sim_note);
+    if (const HeadsetsResult* h = headlineHeadsets(o.headsets_by_design); h && o.headsets > 1)
+        fmt::print(
+            "  {} headsets ({}): FPS mean {:.1f}, min {:.1f}, Jain's index {:.3f}, server {} ms "
+            "per headset-frame (summary.json headsets)\n",
+            h->headsets.size(), h->design, h->fps_mean, h->fps_min, h->jain_fairness_fps,
+            fmtCell(h->server_ms_per_headset_frame, "{:.2f}"));
     fmt::print(
         "  {}\n  {}\n  wrote {}/summary.json, telemetry.csv, frames_*.csv, report.html in {:.0f} "
         "s\n",

@@ -124,6 +124,9 @@ RunOutcome runOutcome(const RunOptions& plan, const HmdProfile& profile,
     o.trace_note = m.trace_note;
     o.quality_note = m.quality_note;
     o.video = std::move(video);
+    o.headsets = plan.headsets;
+    o.identical_workloads = plan.identical_workloads;
+    o.headsets_by_design = m.headsets;
     o.never_shown = m.never_shown;
     return o;
 }
@@ -399,6 +402,31 @@ nlohmann::json ratiosJson(const HeadlineRatios& r) {
     return j;
 }
 
+namespace {
+
+// With more than one headset: the headsets of the headline design (qvr when run) at the top
+// level, every design's besides. One headset's run keeps the keys it always had.
+void headsetsSummaryJson(const RunOutcome& o, nlohmann::json& j) {
+    if (o.headsets <= 1)
+        return;
+    j["headsets_requested"] = o.headsets;
+    j["identical_workloads"] = o.identical_workloads;
+    nlohmann::json by_design = nlohmann::json::object();
+    for (const HeadsetsResult& r : o.headsets_by_design)
+        by_design[r.design] = headsetsJson(r);
+    j["headsets_by_design"] = by_design;
+    const HeadsetsResult* head = headlineHeadsets(o.headsets_by_design);
+    if (!head)
+        return;
+    const nlohmann::json h = headsetsJson(*head);
+    j["headsets_design"] = head->design;
+    j["headsets"] = h["headsets"];
+    j["jain_fairness_fps"] = h["jain_fairness_fps"];
+    j["server_ms_per_headset_frame"] = h["server_ms_per_headset_frame"];
+}
+
+}  // namespace
+
 nlohmann::json summaryJson(const RunOutcome& o) {
     nlohmann::json j;
     settingJson(o, j);
@@ -422,6 +450,7 @@ nlohmann::json summaryJson(const RunOutcome& o) {
         j["sim_note"] = o.sim_note;
     j["server"] = serverJson(o);
     j["trace"] = traceJson(o);
+    headsetsSummaryJson(o, j);
     if (!o.quality_note.empty())
         quality["note"] = o.quality_note;
     j["quality"] = quality;

@@ -312,6 +312,44 @@ void designsHtml(report::HtmlReport& page, const RunOutcome& o) {
     }
 }
 
+// Several headsets on the one server: each one's measurements per design, Jain's fairness index
+// over their FPS and the server's render + encode time per headset-frame.
+void headsetsHtml(report::HtmlReport& page, const RunOutcome& o) {
+    if (o.headsets <= 1)
+        return;
+    page.heading(2, fmt::format("{} headsets on one server", o.headsets));
+    page.paragraph(fmt::format(
+        "Headset 0 runs in this process as every run's headset does; the others each in a "
+        "process of their own, all pinned to the headset core {} and started together at headset "
+        "0's first frame; {}. Jain's fairness index is (ΣFPS)² / (n·ΣFPS²): 1 "
+        "when every headset has the same frame rate. The server time per headset-frame is its "
+        "render, readback and encode time per frame it served while the headsets ran.",
+        o.client_core,
+        o.identical_workloads ? "every headset the same motion and gaze (--identical-workloads)"
+                              : "each its own motion recording and gaze seed"));
+    report::Table t({"design", "headset", "motion", "seed", "FPS", "MTP p99 ms", "KB/frame",
+                     "e1 mean °", "Jain's index (FPS)", "server ms per headset-frame"});
+    for (const HeadsetsResult& r : o.headsets_by_design)
+        for (const HeadsetOutcome& h : r.headsets) {
+            const bool first = h.index == 0;
+            const std::string motion = fs::path(h.workload.motion).stem().string();
+            const std::string seed = std::to_string(h.workload.seed);
+            const std::string jain = first ? num(r.jain_fairness_fps, 3) : "";
+            const std::string server =
+                first ? fmtCell(r.server_ms_per_headset_frame, "{:.2f}") : "";
+            if (!h.error.empty()) {
+                t.row({r.design, std::to_string(h.index), motion, seed, "failed: " + h.error, "",
+                       "", "", jain, server});
+                continue;
+            }
+            const DesignSummary& s = h.summary;
+            t.row({r.design, std::to_string(h.index), motion, seed, num(s.fps_mean),
+                   num(s.mtp_ms_p99), num(s.bytes_per_frame_mean / 1e3), num(s.e1_deg_mean), jain,
+                   server});
+        }
+    page.table(t);
+}
+
 void paperHtml(report::HtmlReport& page, const RunOutcome& o) {
     page.heading(2, "Against the paper");
     const HeadlineRatios r = headlineRatios(o.designs);
@@ -408,6 +446,7 @@ void writeRunReport(const RunOutcome& o, const fs::path& out) {
     report::HtmlReport page("qvr run");
     settingHtml(page, o);
     designsHtml(page, o);
+    headsetsHtml(page, o);
     limitsHtml(page, o);
     countersHtml(page, o);
     page.html(validationHtml(o));

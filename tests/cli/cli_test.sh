@@ -271,6 +271,16 @@ expect_error "calibrate --codec bogus" calibrate --codec bogus --out "$tmp/cal.t
 expect_error "run --hardware /nonexistent" run --hardware /nonexistent.toml --frames 2 --out "$tmp/run"
 expect_error "run --quality-every -1" run --quality-every -1 --frames 2 --out "$tmp/run"
 expect_error "run --hardware <bad runtime.pipeline>" run --hardware "$tmp/rt_bad.toml" --frames 2 --out "$tmp/run"
+# --headsets is bounded (1..16): a bad count exits 2 before anything runs.
+for n in 0 17 x; do
+    "$QVR" run --headsets "$n" --frames 2 --out "$tmp/run" >/dev/null 2>"$tmp/bad_err.txt"
+    rc=$?
+    if [ $rc -eq 2 ] && grep -q -- "--headsets" "$tmp/bad_err.txt"; then
+        pass "run --headsets $n exits 2"
+    else
+        fail "run --headsets $n exits 2" "exit $rc: $(head -c 200 "$tmp/bad_err.txt")"
+    fi
+done
 expect_error "validate --depths 3" validate --depths 3 --dry-run --out "$tmp/val"
 expect_error "validate --frames 2" validate --frames 2 --dry-run --out "$tmp/val"
 expect_error "validate --reps 0" validate --reps 0 --dry-run --out "$tmp/val"

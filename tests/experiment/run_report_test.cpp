@@ -313,6 +313,52 @@ TEST(ValidationHtml, PredictedDesignsByNameWithTheirErrors) {
         << h;
 }
 
+RunOutcome twoHeadsets() {
+    RunOutcome o = handMadeOutcome();
+    o.headsets = 2;
+    o.identical_workloads = true;
+    for (const DesignResult& d : o.designs) {
+        std::vector<HeadsetOutcome> hs(2);
+        for (int k = 0; k < 2; ++k) {
+            hs[size_t(k)].index = k;
+            hs[size_t(k)].workload = {"default", "model", 1};
+            hs[size_t(k)].summary = d.summary;
+            hs[size_t(k)].summary.fps_mean = 30.0 + 10.0 * k;
+        }
+        o.headsets_by_design.push_back(aggregateHeadsets(d.name, hs, ServerShare{4, 20.0}));
+    }
+    return o;
+}
+
+TEST(SummaryJson, SeveralHeadsetsAddTheirListFairnessAndServerTime) {
+    const nlohmann::json one = summaryJson(handMadeOutcome());
+    for (const char* key : {"headsets", "jain_fairness_fps", "server_ms_per_headset_frame",
+                            "headsets_by_design", "headsets_requested"})
+        EXPECT_FALSE(one.contains(key)) << key;
+    const nlohmann::json j = summaryJson(twoHeadsets());
+    EXPECT_EQ(j["headsets_design"], "qvr");
+    ASSERT_EQ(j["headsets"].size(), 2u);
+    EXPECT_DOUBLE_EQ(j["headsets"][1]["fps_mean"].get<double>(), 40.0);
+    EXPECT_NEAR(j["jain_fairness_fps"].get<double>(), 4900.0 / (2.0 * 2500.0), 1e-12);
+    EXPECT_DOUBLE_EQ(j["server_ms_per_headset_frame"].get<double>(), 5.0);
+    EXPECT_EQ(keysOf(j["headsets_by_design"]), (std::set<std::string>{"ffr", "qvr"}));
+    EXPECT_EQ(j["headsets_requested"], 2);
+    EXPECT_EQ(j["identical_workloads"], true);
+}
+
+TEST(WriteRunReport, SeveralHeadsetsHaveTheirTable) {
+    const auto dir = std::filesystem::temp_directory_path() / "qvr_run_report_headsets_test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    writeRunReport(twoHeadsets(), dir);
+    std::ifstream r(dir / "report.html");
+    const std::string html((std::istreambuf_iterator<char>(r)), std::istreambuf_iterator<char>());
+    EXPECT_NE(html.find("2 headsets on one server"), std::string::npos);
+    EXPECT_NE(html.find("server ms per headset-frame"), std::string::npos);
+    EXPECT_NE(html.find("0.980"), std::string::npos);  // Jain's index of 30 and 40 FPS
+    std::filesystem::remove_all(dir);
+}
+
 TEST(WriteRunReport, SummaryAndReportFromTheResult) {
     const auto dir = std::filesystem::temp_directory_path() / "qvr_run_report_test";
     std::filesystem::remove_all(dir);

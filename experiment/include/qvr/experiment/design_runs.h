@@ -19,6 +19,7 @@
 #include "qvr/codec/mp4_writer.h"
 #include "qvr/core/design.h"
 #include "qvr/experiment/calibration.h"
+#include "qvr/experiment/headsets.h"
 #include "qvr/experiment/run_plan.h"
 #include "qvr/experiment/scanout_recorder.h"
 #include "qvr/render/renderer.h"
@@ -101,6 +102,8 @@ struct RunMeasurement {
     std::vector<runtime::ServerBusy> server_busy;  // per design, in the order of runs
     bool recorded_workload = false;                // workload.jsonl by the qvr design
     std::unique_ptr<ScanoutRecorder> recorder;     // what the qvr design's headset displayed
+    // Every headset of each design (headset 0 is the one `runs` holds), in the order of runs.
+    std::vector<HeadsetsResult> headsets;
 };
 
 // Why the designs could not be run: the message (after "qvr run: ") and the exit status.
@@ -109,9 +112,10 @@ struct RunError {
     int exit_status = 1;
 };
 
-// Runs every design of `designs` in turn, writing telemetry.csv, frames_<design>.csv,
-// workload.jsonl, server_*.csv, server_stats.json and trace.json into plan.out as it goes.
-// SIGINT or SIGTERM ends the current design at its next frame boundary and starts no other.
+// Runs every design of `designs` in turn (with plan.headsets headsets at once), writing
+// telemetry.csv, frames_<design>.csv, workload.jsonl, server_*.csv, server_stats.json and
+// trace.json into plan.out as it goes. SIGINT or SIGTERM ends the current design at its next frame
+// boundary and starts no other.
 std::variant<RunMeasurement, RunError> measureDesigns(const RunOptions& plan,
                                                       const std::vector<DesignSpec>& designs,
                                                       const HmdProfile& profile,

@@ -24,4 +24,8 @@ int runExitStatus(const RunOutcome& outcome, const std::string& out);
 int runExperiment(const RunOptions& plan, const std::vector<DesignSpec>& designs,
                   const HmdProfile& profile);
 
+// `qvr run-headset` (internal): one of `qvr run --headsets N`'s other headsets, its settings as
+// a JSON line on stdin (headset_child.h). Returns the exit status.
+int runHeadsetChild();
+
 }  // namespace qvr::experiment

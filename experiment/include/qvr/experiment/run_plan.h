@@ -38,6 +38,10 @@ struct RunOptions {
     float lod_px = 1.0f;
     std::string hardware;      // a calibration (qvr calibrate --out); none: cached or measured
     bool recalibrate = false;  // measure even when a cached calibration exists
+    // Headsets on the one server (headsets.h): headset 0 in this process as always, the others
+    // each in a process of its own, all started together for every design.
+    int headsets = 1;
+    bool identical_workloads = false;  // every headset the plan's motion, gaze and seed
     std::string command_line;
 };
 

@@ -76,6 +76,10 @@ struct RunOutcome {
     std::string quality_note;
     DisplayVideo video;
     std::vector<std::string> never_shown;
+    // Every design's headsets (one each unless qvr run --headsets N), in the order they ran.
+    int headsets = 1;
+    bool identical_workloads = false;
+    std::vector<HeadsetsResult> headsets_by_design;
 };
 
 // The run's outcome from its plan, measurement and predictions.

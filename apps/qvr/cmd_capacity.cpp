@@ -1,0 +1,78 @@
+// `qvr capacity`: headsets per render server at a target frame rate, from a calibration and a
+// workload through the calibrated runtime model (sim/capacity.h holds the model and its limits).
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "options.h"
+#include "qvr/core/design.h"
+#include "qvr/sim/capacity.h"
+
+namespace qvr::cli {
+
+namespace {
+
+struct CapacityCmdOptions {
+    std::string hardware, trace, design = "qvr", json;
+    CapacityOptions model;
+};
+
+int runCapacity(CapacityCmdOptions& o) {
+    auto design = parseDesign(o.design, DesignScope::Runtime);
+    if (!design) {
+        std::fprintf(stderr, "qvr capacity: --design: %s\n", design.error().c_str());
+        return 2;
+    }
+    o.model.design = design->design;
+    o.model.fixed_e1_deg = design->fixed_e1_deg;
+    auto r = planCapacity(o.hardware, o.trace, o.model);
+    if (!r) {
+        std::fprintf(stderr, "qvr capacity: %s\n", r.error().c_str());
+        return 2;
+    }
+    fmt::print("{}", capacityText(*r, o.model));
+    if (!o.json.empty() && !(std::ofstream(o.json) << capacityJson(*r, o.model))) {
+        std::fprintf(stderr, "qvr capacity: cannot write '%s'\n", o.json.c_str());
+        return 1;
+    }
+    return 0;
+}
+
+}  // namespace
+
+static Registered registerCapacity(CLI::App& app) {
+    auto o = std::make_shared<CapacityCmdOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "capacity", "Headsets per render server at a target FPS (the calibrated runtime model)");
+    cmd->add_option("--hardware", o->hardware, "Calibration (qvr calibrate --out FILE)")
+        ->required()
+        ->check(readableFile());
+    cmd->add_option("--trace", o->trace, "Workload (a qvr run's workload.jsonl, data/workloads/)")
+        ->required()
+        ->check(readableFile());
+    cmd->add_option("--target-fps", o->model.target_fps, "Every headset's frame-rate floor")
+        ->required()
+        ->check(finiteRange(0.1, 1000.0));
+    cmd->add_option("--design", o->design, "Runtime design (qvr, ffr, fixed:E, remote, …)")
+        ->capture_default_str();
+    cmd->add_option("--net", o->model.net, "Each headset's link (qvr run --net)")
+        ->capture_default_str();
+    cmd->add_option("--headset-share", o->model.headset_share,
+                    "Each headset's share of its core (qvr run --headset-share)")
+        ->check(finiteRange(0.01, 1.0))
+        ->capture_default_str();
+    cmd->add_flag("--headsets-share-one-core", o->model.headsets_share_one_core,
+                  "The headsets take turns on one core (qvr run --headsets on this machine)");
+    cmd->add_option("--max-headsets", o->model.max_headsets)->check(CLI::Range(1, 64));
+    cmd->add_flag("--every-count", o->model.every_count, "Every count up to --max-headsets");
+    addFramesOption(cmd, o->model.frames, 20, 100000, "Frames each count is modelled over");
+    cmd->add_option("--json", o->json, "Write the result as JSON");
+    return {cmd, [o] { return runCapacity(*o); }};
+}
+
+QVR_REGISTER_COMMAND(94, registerCapacity);
+
+}  // namespace qvr::cli

@@ -1,0 +1,112 @@
+// Capacity planning (sim/capacity.h): the factors on each side's costs, the count at a target,
+// and the model's headset counts against the closed form of a server-bound design.
+#include "qvr/sim/capacity.h"
+
+#include <gtest/gtest.h>
+
+namespace qvr {
+namespace {
+
+WorkloadTrace flatTrace(int frames) {
+    WorkloadTrace t;
+    t.header.name = "flat";
+    t.header.profile = defaultHmdProfile();
+    t.header.profile.width_px = 320;
+    t.header.profile.height_px = 360;
+    t.header.ring_deg = 1.0;
+    t.header.rings = 120;
+    t.header.scales = {1, 2, 4, 8, 16, 32};
+    for (int i = 0; i < frames; ++i) {
+        WorkloadFrame f;
+        f.index = i;
+        f.time_ms = 1000.0 * i / 90.0;
+        f.triangles_per_ring.assign(120, 100.0);
+        f.pixels_per_ring.assign(120, 1000.0);
+        f.bits_per_pixel.assign(6, 0.1);
+        t.frames.push_back(f);
+    }
+    return t;
+}
+
+// Only the server's layer render costs: remote is server-bound (two layers a frame).
+RuntimeCosts serverBoundCosts(double server_layer_ms) {
+    RuntimeCosts c;
+    c.decision = {0, 0, 0};
+    c.fovea = {0.5, 0, 0};
+    c.decode = {0, 0, 0};
+    c.uca = {0.5, 0, 0};
+    c.frame_overhead_ms = 0.0;
+    c.server_render = {server_layer_ms, 0, 0};
+    c.encode = {0, 0, 0};
+    c.server_frame_ms = 0.0;
+    c.link_delay_ms = 0.0;
+    return c;
+}
+
+CapacityOptions remoteOptions(double target_fps) {
+    CapacityOptions o;
+    o.design = Design::Remote;
+    o.target_fps = target_fps;
+    o.net = "rate:100000";
+    o.frames = 120;
+    o.max_headsets = 8;
+    return o;
+}
+
+TEST(CapacityFactors, ServerTimesNHeadsetByShare) {
+    const CapacityFactors own = capacityFactors(4, 0.25, false);
+    EXPECT_DOUBLE_EQ(own.server, 4.0);
+    EXPECT_DOUBLE_EQ(own.headset, 4.0);
+    EXPECT_DOUBLE_EQ(capacityFactors(3, 1.0, false).headset, 1.0);
+    // On one shared core the headsets take turns once they are more than 1/share.
+    EXPECT_DOUBLE_EQ(capacityFactors(3, 1.0, true).headset, 3.0);
+    EXPECT_DOUBLE_EQ(capacityFactors(2, 0.25, true).headset, 4.0);
+    EXPECT_DOUBLE_EQ(capacityFactors(6, 0.25, true).headset, 6.0);
+}
+
+CapacityPoint point(int n, double fps) {
+    CapacityPoint p;
+    p.headsets = n;
+    p.summary.fps_mean = fps;
+    return p;
+}
+
+TEST(HeadsetsAtTarget, LastCountFromOneAtTheTarget) {
+    EXPECT_EQ(headsetsAtTarget({point(1, 90), point(2, 60), point(3, 45)}, 50.0), 2);
+    EXPECT_EQ(headsetsAtTarget({point(1, 90), point(2, 60), point(3, 45)}, 30.0), 3);
+    EXPECT_EQ(headsetsAtTarget({point(1, 20)}, 30.0), 0);
+    // A later count over the target after one below it does not count.
+    EXPECT_EQ(headsetsAtTarget({point(1, 60), point(2, 20), point(3, 40)}, 30.0), 1);
+}
+
+TEST(PredictCapacity, ServerBoundRemoteFollowsOneOverN) {
+    // 2 layers × 7 ms: the server serves a frame in 14 ms, N headsets each every 14·N ms.
+    const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), remoteOptions(20.0));
+    ASSERT_TRUE(r) << r.error();
+    ASSERT_GE(r->points.size(), 3u);
+    for (size_t i = 1; i < r->points.size(); ++i)
+        EXPECT_LT(r->points[i].summary.fps_mean, r->points[i - 1].summary.fps_mean + 1e-9);
+    for (const CapacityPoint& p : r->points) {
+        if (p.headsets < 2)
+            continue;
+        const double closed = 1000.0 / (14.0 * p.headsets);
+        EXPECT_NEAR(p.summary.fps_mean, closed, 0.15 * closed) << p.headsets << " headsets";
+        EXPECT_NEAR(p.server_utilisation, 1.0, 0.15) << p.headsets << " headsets";
+    }
+    // 1000 / (14 · 3) = 23.8 ≥ 20 > 1000 / (14 · 4) = 17.9.
+    EXPECT_EQ(r->headsets, 3);
+}
+
+TEST(PredictCapacity, StopsAfterTwoCountsBelowTheTarget) {
+    const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), remoteOptions(60.0));
+    ASSERT_TRUE(r) << r.error();
+    EXPECT_EQ(r->headsets, 1);
+    EXPECT_EQ(r->points.size(), 3u);
+}
+
+TEST(PredictCapacity, RefusesANonPositiveTarget) {
+    EXPECT_FALSE(predictCapacity(flatTrace(10), serverBoundCosts(7.0), remoteOptions(0.0)));
+}
+
+}  // namespace
+}  // namespace qvr
