@@ -67,14 +67,31 @@ void padPlane(uint8_t* plane, int stride, int w, int h, int canvas_w, int canvas
                     static_cast<size_t>(canvas_w));
 }
 
-class X264Encoder final : public VideoEncoder {
+// What the encoder and the decoder both hold: the codec context, one frame and one packet, the
+// RGBA/YUV converter (freed with them) and the staging buffer for rows swscale cannot take as
+// they are.
+class FfmpegState {
+public:
+    FfmpegState(const FfmpegState&) = delete;
+    FfmpegState& operator=(const FfmpegState&) = delete;
+
+protected:
+    FfmpegState() = default;
+    ~FfmpegState() { sws_freeContext(m_sws); }
+
+    ContextPtr m_ctx;
+    FramePtr m_frame;
+    PacketPtr m_packet;
+    SwsContext* m_sws = nullptr;
+    std::vector<uint8_t> m_staging;
+};
+
+class X264Encoder final : public VideoEncoder, private FfmpegState {
 public:
     explicit X264Encoder(const CodecConfig& config)
         : m_config(config),
           m_canvas(config.canvas_align_px, config.canvas_headroom, config.canvas_shrink_ratio,
                    config.canvas_shrink_after_frames, config.max_side_px) {}
-
-    ~X264Encoder() override { sws_freeContext(m_sws); }
 
     Expected<EncodedFrame> encode(const ImageRgba8& image, bool force_keyframe) override {
         const Stopwatch t0;
@@ -234,11 +251,6 @@ private:
 
     CodecConfig m_config;
     CanvasPolicy m_canvas;
-    ContextPtr m_ctx;
-    FramePtr m_frame;
-    PacketPtr m_packet;
-    SwsContext* m_sws = nullptr;
-    std::vector<uint8_t> m_staging;
     std::vector<uint8_t> m_payload;
     EncoderStats m_stats;
     int64_t m_pts = 0;
@@ -246,10 +258,8 @@ private:
     bool m_force_key = true;
 };
 
-class H264Decoder final : public VideoDecoder {
+class H264Decoder final : public VideoDecoder, private FfmpegState {
 public:
-    ~H264Decoder() override { sws_freeContext(m_sws); }
-
     Status open() {
         const AVCodec* codec = avcodec_find_decoder(AV_CODEC_ID_H264);
         if (!codec)
@@ -376,12 +386,7 @@ private:
         return image;
     }
 
-    ContextPtr m_ctx;
-    FramePtr m_frame;
-    PacketPtr m_packet;
-    SwsContext* m_sws = nullptr;
     std::vector<uint8_t> m_buffer;
-    std::vector<uint8_t> m_staging;
     ReferenceTracker m_tracker;
     double m_last_ms = 0.0;
 };

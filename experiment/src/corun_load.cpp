@@ -5,27 +5,27 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <thread>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "qvr/runtime/server_process.h"
+
 namespace qvr::experiment {
 
 Expected<std::unique_ptr<CoRunLoad>> CoRunLoad::start(const CalibrateOptions& o, int core,
                                                       const std::string& mix) {
-    std::error_code ec;
-    const std::string exe = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-    if (ec)
-        return makeError("cannot find this executable: " + ec.message());
+    const auto self = runtime::selfExecutable();
+    if (!self)
+        return makeError(self.error());
+    const std::string& exe = *self;
     int to_child[2], from_child[2];
     if (pipe2(to_child, O_CLOEXEC) != 0)
         return makeError(std::string("pipe: ") + std::strerror(errno));
@@ -34,10 +34,6 @@ Expected<std::unique_ptr<CoRunLoad>> CoRunLoad::start(const CalibrateOptions& o,
         ::close(to_child[1]);
         return makeError(std::string("pipe: ") + std::strerror(errno));
     }
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, to_child[0], STDIN_FILENO);
-    posix_spawn_file_actions_adddup2(&actions, from_child[1], STDOUT_FILENO);
     std::vector<std::string> args{exe,         "corun-load",
                                   "--scene",   o.scene,
                                   "--profile", o.profile,
@@ -45,20 +41,13 @@ Expected<std::unique_ptr<CoRunLoad>> CoRunLoad::start(const CalibrateOptions& o,
                                   "--core",    std::to_string(core),
                                   "--codec",   o.codec,
                                   "--mix",     mix};
-    std::vector<char*> argv;
-    for (std::string& a : args)
-        argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
+    const auto pid = runtime::spawnProcess(std::move(args), to_child[0], from_child[1]);
     ::close(to_child[0]);
     ::close(from_child[1]);
-    auto load = std::unique_ptr<CoRunLoad>(new CoRunLoad(pid, to_child[1], from_child[0]));
-    if (rc != 0) {
-        load->m_pid = -1;
-        return makeError("cannot start " + exe + ": " + std::strerror(rc));
-    }
+    auto load =
+        std::unique_ptr<CoRunLoad>(new CoRunLoad(pid ? *pid : -1, to_child[1], from_child[0]));
+    if (!pid)
+        return makeError("cannot start " + exe + ": " + pid.error());
     // Its ready line, once the scene is loaded (a minute at most).
     std::string line;
     char c = 0;

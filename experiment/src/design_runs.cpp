@@ -343,8 +343,8 @@ std::optional<RunError> DesignRunner::startOtherHeadsets() {
     return std::nullopt;
 }
 
-// The design's headsets once headset 0 (`own`, none when it failed) has ended: the others'
-// outcomes, their lines, and the span they ran in.
+// The design's headsets once headset 0 (`own`, none when it failed) has ended: its outcome, the
+// others' (awaited) and the span they ran in.
 void DesignRunner::keepHeadsets(const std::string& label, const DesignSummary* own,
                                 int64_t start_ns, bool stopped) {
     HeadsetsWindow w{label, {}, start_ns, 0};

@@ -8,9 +8,11 @@
 #include <fstream>
 #include <memory>
 #include <tuple>
+#include <variant>
 
 #include <fmt/format.h>
 
+#include "qvr/core/enum_table.h"
 #include "qvr/render/camera.h"
 #include "qvr/render/draw_list.h"
 #include "qvr/render/renderer.h"
@@ -25,44 +27,37 @@ namespace fs = std::filesystem;
 using runtime::DesignSummary;
 using runtime::FrameTelemetry;
 
+namespace {
+
+// Each compared metric's key in summary.json and the DesignMetrics member that holds it.
+struct MetricRow {
+    using Member = std::variant<double DesignMetrics::*, std::optional<double> DesignMetrics::*>;
+    Metric value;
+    const char* name;
+    Member member;
+};
+
+constexpr MetricRow kMetrics[] = {
+    {Metric::kFps, "fps_mean", &DesignMetrics::fps_mean},
+    {Metric::kMtpMean, "mtp_ms_mean", &DesignMetrics::mtp_ms_mean},
+    {Metric::kMtpP99, "mtp_ms_p99", &DesignMetrics::mtp_ms_p99},
+    {Metric::kBytes, "bytes_per_frame_mean", &DesignMetrics::bytes_per_frame_mean},
+    {Metric::kE1, "e1_deg_mean", &DesignMetrics::e1_deg_mean},
+    {Metric::kHeadsetBusy, "headset_busy_ms_mean", &DesignMetrics::headset_busy_ms_mean},
+    {Metric::kServerBusy, "server_busy_ms_mean", &DesignMetrics::server_busy_ms_mean}};
+
+}  // namespace
+
 const char* metricKey(Metric metric) {
-    switch (metric) {
-        case Metric::kFps:
-            return "fps_mean";
-        case Metric::kMtpMean:
-            return "mtp_ms_mean";
-        case Metric::kMtpP99:
-            return "mtp_ms_p99";
-        case Metric::kBytes:
-            return "bytes_per_frame_mean";
-        case Metric::kE1:
-            return "e1_deg_mean";
-        case Metric::kHeadsetBusy:
-            return "headset_busy_ms_mean";
-        case Metric::kServerBusy:
-            return "server_busy_ms_mean";
-    }
-    return "";
+    return enumName(kMetrics, metric, "");
 }
 
 std::optional<double> DesignMetrics::value(Metric metric) const {
-    switch (metric) {
-        case Metric::kFps:
-            return fps_mean;
-        case Metric::kMtpMean:
-            return mtp_ms_mean;
-        case Metric::kMtpP99:
-            return mtp_ms_p99;
-        case Metric::kBytes:
-            return bytes_per_frame_mean;
-        case Metric::kE1:
-            return e1_deg_mean;
-        case Metric::kHeadsetBusy:
-            return headset_busy_ms_mean;
-        case Metric::kServerBusy:
-            return server_busy_ms_mean;
-    }
-    return std::nullopt;
+    const MetricRow* row = enumRow(kMetrics, metric);
+    if (row == nullptr)
+        return std::nullopt;
+    return std::visit([this](auto member) -> std::optional<double> { return this->*member; },
+                      row->member);
 }
 
 DesignMetrics measuredMetrics(const DesignSummary& s, std::optional<double> server_busy_ms_mean) {

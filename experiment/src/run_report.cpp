@@ -185,15 +185,11 @@ nlohmann::json optionalJson(const std::optional<double>& v) {
 // The metrics a model predicts: the five headline ones, and each side's own cost where the model
 // has it.
 nlohmann::json predictedJson(const DesignMetrics& m) {
-    nlohmann::json j = {{"fps_mean", m.fps_mean},
-                        {"mtp_ms_mean", m.mtp_ms_mean},
-                        {"mtp_ms_p99", m.mtp_ms_p99},
-                        {"bytes_per_frame_mean", m.bytes_per_frame_mean},
-                        {"e1_deg_mean", m.e1_deg_mean}};
-    if (m.headset_busy_ms_mean)
-        j["headset_busy_ms_mean"] = *m.headset_busy_ms_mean;
-    if (m.server_busy_ms_mean)
-        j["server_busy_ms_mean"] = *m.server_busy_ms_mean;
+    nlohmann::json j = nlohmann::json::object();
+    for (Metric metric : kComparedMetrics) {
+        if (const std::optional<double> v = m.value(metric))
+            j[metricKey(metric)] = *v;
+    }
     return j;
 }
 

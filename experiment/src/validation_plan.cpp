@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "qvr/core/enum_table.h"
 #include "qvr/core/shell_quote.h"
 
 #include "qvr/experiment/validation.h"
@@ -41,15 +42,11 @@ size_t addCalibration(ValidationPlan& plan, const std::string& scene, int rep) {
 }  // namespace
 
 const char* calibrationPolicyName(CalibrationPolicy policy) {
-    switch (policy) {
-        case CalibrationPolicy::kPerRep:
-            return "per-rep";
-        case CalibrationPolicy::kOnce:
-            return "once";
-        case CalibrationPolicy::kGiven:
-            return "hardware";
-    }
-    return "?";
+    static constexpr EnumName<CalibrationPolicy> kNames[] = {
+        {CalibrationPolicy::kPerRep, "per-rep"},
+        {CalibrationPolicy::kOnce, "once"},
+        {CalibrationPolicy::kGiven, "hardware"}};
+    return enumName(kNames, policy);
 }
 
 size_t ValidationPlan::conditions() const {

@@ -440,6 +440,119 @@ WireError decodeControlHeader(std::span<const uint8_t> bytes, ControlHeader& out
     return WireError::kNone;
 }
 
+namespace {
+
+// Each control message's fields from r, range-checked; decodeFrameRequest is FrameRequest's.
+WireError decodeBody(ByteReader& r, ClientHello& m) {
+    r.bytes(m.client_nonce);
+    m.media_port = r.u16();
+    r.bytes(m.settings.codec);
+    r.bytes(m.settings.profile);
+    m.settings.width_px = r.u16();
+    m.settings.height_px = r.u16();
+    m.settings.refresh_mhz = r.u32();
+    const bool ok =
+        m.media_port != 0 && validName(m.settings.codec) && validName(m.settings.profile);
+    return ok ? WireError::kNone : WireError::kBadField;
+}
+
+WireError decodeBody(ByteReader& r, ServerChallenge& m) {
+    r.bytes(m.server_nonce);
+    m.session_id = r.u64();
+    r.bytes(m.server_proof);
+    return m.session_id != 0 ? WireError::kNone : WireError::kBadField;
+}
+
+WireError decodeBody(ByteReader& r, ClientAuth& m) {
+    r.bytes(m.client_proof);
+    return WireError::kNone;
+}
+
+WireError decodeBody(ByteReader& r, Welcome& m) {
+    m.session_id = r.u64();
+    m.media_port = r.u16();
+    return m.session_id != 0 && m.media_port != 0 ? WireError::kNone : WireError::kBadField;
+}
+
+WireError decodeBody(ByteReader& r, FrameRequest& m) {
+    return decodeFrameRequest(r, m);
+}
+
+WireError decodeBody(ByteReader& r, MediaAck& m) {
+    m.frame_id = r.u32();
+    m.stream_id = r.u8();
+    const uint8_t complete = r.u8();
+    m.packets_received = r.u16();
+    m.bytes_received = r.u32();
+    m.first_rx_ns = r.u64();
+    m.last_rx_ns = r.u64();
+    m.loss_ppm = r.u32();
+    m.complete = complete == 1;
+    if (m.stream_id >= kMaxStreams || complete > 1 || m.packets_received > kMaxPacketsPerFrame ||
+        m.bytes_received > kMaxStreamFrameBytes || m.last_rx_ns < m.first_rx_ns ||
+        m.loss_ppm > 1'000'000) {
+        return WireError::kBadField;
+    }
+    return WireError::kNone;
+}
+
+WireError decodeBody(ByteReader& r, KeyFrameRequest& m) {
+    m.stream_mask = r.u8();
+    m.last_frame_id = r.u32();
+    const uint8_t reason = r.u8();
+    if (m.stream_mask == 0 || m.stream_mask >= (1u << kMaxStreams) || reason < 1 || reason > 3) {
+        return WireError::kBadField;
+    }
+    m.reason = static_cast<KeyFrameReason>(reason);
+    return WireError::kNone;
+}
+
+WireError decodeBody(ByteReader& r, ThroughputReport& m) {
+    m.throughput_bps = r.u64();
+    m.samples = r.u32();
+    return m.throughput_bps <= 1'000'000'000'000ull ? WireError::kNone : WireError::kBadField;
+}
+
+WireError decodeBody(ByteReader& r, Bye& m) {
+    const uint8_t reason = r.u8();
+    if (reason > kMaxByeReason) {
+        return WireError::kBadField;
+    }
+    m.reason = static_cast<ByeReason>(reason);
+    return WireError::kNone;
+}
+
+WireError decodeBody(ByteReader& r, Nack& m) {
+    m.stream_id = r.u8();
+    m.first_seq = r.u32();
+    m.missing_mask = r.u64();
+    return m.stream_id < kMaxStreams && m.missing_mask != 0 ? WireError::kNone
+                                                            : WireError::kBadField;
+}
+
+WireError decodeBody(ByteReader& r, RouteConfirm& m) {
+    r.bytes(m.token);
+    return WireError::kNone;
+}
+
+WireError decodeBody(ByteReader& r, KeepAlive& m) {
+    m.client_send_ns = r.u64();
+    return WireError::kNone;
+}
+
+// A T into out when its fields are in range; out is left alone otherwise.
+template <typename T>
+WireError decodeInto(ByteReader& r, ControlMessage& out) {
+    T m;
+    const WireError e = decodeBody(r, m);
+    if (e == WireError::kNone) {
+        out = m;
+    }
+    return e;
+}
+
+}  // namespace
+
 WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payload,
                                ControlMessage& out) {
     const size_t expected = payloadBytesOf(type);
@@ -453,132 +566,49 @@ WireError decodeControlPayload(ControlType type, std::span<const uint8_t> payloa
         return WireError::kTrailingBytes;
     }
     ByteReader r(payload);
+    WireError e = WireError::kUnknownType;  // kSealed: unreachable, payloadBytesOf is 0
     switch (type) {
-        case ControlType::kClientHello: {
-            ClientHello m;
-            r.bytes(m.client_nonce);
-            m.media_port = r.u16();
-            r.bytes(m.settings.codec);
-            r.bytes(m.settings.profile);
-            m.settings.width_px = r.u16();
-            m.settings.height_px = r.u16();
-            m.settings.refresh_mhz = r.u32();
-            if (m.media_port == 0 || !validName(m.settings.codec) ||
-                !validName(m.settings.profile)) {
-                return WireError::kBadField;
-            }
-            out = m;
+        case ControlType::kClientHello:
+            e = decodeInto<ClientHello>(r, out);
             break;
-        }
-        case ControlType::kServerChallenge: {
-            ServerChallenge m;
-            r.bytes(m.server_nonce);
-            m.session_id = r.u64();
-            r.bytes(m.server_proof);
-            if (m.session_id == 0) {
-                return WireError::kBadField;
-            }
-            out = m;
+        case ControlType::kServerChallenge:
+            e = decodeInto<ServerChallenge>(r, out);
             break;
-        }
-        case ControlType::kClientAuth: {
-            ClientAuth m;
-            r.bytes(m.client_proof);
-            out = m;
+        case ControlType::kClientAuth:
+            e = decodeInto<ClientAuth>(r, out);
             break;
-        }
-        case ControlType::kWelcome: {
-            Welcome m;
-            m.session_id = r.u64();
-            m.media_port = r.u16();
-            if (m.session_id == 0 || m.media_port == 0) {
-                return WireError::kBadField;
-            }
-            out = m;
+        case ControlType::kWelcome:
+            e = decodeInto<Welcome>(r, out);
             break;
-        }
-        case ControlType::kFrameRequest: {
-            FrameRequest m;
-            const WireError e = decodeFrameRequest(r, m);
-            if (e != WireError::kNone) {
-                return e;
-            }
-            out = m;
+        case ControlType::kFrameRequest:
+            e = decodeInto<FrameRequest>(r, out);
             break;
-        }
-        case ControlType::kMediaAck: {
-            MediaAck m;
-            m.frame_id = r.u32();
-            m.stream_id = r.u8();
-            const uint8_t complete = r.u8();
-            m.packets_received = r.u16();
-            m.bytes_received = r.u32();
-            m.first_rx_ns = r.u64();
-            m.last_rx_ns = r.u64();
-            m.loss_ppm = r.u32();
-            m.complete = complete == 1;
-            if (m.stream_id >= kMaxStreams || complete > 1 ||
-                m.packets_received > kMaxPacketsPerFrame ||
-                m.bytes_received > kMaxStreamFrameBytes || m.last_rx_ns < m.first_rx_ns ||
-                m.loss_ppm > 1'000'000) {
-                return WireError::kBadField;
-            }
-            out = m;
+        case ControlType::kMediaAck:
+            e = decodeInto<MediaAck>(r, out);
             break;
-        }
-        case ControlType::kKeyFrameRequest: {
-            KeyFrameRequest m;
-            m.stream_mask = r.u8();
-            m.last_frame_id = r.u32();
-            const uint8_t reason = r.u8();
-            if (m.stream_mask == 0 || m.stream_mask >= (1u << kMaxStreams) || reason < 1 ||
-                reason > 3) {
-                return WireError::kBadField;
-            }
-            m.reason = static_cast<KeyFrameReason>(reason);
-            out = m;
+        case ControlType::kKeyFrameRequest:
+            e = decodeInto<KeyFrameRequest>(r, out);
             break;
-        }
-        case ControlType::kThroughputReport: {
-            ThroughputReport m;
-            m.throughput_bps = r.u64();
-            m.samples = r.u32();
-            if (m.throughput_bps > 1'000'000'000'000ull) {
-                return WireError::kBadField;
-            }
-            out = m;
+        case ControlType::kThroughputReport:
+            e = decodeInto<ThroughputReport>(r, out);
             break;
-        }
-        case ControlType::kBye: {
-            const uint8_t reason = r.u8();
-            if (reason > kMaxByeReason) {
-                return WireError::kBadField;
-            }
-            out = Bye{static_cast<ByeReason>(reason)};
+        case ControlType::kBye:
+            e = decodeInto<Bye>(r, out);
             break;
-        }
-        case ControlType::kNack: {
-            Nack m;
-            m.stream_id = r.u8();
-            m.first_seq = r.u32();
-            m.missing_mask = r.u64();
-            if (m.stream_id >= kMaxStreams || m.missing_mask == 0) {
-                return WireError::kBadField;
-            }
-            out = m;
+        case ControlType::kNack:
+            e = decodeInto<Nack>(r, out);
             break;
-        }
-        case ControlType::kRouteConfirm: {
-            RouteConfirm m;
-            r.bytes(m.token);
-            out = m;
+        case ControlType::kRouteConfirm:
+            e = decodeInto<RouteConfirm>(r, out);
             break;
-        }
         case ControlType::kKeepAlive:
-            out = KeepAlive{r.u64()};
+            e = decodeInto<KeepAlive>(r, out);
             break;
         case ControlType::kSealed:
-            return WireError::kUnknownType;  // unreachable: payloadBytesOf is 0
+            break;
+    }
+    if (e != WireError::kNone) {
+        return e;
     }
     return r.ok() ? WireError::kNone : WireError::kTruncated;
 }

@@ -64,6 +64,25 @@ Expected<std::string> selfExecutable() {
     return p.string();
 }
 
+Expected<pid_t> spawnProcess(std::vector<std::string> argv, int stdin_fd, int stdout_fd) {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    if (stdin_fd != -1)
+        posix_spawn_file_actions_adddup2(&actions, stdin_fd, STDIN_FILENO);
+    if (stdout_fd != -1)
+        posix_spawn_file_actions_adddup2(&actions, stdout_fd, STDOUT_FILENO);
+    std::vector<char*> argv_c;
+    for (std::string& a : argv)
+        argv_c.push_back(a.data());
+    argv_c.push_back(nullptr);
+    pid_t pid = -1;
+    const int rc = posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, argv_c.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0)
+        return makeError(std::strerror(rc));
+    return pid;
+}
+
 struct ServerProcess::Impl {
     pid_t pid = -1;
     int stdout_fd = -1;  // non-blocking once the child is ready
@@ -137,26 +156,16 @@ Expected<ServerProcess> ServerProcess::start(const std::string& executable,
     int fds[2];
     if (pipe2(fds, O_CLOEXEC) != 0)
         return makeError(std::string("server process: pipe: ") + std::strerror(errno));
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
-    std::vector<std::string> argv_s;
-    argv_s.push_back(executable);
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : argv_s)
-        argv.push_back(a.data());
-    argv.push_back(nullptr);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, executable.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
+    std::vector<std::string> argv{executable};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const auto pid = spawnProcess(std::move(argv), -1, fds[1]);
     close(fds[1]);
-    if (rc != 0) {
+    if (!pid) {
         close(fds[0]);
-        return makeError("server process: cannot start " + executable + ": " + std::strerror(rc));
+        return makeError("server process: cannot start " + executable + ": " + pid.error());
     }
     auto impl = std::make_unique<Impl>();
-    impl->pid = pid;
+    impl->pid = *pid;
     impl->stdout_fd = fds[0];
     // Read lines until the ready line, the child's exit or the deadline.
     std::string pending;

@@ -503,6 +503,34 @@ void nodeSphere(const glm::vec3& mn, const glm::vec3& mx, glm::dvec3& center, do
     radius = 0.5 * glm::length(glm::dvec3(mx) - glm::dvec3(mn)) * (1.0 + 1e-12);
 }
 
+// Depth-first over the nodes whose boxes are not outside the planes. `whole(node, side)` ends a
+// node's walk when it returns true (the node is outside the query or counted whole); otherwise
+// the walk goes on into its children, or at a leaf calls `leaf(node)` to test its triangles.
+template <typename Nodes, typename Whole, typename Leaf>
+void walkNodes(const Nodes& nodes, const Plane* planes, int plane_count, BvhQueryStats& st,
+               Whole whole, Leaf leaf) {
+    // (node, planes still to test) pairs.
+    std::pair<uint32_t, uint32_t> stack[64];
+    int top = 0;
+    stack[top++] = {0u, (1u << plane_count) - 1};
+    while (top > 0) {
+        auto [node_index, mask] = stack[--top];
+        const auto& node = nodes[node_index];
+        ++st.nodes_visited;
+        const BoxSide side = boxAgainst(node.min, node.max, planes, plane_count, &mask);
+        if (side == BoxSide::kOutside || whole(node, side))
+            continue;
+        if (node.left == 0) {
+            st.triangles_tested += node.end - node.begin;
+            leaf(node);
+        } else {
+            QVR_CHECK(top + 2 <= 64);
+            stack[top++] = {node.left, mask};
+            stack[top++] = {node.left + 1, mask};
+        }
+    }
+}
+
 }  // namespace
 
 uint64_t TriangleBvh::countTrianglesInCone(const ViewCone& cone, BvhQueryStats* stats) const {
@@ -514,39 +542,25 @@ uint64_t TriangleBvh::countTrianglesInCone(const ViewCone& cone, BvhQueryStats* 
     const Plane slab[2] = {Plane{q.axis, -q.near_m - glm::dot(q.axis, q.apex)},
                            Plane{-q.axis, q.far_m + glm::dot(q.axis, q.apex)}};
     uint64_t count = 0;
-    // (node, planes still to test) pairs.
-    std::pair<uint32_t, uint32_t> stack[64];
-    int top = 0;
-    stack[top++] = {0u, (1u << 2) - 1};
-    while (top > 0) {
-        auto [node_index, mask] = stack[--top];
-        const Node& node = m_nodes[node_index];
-        ++st.nodes_visited;
-        const BoxSide side = boxAgainst(node.min, node.max, slab, 2, &mask);
-        if (side == BoxSide::kOutside)
-            continue;
+    const auto whole = [&](const Node& node, BoxSide side) {
         glm::dvec3 center;
         double radius;
         nodeSphere(node.min, node.max, center, radius);
         const CosRange r = sphereCosRange(center - q.apex, radius, q.axis);
         if (r.valid && r.cos_lo < q.cos_half - kCosMargin)
-            continue;  // entirely outside the cone
+            return true;  // entirely outside the cone
         if (side == BoxSide::kInside && r.valid && r.cos_hi > q.cos_half + kCosMargin) {
             // The whole subtree lies inside the cone: count it without visiting.
             count += node.end - node.begin;
             ++st.nodes_accepted_whole;
-            continue;
+            return true;
         }
-        if (node.left == 0) {
-            st.triangles_tested += node.end - node.begin;
-            for (uint32_t i = node.begin; i < node.end; ++i)
-                count += q.contains(&m_tri[3 * static_cast<size_t>(i)], false) ? 1 : 0;
-        } else {
-            QVR_CHECK(top + 2 <= 64);
-            stack[top++] = {node.left, mask};
-            stack[top++] = {node.left + 1, mask};
-        }
-    }
+        return false;
+    };
+    walkNodes(m_nodes, slab, 2, st, whole, [&](const Node& node) {
+        for (uint32_t i = node.begin; i < node.end; ++i)
+            count += q.contains(&m_tri[3 * static_cast<size_t>(i)], false) ? 1 : 0;
+    });
     return count;
 }
 
@@ -580,46 +594,31 @@ std::vector<uint64_t> TriangleBvh::trianglesPerRing(const EyeView& view,
     const ViewQuery q(view, gaze_dir_eye, ring_deg, rings);
     const auto world = worldFrustum(view);
     const glm::dvec3 g_world = view.orientation * glm::normalize(gaze_dir_eye);
-    // (node, planes still to test) pairs.
-    std::pair<uint32_t, uint32_t> stack[64];
-    int top = 0;
-    stack[top++] = {0u, (1u << 6) - 1};
-    while (top > 0) {
-        auto [node_index, mask] = stack[--top];
-        const Node& node = m_nodes[node_index];
-        ++st.nodes_visited;
-        const BoxSide side = boxAgainst(node.min, node.max, world.data(), 6, &mask);
-        if (side == BoxSide::kOutside)
-            continue;
-        if (side == BoxSide::kInside) {
-            // Entirely inside the frustum: if its bounding sphere's angular range lies within
-            // one ring, every triangle below lands in that ring.
-            int ring = 0;
-            if (rings > 1) {
-                glm::dvec3 center;
-                double radius;
-                nodeSphere(node.min, node.max, center, radius);
-                ring = q.rings().ofRange(sphereCosRange(center - view.position_m, radius, g_world));
-            }
-            if (ring >= 0) {
-                hist[static_cast<size_t>(ring)] += node.end - node.begin;
-                ++st.nodes_accepted_whole;
-                continue;
-            }
+    const auto whole = [&](const Node& node, BoxSide side) {
+        if (side != BoxSide::kInside)
+            return false;
+        // Entirely inside the frustum: if its bounding sphere's angular range lies within one
+        // ring, every triangle below lands in that ring.
+        int ring = 0;
+        if (rings > 1) {
+            glm::dvec3 center;
+            double radius;
+            nodeSphere(node.min, node.max, center, radius);
+            ring = q.rings().ofRange(sphereCosRange(center - view.position_m, radius, g_world));
         }
-        if (node.left == 0) {
-            st.triangles_tested += node.end - node.begin;
-            for (uint32_t i = node.begin; i < node.end; ++i) {
-                const int ring = q.classify(&m_tri[3 * static_cast<size_t>(i)], false);
-                if (ring >= 0)
-                    ++hist[static_cast<size_t>(ring)];
-            }
-        } else {
-            QVR_CHECK(top + 2 <= 64);
-            stack[top++] = {node.left, mask};
-            stack[top++] = {node.left + 1, mask};
+        if (ring < 0)
+            return false;
+        hist[static_cast<size_t>(ring)] += node.end - node.begin;
+        ++st.nodes_accepted_whole;
+        return true;
+    };
+    walkNodes(m_nodes, world.data(), 6, st, whole, [&](const Node& node) {
+        for (uint32_t i = node.begin; i < node.end; ++i) {
+            const int ring = q.classify(&m_tri[3 * static_cast<size_t>(i)], false);
+            if (ring >= 0)
+                ++hist[static_cast<size_t>(ring)];
         }
-    }
+    });
     return hist;
 }
 

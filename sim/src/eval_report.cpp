@@ -26,6 +26,35 @@ std::string benchHeader(const EvalRuns& runs, const std::string& first,
     return s;
 }
 
+// A gnuplot script: the clustered histogram of columns 2 to last_column of csv, a cluster per
+// row (a configuration, labelled by column 1).
+std::string configHistogram(const std::string& title, const std::string& ylabel,
+                            const std::string& csv, size_t last_column) {
+    return fmt::format(
+        "set datafile separator ','\nset title '{}'\nset style data histogram\nset style "
+        "histogram clustered gap 1\nset style fill solid 0.8 border -1\nset key outside "
+        "right\nset xtics rotate by -30\nset grid ytics\nset ylabel '{}'\nplot for [i=2:{}] "
+        "'{}' using i:xtic(1) title columnheader(i)\n",
+        title, ylabel, last_column, csv);
+}
+
+// ",<prefix><design>" for each compared design.
+std::string designHeader(const std::string& prefix) {
+    std::string s;
+    for (Design d : kCompared)
+        s += fmt::format(",{}{}", prefix, traitsOf(d).name);
+    return s;
+}
+
+// Bench b's name and label, then value(summary) for each compared design, to 4 places.
+template <typename Value>
+std::string designRow(const EvalRuns& runs, size_t b, Value value) {
+    std::string s = fmt::format("{},{}", runs.benches[b].name, runs.benches[b].label);
+    for (Design d : kCompared)
+        s += fmtCell(value(runs.at(b, d)), 4);
+    return s;
+}
+
 }  // namespace
 
 Outputs::Outputs(const fs::path& dir) : m_dir(dir), m_plotter(dir, 1100, 520) {}
@@ -54,15 +83,12 @@ bool Outputs::has(const std::string& name) const {
 
 // Fig. 12: end-to-end speedup over local; FPS of sw and qvr over local.
 Expected<std::string> writeFig12(const EvalRuns& runs, Outputs& out) {
-    std::string fig12 = "bench,label";
-    for (Design d : kCompared)
-        fig12 += fmt::format(",{}", traitsOf(d).name);
-    fig12 += ",fps_sw_over_local,fps_qvr_over_local\n";
+    std::string fig12 =
+        "bench,label" + designHeader("") + ",fps_sw_over_local,fps_qvr_over_local\n";
     for (size_t b = 0; b < runs.size(); ++b) {
         const RunSummary& local = runs.at(b, Design::Local);
-        fig12 += fmt::format("{},{}", runs.benches[b].name, runs.benches[b].label);
-        for (Design d : kCompared)
-            fig12 += fmtCell(local.mtp_ms_mean / runs.at(b, d).mtp_ms_mean, 4);
+        fig12 += designRow(runs, b,
+                           [&](const RunSummary& s) { return local.mtp_ms_mean / s.mtp_ms_mean; });
         fig12 +=
             fmt::format(",{},{}\n", fmtNum(runs.at(b, Design::Sw).fps_mean / local.fps_mean, 4),
                         fmtNum(runs.at(b, Design::Qvr).fps_mean / local.fps_mean, 4));
@@ -83,17 +109,12 @@ Expected<std::string> writeFig12(const EvalRuns& runs, Outputs& out) {
 
 // Fig. 13: transmitted data and shaded resolution normalised to remote.
 Expected<std::string> writeFig13(const EvalRuns& runs, Outputs& out) {
-    std::string fig13 = "bench,label";
-    for (Design d : kCompared)
-        fig13 += fmt::format(",data_{}", traitsOf(d).name);
-    for (Design d : kCompared)
-        fig13 += fmt::format(",pixels_{}", traitsOf(d).name);
-    fig13 += "\n";
+    std::string fig13 = "bench,label" + designHeader("data_") + designHeader("pixels_") + "\n";
     for (size_t b = 0; b < runs.size(); ++b) {
         const RunSummary& remote = runs.at(b, Design::Remote);
-        fig13 += fmt::format("{},{}", runs.benches[b].name, runs.benches[b].label);
-        for (Design d : kCompared)
-            fig13 += fmtCell(runs.at(b, d).bytes_per_frame_mean / remote.bytes_per_frame_mean, 4);
+        fig13 += designRow(runs, b, [&](const RunSummary& s) {
+            return s.bytes_per_frame_mean / remote.bytes_per_frame_mean;
+        });
         for (Design d : kCompared)
             fig13 += fmtCell(runs.at(b, d).pixels_per_frame_mean / remote.pixels_per_frame_mean, 4);
         fig13 += "\n";
@@ -173,12 +194,8 @@ Expected<std::string> writeTable4(const EvalRuns& runs, Outputs& out) {
     if (Status st = out.csv("table4_plot.csv", t4_plot); !st)
         return makeError(st.error());
     out.plot("table4", "Table 4: steady-state e1 (deg) of Q-VR",
-             fmt::format("set datafile separator ','\nset title 'Table 4: steady-state e1 (deg) "
-                         "of Q-VR'\nset style data histogram\nset style histogram clustered gap "
-                         "1\nset style fill solid 0.8 border -1\nset key outside right\nset "
-                         "xtics rotate by -30\nset grid ytics\nset ylabel 'e1 (deg)'\nplot for "
-                         "[i=2:{}] 'table4_plot.csv' using i:xtic(1) title columnheader(i)\n",
-                         runs.size() + 1));
+             configHistogram("Table 4: steady-state e1 (deg) of Q-VR", "e1 (deg)",
+                             "table4_plot.csv", runs.size() + 1));
     return t4;
 }
 
@@ -201,13 +218,8 @@ Expected<std::string> writeFig15(const EvalRuns& runs, Outputs& out) {
     if (Status st = out.csv("fig15_energy.csv", f15); !st)
         return makeError(st.error());
     out.plot("fig15", "Fig. 15: Q-VR energy per frame normalised to local (x)",
-             fmt::format("set datafile separator ','\nset title 'Fig. 15: Q-VR energy per frame "
-                         "normalised to local'\nset style data histogram\nset style histogram "
-                         "clustered gap 1\nset style fill solid 0.8 border -1\nset key outside "
-                         "right\nset xtics rotate by -30\nset grid ytics\nset ylabel 'energy / "
-                         "local energy (x)'\nplot for [i=2:{}] 'fig15_energy.csv' using "
-                         "i:xtic(1) title columnheader(i)\n",
-                         runs.size() + 2));
+             configHistogram("Fig. 15: Q-VR energy per frame normalised to local",
+                             "energy / local energy (x)", "fig15_energy.csv", runs.size() + 2));
     return f15;
 }
 

@@ -281,6 +281,19 @@ for n in 0 17 x; do
         fail "run --headsets $n exits 2" "exit $rc: $(head -c 200 "$tmp/bad_err.txt")"
     fi
 done
+# qvr capacity: a calibration and a workload are required; bad values exit 2.
+for args in "--trace x --target-fps 30" \
+    "--hardware /nonexistent.toml --trace x --target-fps 30" \
+    "--hardware $tmp/rt_bad.toml --trace $tmp/rt_bad.toml --target-fps 0"; do
+    # shellcheck disable=SC2086
+    "$QVR" capacity $args >/dev/null 2>"$tmp/bad_err.txt"
+    rc=$?
+    if [ $rc -eq 2 ] && [ -s "$tmp/bad_err.txt" ]; then
+        pass "capacity $args exits 2"
+    else
+        fail "capacity $args exits 2" "exit $rc"
+    fi
+done
 expect_error "validate --depths 3" validate --depths 3 --dry-run --out "$tmp/val"
 expect_error "validate --frames 2" validate --frames 2 --dry-run --out "$tmp/val"
 expect_error "validate --reps 0" validate --reps 0 --dry-run --out "$tmp/val"

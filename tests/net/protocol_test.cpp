@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <set>
+#include <string_view>
 
 #include "qvr/foveation/hmd_profile.h"
 #include "qvr/net/fec.h"
@@ -318,6 +320,27 @@ TEST(NetProtocol, MalformedMediaPacketsAreRejected) {
 
 // Random corruption of valid messages: each decode either succeeds or names an error, and a
 // message that decodes re-encodes to a decodable message. Run under ASan/UBSan in CI.
+TEST(NetProtocol, EveryByeReasonAndWireErrorHasItsOwnText) {
+    std::set<std::string_view> names, texts;
+    for (uint8_t r = 0; r <= kMaxByeReason; ++r) {
+        names.insert(byeReasonName(static_cast<ByeReason>(r)));
+        texts.insert(byeReasonClientText(static_cast<ByeReason>(r)));
+    }
+    EXPECT_EQ(names.size(), kMaxByeReason + 1u);
+    EXPECT_EQ(texts.size(), kMaxByeReason + 1u);
+    EXPECT_EQ(names.count("?"), 0u);
+    EXPECT_EQ(byeReasonName(ByeReason::kServerFull), "server full");
+    EXPECT_EQ(byeReasonClientText(ByeReason::kServerFull), "is full");
+    EXPECT_EQ(byeReasonName(static_cast<ByeReason>(kMaxByeReason + 1)), "?");
+    EXPECT_EQ(byeReasonClientText(static_cast<ByeReason>(kMaxByeReason + 1)), "said bye");
+    std::set<std::string_view> errors;
+    for (int e = 0; e < kWireErrorCount; ++e)
+        errors.insert(wireErrorName(static_cast<WireError>(e)));
+    EXPECT_EQ(errors.size(), static_cast<size_t>(kWireErrorCount));
+    EXPECT_EQ(errors.count("?"), 0u);
+    EXPECT_EQ(wireErrorName(WireError::kBadMac), "bad MAC");
+}
+
 TEST(NetProtocol, RandomCorruptionNeverCrashes) {
     std::mt19937_64 rng(20210419);
     std::vector<std::vector<uint8_t>> seeds;

@@ -8,6 +8,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -151,6 +152,34 @@ TEST(ServerProcess, ErrorsWithoutCrashingWhenTheExecutableDoesNotExist) {
     // A file that exists but cannot be executed.
     auto not_exe = ServerProcess::start("/etc/hostname", {}, 2000);
     EXPECT_FALSE(not_exe.ok());
+}
+
+TEST(SpawnProcess, WiresTheChildsStandardInputAndOutputToTheGivenDescriptors) {
+    int to_child[2], from_child[2];
+    ASSERT_EQ(::pipe2(to_child, O_CLOEXEC), 0);
+    ASSERT_EQ(::pipe2(from_child, O_CLOEXEC), 0);
+    const auto pid = spawnProcess({"/bin/sh", "-c", "read line; echo \"got $line\""}, to_child[0],
+                                  from_child[1]);
+    ::close(to_child[0]);
+    ::close(from_child[1]);
+    ASSERT_TRUE(pid.ok()) << pid.error();
+    ASSERT_EQ(::write(to_child[1], "hi\n", 3), 3);
+    ::close(to_child[1]);
+    std::string out;
+    char c = 0;
+    while (::read(from_child[0], &c, 1) == 1)
+        out += c;
+    ::close(from_child[0]);
+    int status = 0;
+    ASSERT_EQ(::waitpid(*pid, &status, 0), *pid);
+    EXPECT_EQ(out, "got hi\n");
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
+TEST(SpawnProcess, SaysWhyWhenTheExecutableCannotStart) {
+    const auto pid = spawnProcess({"/nonexistent/qvr-spawn"}, -1, -1);
+    ASSERT_FALSE(pid.ok());
+    EXPECT_NE(pid.error().find("No such file"), std::string::npos) << pid.error();
 }
 
 TEST(ServerProcess, MovingTransfersOwnershipOfTheChild) {

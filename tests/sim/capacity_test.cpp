@@ -104,6 +104,28 @@ TEST(PredictCapacity, StopsAfterTwoCountsBelowTheTarget) {
     EXPECT_EQ(r->points.size(), 3u);
 }
 
+TEST(PredictCapacity, EveryCountWhenAsked) {
+    CapacityOptions o = remoteOptions(60.0);
+    o.every_count = true;
+    o.max_headsets = 5;
+    const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), o);
+    ASSERT_TRUE(r) << r.error();
+    EXPECT_EQ(r->points.size(), 5u);
+    EXPECT_EQ(r->headsets, 1);
+}
+
+TEST(CapacityOutput, TextAndJsonSayTheCountAtTheTarget) {
+    const CapacityOptions o = remoteOptions(20.0);
+    const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), o);
+    ASSERT_TRUE(r) << r.error();
+    EXPECT_NE(capacityText(*r, o).find("3 headsets per server at 20 FPS"), std::string::npos)
+        << capacityText(*r, o);
+    const std::string json = capacityJson(*r, o);
+    EXPECT_NE(json.find("\"headsets_at_target\": 3"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"server_ms_per_headset_frame\""), std::string::npos);
+    EXPECT_NE(json.find("\"design\": \"remote\""), std::string::npos);
+}
+
 TEST(PredictCapacity, RefusesANonPositiveTarget) {
     EXPECT_FALSE(predictCapacity(flatTrace(10), serverBoundCosts(7.0), remoteOptions(0.0)));
 }

@@ -152,6 +152,21 @@ TEST(HeadMotion, ResamplesPlacesAndPicksUnits) {
     EXPECT_FALSE(headTraceFromBvh(*m, o).ok()) << "more frames than the recording holds";
 }
 
+TEST(HeadMotion, NamesParsesAndSizesEveryUnit) {
+    for (BvhUnit unit : {BvhUnit::kAuto, BvhUnit::kMetre, BvhUnit::kCentimetre, BvhUnit::kInch,
+                         BvhUnit::kCmuAsf}) {
+        auto back = bvhUnitFromName(bvhUnitName(unit));
+        ASSERT_TRUE(back.ok()) << bvhUnitName(unit);
+        EXPECT_EQ(*back, unit);
+    }
+    EXPECT_EQ(bvhUnitMetres(BvhUnit::kAuto), 0.0);
+    EXPECT_EQ(bvhUnitMetres(BvhUnit::kCentimetre), 0.01);
+    EXPECT_DOUBLE_EQ(bvhUnitMetres(BvhUnit::kCmuAsf), 0.0254 / 0.45);
+    auto bad = bvhUnitFromName("feet");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_EQ(bad.error(), "unit 'feet': expected auto, m, cm, inch or cmu");
+}
+
 TEST(HeadMotion, FindsTheHeadByNameOrAsTheTopOfTheSpine) {
     auto m = parseBvh(smallBvh(), "small.bvh");
     ASSERT_TRUE(m.ok());

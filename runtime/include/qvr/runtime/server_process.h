@@ -47,4 +47,9 @@ private:
 // The path of the running executable (/proc/self/exe).
 Expected<std::string> selfExecutable();
 
+// Starts argv[0] with the arguments argv and this process's environment; its standard input and
+// output are dup'ed from stdin_fd and stdout_fd where those are not -1. The child's pid, or the
+// reason it did not start (strerror's text).
+Expected<pid_t> spawnProcess(std::vector<std::string> argv, int stdin_fd, int stdout_fd);
+
 }  // namespace qvr::runtime
