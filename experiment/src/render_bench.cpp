@@ -159,22 +159,24 @@ Expected<RenderBenchResult> runRenderBench(const RenderBenchPlan& plan,
 }
 
 nlohmann::json renderBenchJson(const RenderBenchResult& r) {
-    nlohmann::json j = {{"profile", r.plan.profile.name},
-                        {"width_px", r.plan.profile.width_px},
-                        {"height_px", r.plan.profile.height_px},
-                        {"e1_deg", r.layers_plan.e1_deg},
-                        {"s1", r.layers_plan.s1},
-                        {"s2", r.layers_plan.s2},
-                        {"renderer", r.renderer},
-                        {"frames", r.plan.frames},
-                        {"msaa_samples", r.plan.renderer.msaa_samples},
-                        {"load_average", r.load_average},
-                        {"scenes", nlohmann::json::array()}};
+    nlohmann::json j;
+    j["profile"] = r.plan.profile.name;
+    j["width_px"] = r.plan.profile.width_px;
+    j["height_px"] = r.plan.profile.height_px;
+    j["e1_deg"] = r.layers_plan.e1_deg;
+    j["s1"] = r.layers_plan.s1;
+    j["s2"] = r.layers_plan.s2;
+    j["renderer"] = r.renderer;
+    j["frames"] = r.plan.frames;
+    j["msaa_samples"] = r.plan.renderer.msaa_samples;
+    j["load_average"] = r.load_average;
+    j["scenes"] = nlohmann::json::array();
     for (const RenderBenchSceneResult& s : r.scenes) {
-        nlohmann::json js = {{"scene", s.scene},
-                             {"triangles", s.triangles},
-                             {"load_ms", s.load_ms},
-                             {"upload_ms", s.upload_ms}};
+        nlohmann::json js;
+        js["scene"] = s.scene;
+        js["triangles"] = s.triangles;
+        js["load_ms"] = s.load_ms;
+        js["upload_ms"] = s.upload_ms;
         for (const RenderBenchLayer& l : s.layers)
             js["layers"][l.name] = {{"pixels", l.pixels},
                                     {"render_ms_median", l.render_ms_median},

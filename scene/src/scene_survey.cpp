@@ -52,17 +52,18 @@ Expected<SceneInfo> surveyScene(const std::string& name, const SceneLoadOptions&
 }
 
 nlohmann::json sceneInfoJson(const SceneInfo& s) {
-    nlohmann::json j = {{"scene", s.name},
-                        {"format", s.format},
-                        {"triangles", s.counts.triangles},
-                        {"patch_triangles", s.counts.patch_triangles},
-                        {"total_triangles", s.counts.total()},
-                        {"patch_level", s.patch_level},
-                        {"vertices", s.vertices},
-                        {"batches", s.batches},
-                        {"textures", s.textures},
-                        {"texture_bytes", s.texture_bytes},
-                        {"lightmaps", s.lightmaps}};
+    nlohmann::json j;
+    j["scene"] = s.name;
+    j["format"] = s.format;
+    j["triangles"] = s.counts.triangles;
+    j["patch_triangles"] = s.counts.patch_triangles;
+    j["total_triangles"] = s.counts.total();
+    j["patch_level"] = s.patch_level;
+    j["vertices"] = s.vertices;
+    j["batches"] = s.batches;
+    j["textures"] = s.textures;
+    j["texture_bytes"] = s.texture_bytes;
+    j["lightmaps"] = s.lightmaps;
     j["bounds"] = {{"min", vecJson(s.bounds.min)},
                    {"max", vecJson(s.bounds.max)},
                    {"size", vecJson(s.bounds.max - s.bounds.min)}};
@@ -158,27 +159,28 @@ SceneCount countSceneView(const Scene& scene, const SceneCountPlan& plan) {
 
 nlohmann::json sceneCountJson(const SceneCount& c) {
     const SceneCountPlan& p = c.plan;
-    nlohmann::json j = {{"scene", c.scene},
-                        {"triangles", c.triangles},
-                        {"spawn", p.spawn},
-                        {"eye_position_m", vecJson(c.eye_position_m)},
-                        {"yaw_deg", c.yaw_deg},
-                        {"pitch_deg", p.pitch_deg},
-                        {"profile", p.profile},
-                        {"fov_deg", {p.fov_h_deg, p.fov_v_deg}},
-                        {"near_m", p.near_m},
-                        {"far_m", p.far_m},
-                        {"gaze_deg", {p.gaze_x_deg, p.gaze_y_deg}},
-                        {"ring_deg", p.ring_deg},
-                        {"triangles_in_view", c.in_view},
-                        {"triangles_per_ring", c.per_ring},
-                        {"e1_deg", p.e1_deg},
-                        {"triangles_in_fovea_cone", c.in_cone},
-                        {"bvh_build_ms", c.bvh_build_ms},
-                        {"rings_ms", c.rings_ms},
-                        {"cone_ms", c.cone_ms},
-                        {"rings_nodes_visited", c.ring_stats.nodes_visited},
-                        {"rings_triangles_tested", c.ring_stats.triangles_tested}};
+    nlohmann::json j;
+    j["scene"] = c.scene;
+    j["triangles"] = c.triangles;
+    j["spawn"] = p.spawn;
+    j["eye_position_m"] = vecJson(c.eye_position_m);
+    j["yaw_deg"] = c.yaw_deg;
+    j["pitch_deg"] = p.pitch_deg;
+    j["profile"] = p.profile;
+    j["fov_deg"] = {p.fov_h_deg, p.fov_v_deg};
+    j["near_m"] = p.near_m;
+    j["far_m"] = p.far_m;
+    j["gaze_deg"] = {p.gaze_x_deg, p.gaze_y_deg};
+    j["ring_deg"] = p.ring_deg;
+    j["triangles_in_view"] = c.in_view;
+    j["triangles_per_ring"] = c.per_ring;
+    j["e1_deg"] = p.e1_deg;
+    j["triangles_in_fovea_cone"] = c.in_cone;
+    j["bvh_build_ms"] = c.bvh_build_ms;
+    j["rings_ms"] = c.rings_ms;
+    j["cone_ms"] = c.cone_ms;
+    j["rings_nodes_visited"] = c.ring_stats.nodes_visited;
+    j["rings_triangles_tested"] = c.ring_stats.triangles_tested;
     if (p.brute_force) {
         j["brute_force_ms"] = c.brute_force_ms;
         j["brute_force_agrees"] = c.brute_force_agrees;
