@@ -1,10 +1,6 @@
 // Option parsers shared by several subcommands, so that `--gaze` means the same everywhere.
 #pragma once
 
-#include <arpa/inet.h>
-#include <netdb.h>
-#include <sys/socket.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,9 +8,14 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "options.h"
+#ifdef QVR_HAVE_NET
+#include "qvr/net/host_port.h"
+#endif
 #include "qvr/foveation/eye_geometry.h"
+#include "qvr/foveation/hmd_profile.h"
 
 namespace qvr::cli {
 
@@ -30,82 +31,6 @@ inline bool parseGazeDeg(const std::string& text, Gaze& gaze) {
     return true;
 }
 
-// "HOST:PORT" or "[IPV6]:PORT": PORT all digits in 1..65535; HOST an IPv4 or IPv6 address, or
-// a name that resolves now. On failure `error` says what is wrong.
-inline bool parseHostPort(const std::string& text, std::string& host, uint16_t& port,
-                          std::string& error) {
-    const size_t colon = text.rfind(':');
-    if (colon == std::string::npos) {
-        error = "must be HOST:PORT, got '" + text + "'";
-        return false;
-    }
-    const std::string port_text = text.substr(colon + 1);
-    unsigned long value = 0;
-    if (port_text.empty() || port_text.size() > 5 ||
-        port_text.find_first_not_of("0123456789") != std::string::npos ||
-        (value = std::stoul(port_text)) == 0 || value > 65535) {
-        error = "the port must be a number in 1..65535, got '" + port_text + "' in '" + text + "'";
-        return false;
-    }
-    std::string h = text.substr(0, colon);
-    unsigned char addr[16];
-    if (h.size() >= 2 && h.front() == '[' && h.back() == ']') {
-        h = h.substr(1, h.size() - 2);
-        if (inet_pton(AF_INET6, h.c_str(), addr) != 1) {
-            error = "'" + h + "' is not an IPv6 address";
-            return false;
-        }
-    } else if (h.empty()) {
-        error = "no host in '" + text + "' (HOST:PORT, e.g. 127.0.0.1:7400)";
-        return false;
-    } else if (h.find_first_not_of("0123456789.") == std::string::npos) {
-        if (inet_pton(AF_INET, h.c_str(), addr) != 1) {
-            error = "'" + h + "' is not an IPv4 address";
-            return false;
-        }
-    } else if (h.find(':') != std::string::npos) {
-        error = "an IPv6 address needs brackets: [" + h + "]:PORT";
-        return false;
-    } else {
-        addrinfo hints{};
-        hints.ai_socktype = SOCK_STREAM;
-        addrinfo* found = nullptr;
-        if (getaddrinfo(h.c_str(), nullptr, &hints, &found) != 0 || !found) {
-            error = "cannot resolve host '" + h + "'";
-            return false;
-        }
-        freeaddrinfo(found);
-    }
-    host = h;
-    port = static_cast<uint16_t>(value);
-    return true;
-}
-
-// A bind address: an IPv4 or IPv6 literal (no names: a server binds to what it is told).
-inline bool isIpAddress(const std::string& text) {
-    unsigned char addr[16];
-    return inet_pton(AF_INET, text.c_str(), addr) == 1 ||
-           inet_pton(AF_INET6, text.c_str(), addr) == 1;
-}
-
-// Checks, before any work, that `path` can be written (creates or truncates it), so that a run
-// does not fail only at its end. An empty path is fine (nothing to write).
-inline bool checkWritableFile(const std::string& path, std::string& error) {
-    if (path.empty())
-        return true;
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
-        error = "'" + path + "' is a directory";
-        return false;
-    }
-    std::ofstream f(path, std::ios::app);
-    if (!f) {
-        error = "cannot write '" + path + "' (does its directory exist?)";
-        return false;
-    }
-    return true;
-}
-
 // Creates the output folder up front; false (with `error`) when it cannot be.
 inline bool makeOutputDir(const std::string& dir, std::string& error) {
     std::error_code ec;
@@ -117,5 +42,67 @@ inline bool makeOutputDir(const std::string& dir, std::string& error) {
     }
     return true;
 }
+
+// A check that `parse` accepts the text; else "must be <what>, got '<text>'".
+template <typename T>
+CLI::Validator parsedBy(bool (*parse)(const std::string&, T&), const std::string& what,
+                        const std::string& desc, const std::string& name) {
+    return CLI::Validator(
+        [parse, what](std::string& text) -> std::string {
+            T value{};
+            return parse(text, value) ? std::string() : "must be " + what + ", got '" + text + "'";
+        },
+        desc, name);
+}
+
+// The gaze of a --gaze point option, which its check has already accepted.
+inline Gaze checkedGaze(const std::string& text) {
+    Gaze gaze;
+    parseGazeDeg(text, gaze);
+    return gaze;
+}
+
+// The HMD profile of a --profile option, which its check has already loaded once.
+inline HmdProfile checkedHmdProfile(const std::string& name) {
+    return hmdProfileByName(name).value();
+}
+
+// A number option refused unless finite and within [lo, hi]; its default shows in the help.
+template <typename T>
+CLI::Option* addFinite(CLI::App* cmd, const std::string& name, T& value, const std::string& help,
+                       double lo, double hi) {
+    return cmd->add_option(name, value, help)->check(finiteRange(lo, hi))->capture_default_str();
+}
+
+// A whole-number option within [lo, hi]; its default shows in the help.
+inline CLI::Option* addInt(CLI::App* cmd, const std::string& name, int& value,
+                           const std::string& help, int lo, int hi) {
+    return cmd->add_option(name, value, help)->check(CLI::Range(lo, hi))->capture_default_str();
+}
+
+// --e1: the fovea radius in degrees of eccentricity, within [0, max_deg].
+inline CLI::Option* addE1Option(CLI::App* cmd, double& e1_deg, double max_deg) {
+    return addFinite(cmd, "--e1", e1_deg, "Fovea radius e1 in degrees of eccentricity", 0.0,
+                     max_deg);
+}
+
+// --json: print machine-readable JSON instead of text.
+inline CLI::Option* addJsonFlag(CLI::App* cmd, bool& json) {
+    return cmd->add_flag("--json", json, "Print machine-readable JSON");
+}
+
+// --msaa: samples per pixel of the OpenGL renderer.
+inline CLI::Option* addMsaaOption(CLI::App* cmd, int& msaa) {
+    return addInt(cmd, "--msaa", msaa, "Samples per pixel (1: no multisampling)", 1, 32);
+}
+
+// Prints a command's report: the JSON object with --json, else the text.
+inline void printReport(bool json, const nlohmann::json& j, const std::string& text) {
+    std::fputs(json ? (j.dump(2) + "\n").c_str() : text.c_str(), stdout);
+}
+
+// The SCENE argument or option every scene-loading command takes.
+inline constexpr const char* kSceneHelp =
+    "openarena:MAP, nexuiz:MAP, builtin:room[?objects=N], or a .bsp/.pk3/.gltf/.glb/.obj file";
 
 }  // namespace qvr::cli

@@ -9,16 +9,12 @@
 #include <memory>
 #include <string>
 
-#include <fmt/format.h>
-
-#include "commands.h"
-#include "options.h"
+#include "bench_commands.h"
+#include "cli_parse.h"
 #include "qvr/render/gl_renderer.h"
-#include "qvr/trace/recorder.h"
+#include "qvr/trace/record_report.h"
 
 namespace qvr::cli {
-
-bool addTraceCommand(int order, RegisterFn fn);
 
 namespace {
 
@@ -45,9 +41,7 @@ Registered registerTraceRecord(CLI::App& parent) {
         "record",
         "Render a level along motion and gaze traces and write the measured workload "
         "trace (docs/RECORDING.md)");
-    cmd->add_option("--scene", o->record.scene,
-                    "openarena:MAP, nexuiz:MAP, builtin:room[?objects=N] or a file")
-        ->required();
+    cmd->add_option("--scene", o->record.scene, kSceneHelp)->required();
     cmd->add_option("--motion", o->record.motion,
                     "Head motion: pose CSV, BVH file, or 'default' (CMU 01_01 from "
                     "assimp-testmodels)")
@@ -59,29 +53,18 @@ Registered registerTraceRecord(CLI::App& parent) {
     seed->excludes(gaze);
     addProfileOption(cmd, o->profile);
     addFramesOption(cmd, o->record.frames, 1, 1'000'000, "Frames to record at the display rate");
-    cmd->add_option("--spawn", o->record.spawn, "Spawn point to start from")
-        ->check(CLI::Range(0, 1'000'000))
-        ->capture_default_str();
+    addInt(cmd, "--spawn", o->record.spawn, "Spawn point to start from", 0, 1'000'000);
     cmd->add_option("--name", o->record.name, "Trace name (default: the scene name)");
-    cmd->add_option("--raster-scale", o->record.raster_scale,
-                    "CPU z-buffer (overdraw, depth, objects) at 1/N resolution")
-        ->check(CLI::Range(1, 16))
-        ->capture_default_str();
-    cmd->add_option("--foreground", o->record.foreground_objects,
-                    "Nearest visible objects that form the static design's foreground")
-        ->check(CLI::Range(0, 1000))
-        ->capture_default_str();
+    addInt(cmd, "--raster-scale", o->record.raster_scale,
+           "CPU z-buffer (overdraw, depth, objects) at 1/N resolution", 1, 16);
+    addInt(cmd, "--foreground", o->record.foreground_objects,
+           "Nearest visible objects that form the static design's foreground", 0, 1000);
     cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")
         ->required()
         ->check(writableFile());
     cmd->add_flag("--quiet", o->quiet, "No progress line");
     Action action = [o]() -> int {
-        auto profile = hmdProfileByName(o->profile);
-        if (!profile) {
-            std::fprintf(stderr, "%s: --profile: %s\n", kCmd, profile.error().c_str());
-            return 2;
-        }
-        o->record.profile = *profile;
+        o->record.profile = checkedHmdProfile(o->profile);
         auto inputs = prepareRecording(o->record);
         if (!inputs) {
             std::fprintf(stderr, "%s: %s\n", kCmd, inputs.error().c_str());
@@ -98,26 +81,12 @@ Registered registerTraceRecord(CLI::App& parent) {
             return 1;
         }
         const bool tty = isatty(STDERR_FILENO) != 0;
-        fmt::print(stderr,
-                   "{}: {} ({} triangles, {} batches, {} spawn points), {}x{} at {} Hz, "
-                   "{} frames, {}\n",
-                   kCmd, inputs->scene.name, inputs->scene.triangleCount(),
-                   inputs->scene.batches.size(), inputs->scene.spawns.size(),
-                   o->record.profile.width_px, o->record.profile.height_px,
-                   o->record.profile.refresh_hz, o->record.frames, (*renderer)->info().renderer);
+        const std::string line =
+            recordingHeadline(o->record, *inputs, (*renderer)->info().renderer);
+        std::fprintf(stderr, "%s: %s", kCmd, line.c_str());
         auto progress = [o, tty](const RecordProgress& p) {
-            if (o->quiet)
-                return;
-            const double per_frame = p.elapsed_s / static_cast<double>(p.frame);
-            const double eta = per_frame * static_cast<double>(p.frames - p.frame);
-            // A terminal gets one rewritten line; a log gets a line every 10 frames.
-            if (tty) {
-                fmt::print(stderr, "\r  frame {}/{}  {:.2f} s/frame  ETA {:.0f} s   ", p.frame,
-                           p.frames, per_frame, eta);
-            } else if (p.frame % 10 == 0 || p.frame == p.frames) {
-                fmt::print(stderr, "  frame {}/{}  {:.2f} s/frame  ETA {:.0f} s\n", p.frame,
-                           p.frames, per_frame, eta);
-            }
+            if (!o->quiet)
+                std::fputs(recordProgressLine(p, tty).c_str(), stderr);
         };
         g_stop.store(false);
         std::signal(SIGINT, onStopSignal);
@@ -127,7 +96,7 @@ Registered registerTraceRecord(CLI::App& parent) {
         std::signal(SIGTERM, SIG_DFL);
         out.close();
         if (tty && !o->quiet)
-            fmt::print(stderr, "\n");
+            std::fputc('\n', stderr);
         if (!result) {
             std::fprintf(stderr, "%s: %s (the lines written before stay valid)\n", kCmd,
                          result.error().c_str());
@@ -139,16 +108,14 @@ Registered registerTraceRecord(CLI::App& parent) {
                          o->out.c_str());
             return 130;
         }
-        fmt::print("wrote {}: {} frames of {} in {:.1f} s ({:.2f} s/frame)\n", o->out,
-                   result->frames_written, result->header.name, result->elapsed_s,
-                   result->elapsed_s / static_cast<double>(result->frames_written));
+        std::fputs(recordingDoneLine(*result, o->out).c_str(), stdout);
         return 0;
     };
     return {cmd, action};
 }
 
-[[maybe_unused]] const bool kRecordRegistered = addTraceCommand(30, &registerTraceRecord);
-
 }  // namespace
+
+QVR_REGISTER_SUBCOMMAND("trace", 30, registerTraceRecord);
 
 }  // namespace qvr::cli

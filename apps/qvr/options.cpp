@@ -1,19 +1,20 @@
 // The shared option declarations and their checks (options.h).
 #include "options.h"
 
-#include <sched.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <vector>
+#include <functional>
 
 #include <fmt/format.h>
 
 #include "cli_parse.h"
+#include "qvr/core/cpu_cores.h"
 #include "qvr/foveation/hmd_profile.h"
 
 #ifdef QVR_HAVE_RUNTIME
@@ -38,53 +39,29 @@ bool parseDouble(const std::string& text, double& value) {
     return end == text.c_str() + text.size();
 }
 
-// The cores this process may run on: pinning to any other fails.
-std::vector<int> allowedCores() {
-    std::vector<int> cores;
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    if (sched_getaffinity(0, sizeof(set), &set) == 0)
-        for (int c = 0; c < CPU_SETSIZE; ++c)
-            if (CPU_ISSET(c, &set))
-                cores.push_back(c);
-    return cores;
-}
-
-std::string describeCores(const std::vector<int>& cores) {
-    std::string out;
-    for (size_t i = 0; i < cores.size();) {
-        size_t j = i;
-        while (j + 1 < cores.size() && cores[j + 1] == cores[j] + 1)
-            ++j;
-        out += (out.empty() ? "" : ",") +
-               (j == i ? std::to_string(cores[i]) : fmt::format("{}-{}", cores[i], cores[j]));
-        i = j + 1;
-    }
-    return out;
+// Refuses text that is not a finite number within `in_range`; `what` says what it must be.
+CLI::Validator finiteCheck(std::function<bool(double)> in_range, const std::string& what,
+                           const std::string& desc, const std::string& name) {
+    return CLI::Validator(
+        [in_range, what](std::string& text) -> std::string {
+            double v = 0;
+            if (!parseDouble(text, v) || !std::isfinite(v) || !in_range(v))
+                return fmt::format("must be {}, got '{}'", what, text);
+            return {};
+        },
+        desc, name);
 }
 
 }  // namespace
 
 CLI::Validator finiteRange(double lo, double hi) {
-    return CLI::Validator(
-        [lo, hi](std::string& text) -> std::string {
-            double v = 0;
-            if (!parseDouble(text, v) || !std::isfinite(v) || v < lo || v > hi)
-                return fmt::format("must be a finite number in [{}, {}], got '{}'", lo, hi, text);
-            return {};
-        },
-        fmt::format("FINITE in [{} - {}]", lo, hi), "FINITE_RANGE");
+    return finiteCheck([lo, hi](double v) { return v >= lo && v <= hi; },
+                       fmt::format("a finite number in [{}, {}]", lo, hi),
+                       fmt::format("FINITE in [{} - {}]", lo, hi), "FINITE_RANGE");
 }
 
 CLI::Validator finiteNumber() {
-    return CLI::Validator(
-        [](std::string& text) -> std::string {
-            double v = 0;
-            if (!parseDouble(text, v) || !std::isfinite(v))
-                return fmt::format("must be a finite number, got '{}'", text);
-            return {};
-        },
-        "FINITE", "FINITE");
+    return finiteCheck([](double) { return true; }, "a finite number", "FINITE", "FINITE");
 }
 
 CLI::Validator unsignedInteger() {
@@ -195,23 +172,14 @@ CLI::Option* addProfileOption(CLI::App* cmd, std::string& profile, ProfileNames 
 
 CLI::Option* addFramesOption(CLI::App* cmd, int& frames, int min_frames, int max_frames,
                              const std::string& help) {
-    return cmd->add_option("--frames", frames, help)
-        ->check(CLI::Range(min_frames, max_frames))
-        ->capture_default_str();
+    return addInt(cmd, "--frames", frames, help, min_frames, max_frames);
 }
 
 CLI::Option* addGazePointOption(CLI::App* cmd, std::string& gaze) {
     return cmd
         ->add_option("--gaze", gaze,
                      "Gaze point X,Y in degrees right/up of the optical axis (each within ±80)")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                Gaze g;
-                return parseGazeDeg(text, g)
-                           ? std::string()
-                           : "must be X,Y in degrees within ±80, got '" + text + "'";
-            },
-            "X,Y", "GAZE_POINT"))
+        ->check(parsedBy(&parseGazeDeg, "X,Y in degrees within ±80", "X,Y", "GAZE_POINT"))
         ->capture_default_str();
 }
 
@@ -243,9 +211,8 @@ CLI::Option* addCoreOption(CLI::App* cmd, int& core, const std::string& help) {
                 const bool digits = !text.empty() && text.size() < 7 &&
                                     text.find_first_not_of("0123456789") == std::string::npos;
                 const int c = digits ? std::stoi(text) : -2;
-                for (int allowed : cores)
-                    if (allowed == c)
-                        return {};
+                if (std::find(cores.begin(), cores.end(), c) != cores.end())
+                    return {};
                 return fmt::format(
                     "must be -1 (no pinning) or a core this process may run on "
                     "({}), got '{}'",
@@ -256,12 +223,10 @@ CLI::Option* addCoreOption(CLI::App* cmd, int& core, const std::string& help) {
 }
 
 CLI::Option* addLodOption(CLI::App* cmd, float& lod_px) {
-    return cmd
-        ->add_option("--lod-px", lod_px,
+    return addFinite(cmd, "--lod-px", lod_px,
                      "Level of detail: largest vertex move in each view's own pixels (0: full "
-                     "detail)")
-        ->check(finiteRange(0.0, 16.0))
-        ->capture_default_str();
+                     "detail)",
+                     0.0, 16.0);
 }
 
 #ifdef QVR_HAVE_RUNTIME
