@@ -134,6 +134,7 @@ ModelSettings modelSettings(const RunOptions& plan) {
     s.remote_timeout_ms = plan.remote_timeout_ms;
     s.warmup_frames = plan.warmup_frames;  // the same frames left out as measured
     s.record_scanout = plan.video;         // every design's headset copies its scan-out
+    s.headset_share = plan.headset_share;
     return s;
 }
 
@@ -182,7 +183,12 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     if (!simDesignOf(inputs.design, sd, fixed_e1))
         return p;
     p.speed = inputs.speed;
-    if (auto r = runModel(trace, sd, fixed_e1, calibrated, settings, inputs)) {
+    // A quota of `share` of the core per period: the headset's work takes 1 / share the wall
+    // time (docs/MODEL.md, the headset's share).
+    const RuntimeCosts costs = settings.headset_share < 1.0
+                                   ? calibrated.atSpeed(1.0 / settings.headset_share, 1.0)
+                                   : calibrated;
+    if (auto r = runModel(trace, sd, fixed_e1, costs, settings, inputs)) {
         p.calibrated = RuntimePrediction{metricsOf(r->summary), r->summary.t_remote_ms_mean,
                                          r->summary.frames_reused};
         if (frames)
@@ -190,7 +196,7 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
         // With probes: the same model with the costs at the probes' speed, beside it.
         if (inputs.speed)
             if (auto at = runModel(trace, sd, fixed_e1,
-                                   calibrated.atSpeed(inputs.speed->headset, inputs.speed->server),
+                                   costs.atSpeed(inputs.speed->headset, inputs.speed->server),
                                    settings, inputs))
                 p.at_probe_speed = metricsOf(at->summary);
     }
