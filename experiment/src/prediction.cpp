@@ -409,6 +409,15 @@ RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
         writePredictedFrames(predicted_csv, di.design, frames);
         rp.by_design[di.design] = std::move(p);
     }
+    if (plan.headset_share < 1.0 && measurement.share_group) {
+        const auto t = measurement.share_group->throttling();
+        rp.sim_note += fmt::format(
+            "{}the model ran the headset at {:.2f}x its calibrated times (--headset-share {:g}); "
+            "the quota throttled {} of {} periods: where few, a busy host gave the headset less "
+            "than its share anyway and the prediction is low (docs/MODEL.md §13)",
+            rp.sim_note.empty() ? "" : "; ", 1.0 / plan.headset_share, plan.headset_share,
+            t.throttled_periods, t.periods);
+    }
     return rp;
 }
 
