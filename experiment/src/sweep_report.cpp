@@ -24,6 +24,12 @@ constexpr double kMtpOverBest = 1.10, kSlowLinkMbps = 3.0;
 constexpr double kModelMeanPct = 10.0, kModelWorstPct = 25.0;
 constexpr int kMinConditions = 16;
 
+// A trace link by its file name (the folder is in sweep.json).
+std::string linkLabel(const std::string& link) {
+    return link.rfind("trace:", 0) == 0 ? "trace:" + fs::path(link.substr(6)).filename().string()
+                                        : link;
+}
+
 std::string cell(const std::optional<double>& v, const char* spec) {
     return v ? fmt::format(fmt::runtime(spec), *v) : "—";
 }
@@ -163,9 +169,9 @@ std::string sweepMarkdown(const SweepOptions& o, const SweepResult& r) {
             spread.push_back(fmt::format("{} {:.0f}%", d, pct));
         s += fmt::format(
             "| {} | {} | {} | {} | {:g} | {} | {} | {} {:.1f} | {} | {} | {} | {} | {} |\n",
-            v.condition + 1, c.scene, c.link, cell(v.link_mbps, "{:.1f}"), c.headset_share,
-            fs::path(c.motion).stem().string(), c.gaze_seed, v.best_fixed, v.best_fixed_fps,
-            cell(v.qvr_over_best, "{:.2f}"), cell(v.qvr_over_ffr, "{:.2f}"),
+            v.condition + 1, c.scene, linkLabel(c.link), cell(v.link_mbps, "{:.1f}"),
+            c.headset_share, fs::path(c.motion).stem().string(), c.gaze_seed, v.best_fixed,
+            v.best_fixed_fps, cell(v.qvr_over_best, "{:.2f}"), cell(v.qvr_over_ffr, "{:.2f}"),
             cell(v.qvr_over_aimd, "{:.2f}"), cell(v.mtp_p99_over_best, "{:.2f}"),
             fmt::join(spread, ", "));
     }

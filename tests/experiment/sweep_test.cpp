@@ -193,6 +193,8 @@ TEST(SweepRun, RepeatsTheBestFixedAndJudgesTheRatios) {
     o.adaptive = {"qvr", "sw", "ffr", "aimd"};
     o.fixed_grid_deg = {2, 10, 20};
     o.space.scenes = {"builtin:room"};
+    o.space.traces = {"trace:/x/a.down"};
+    o.space.trace_odds = 1.0;
     FakeRunner runner;
     runner.fps = {{"qvr", 38.0},     {"sw", 30.0},       {"ffr", 20.0},     {"aimd", 35.0},
                   {"fixed:2", 15.0}, {"fixed:10", 40.0}, {"fixed:20", 33.0}};
@@ -228,6 +230,7 @@ TEST(SweepRun, RepeatsTheBestFixedAndJudgesTheRatios) {
     EXPECT_FALSE(pass.at("at least 16 conditions"));
     const std::string md = sweepMarkdown(o, r);
     EXPECT_NE(md.find("PASS qvr >= ffr on all"), std::string::npos);
+    EXPECT_NE(md.find("| 1 | builtin:room | trace:a.down |"), std::string::npos) << md;
     EXPECT_NE(sweepCsv(r).find("1,builtin:room,"), std::string::npos);
     EXPECT_EQ(sweepJson(o, r)["runs"].size(), r.rows.size());
 }
