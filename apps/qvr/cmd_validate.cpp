@@ -1,6 +1,7 @@
 // `qvr validate`: the simulator's correlation sheet (qvr/experiment/validation.h): checks its
 // options and takes the sheet.
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -25,6 +26,9 @@ struct ValidateOptions {
     std::string links;  // default: wifi,lte,5g and the ATT Mahimahi trace when found
     std::string scenes = "builtin:room,openarena:oa_dm5";
     std::string depths = "1,2";
+    std::string motions = "default";
+    std::string shares = "1";
+    std::string calibration_scene;  // empty: each scene calibrated on itself
     int frames = 40;
     int reps = 1;
     // A run taken again when its speed probes say the machine was not steady over it.
@@ -79,11 +83,34 @@ int runValidate(const ValidateOptions& o) {
         }
         depths.push_back(d == "1" ? 1 : 2);
     }
-    if (links.empty() || scenes.empty() || depths.empty() || splitList(o.designs).empty()) {
-        std::fprintf(stderr, "qvr validate: empty --links, --scenes, --depths or --designs\n");
+    std::vector<double> shares;
+    for (const std::string& s : splitList(o.shares)) {
+        char* end = nullptr;
+        const double v = std::strtod(s.c_str(), &end);
+        if (end == s.c_str() || *end != '\0' || !(v > 0.05 && v <= 1.0)) {
+            std::fprintf(stderr,
+                         "qvr validate: --headset-shares takes shares in (0.05, 1], got '%s'\n",
+                         s.c_str());
+            return 2;
+        }
+        shares.push_back(v);
+    }
+    const std::vector<std::string> motions = splitList(o.motions);
+    if (links.empty() || scenes.empty() || depths.empty() || splitList(o.designs).empty() ||
+        motions.empty() || shares.empty()) {
+        std::fprintf(stderr,
+                     "qvr validate: empty --links, --scenes, --depths, --designs, --motions or "
+                     "--headset-shares\n");
         return 2;
     }
-    if (!o.hardware.empty() && scenes.size() != 1) {
+    for (const std::string& m : motions) {
+        std::error_code ec;
+        if (m != "default" && m != "still" && !fs::is_regular_file(m, ec)) {
+            std::fprintf(stderr, "qvr validate: --motions: %s: no such file\n", m.c_str());
+            return 2;
+        }
+    }
+    if (!o.hardware.empty() && scenes.size() != 1 && o.calibration_scene.empty()) {
         std::fprintf(stderr,
                      "qvr validate: --hardware is one scene's calibration; give one "
                      "--scenes\n");
@@ -113,6 +140,9 @@ int runValidate(const ValidateOptions& o) {
                           .links = links,
                           .scenes = scenes,
                           .depths = depths,
+                          .motions = motions,
+                          .headset_shares = shares,
+                          .calibration_scene = o.calibration_scene,
                           .frames = o.frames,
                           .reps = o.reps,
                           .retakes = o.retakes,
@@ -138,6 +168,14 @@ static Registered registerValidate(CLI::App& app) {
                     "Mahimahi trace of shared/data/network)");
     cmd->add_option("--scenes", o->scenes, "Comma-separated scenes")->capture_default_str();
     cmd->add_option("--depths", o->depths, "Frames in flight: 1, 2 or 1,2")->capture_default_str();
+    cmd->add_option("--motions", o->motions, "Comma-separated head motions of every run")
+        ->capture_default_str();
+    cmd->add_option("--headset-shares", o->shares,
+                    "Comma-separated headset shares of every run (qvr run --headset-share)")
+        ->capture_default_str();
+    cmd->add_option("--calibration-scene", o->calibration_scene,
+                    "Calibrate on this scene only and predict every scene's runs with it (out of "
+                    "sample); default: each scene calibrated on itself");
     addFramesOption(cmd, o->frames, 5, 100000, "Frames per design per run");
     cmd->add_option("--reps", o->reps, "Repetitions of every condition")
         ->check(CLI::Range(1, 20))

@@ -129,6 +129,7 @@ ModelSettings modelSettings(const RunOptions& plan) {
     s.remote_timeout_ms = plan.remote_timeout_ms;
     s.warmup_frames = plan.warmup_frames;  // the same frames left out as measured
     s.record_scanout = plan.video;         // every design's headset copies its scan-out
+    s.headset_share = plan.headset_share;
     return s;
 }
 
@@ -177,7 +178,12 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     if (!simDesignOf(inputs.design, sd, fixed_e1))
         return p;
     p.speed = inputs.speed;
-    if (auto r = runModel(trace, sd, fixed_e1, calibrated, settings, inputs)) {
+    // A quota of `share` of the core per period: the headset's work takes 1 / share the wall
+    // time (docs/MODEL.md, the headset's share).
+    const RuntimeCosts costs = settings.headset_share < 1.0
+                                   ? calibrated.atSpeed(1.0 / settings.headset_share, 1.0)
+                                   : calibrated;
+    if (auto r = runModel(trace, sd, fixed_e1, costs, settings, inputs)) {
         p.calibrated = RuntimePrediction{metricsOf(r->summary), r->summary.t_remote_ms_mean,
                                          r->summary.frames_reused};
         if (frames)
@@ -185,7 +191,7 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
         // With probes: the same model with the costs at the probes' speed, beside it.
         if (inputs.speed)
             if (auto at = runModel(trace, sd, fixed_e1,
-                                   calibrated.atSpeed(inputs.speed->headset, inputs.speed->server),
+                                   costs.atSpeed(inputs.speed->headset, inputs.speed->server),
                                    settings, inputs))
                 p.at_probe_speed = metricsOf(at->summary);
     }
@@ -397,6 +403,15 @@ RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
         DesignPrediction p = predictDesign(*w.trace, di, calibrated, settings, paper_net, &frames);
         writePredictedFrames(predicted_csv, di.design, frames);
         rp.by_design[di.design] = std::move(p);
+    }
+    if (plan.headset_share < 1.0 && measurement.share_group) {
+        const auto t = measurement.share_group->throttling();
+        rp.sim_note += fmt::format(
+            "{}the model ran the headset at {:.2f}x its calibrated times (--headset-share {:g}); "
+            "the quota throttled {} of {} periods: where few, a busy host gave the headset less "
+            "than its share anyway and the prediction is low (docs/MODEL.md §13)",
+            rp.sim_note.empty() ? "" : "; ", 1.0 / plan.headset_share, plan.headset_share,
+            t.throttled_periods, t.periods);
     }
     return rp;
 }

@@ -87,7 +87,9 @@ private:
     }
 
     void printRunProgress(const PlannedRun& r, int take) {
-        fmt::print(m_out, "  {} | {} | depth {} | rep {}{} ...", r.scene, r.link, r.depth,
+        fmt::print(m_out, "  {} | {} | depth {}{}{} | rep {}{} ...", r.scene, r.link, r.depth,
+                   r.motion == "default" ? "" : " | motion " + r.motion,
+                   r.headset_share < 1.0 ? fmt::format(" | share {:g}", r.headset_share) : "",
                    r.rep + 1, take == 0 ? "" : fmt::format(" take {}", take + 1));
         std::fflush(m_out);
     }
@@ -198,12 +200,12 @@ private:
                 m_result.run_speed_spread_pct.push_back(sp);
             m_result.run_disturbance_pct.push_back(disturbance);
         }
-        m_result.rows.add(best, r.scene, r.link, r.depth);
+        m_result.rows.add(best, r.scene, r.link, r.depth, r.motion, r.headset_share);
         ++m_result.runs_counted;
-        m_result.rows_first_takes.add(first, r.scene, r.link, r.depth);
+        m_result.rows_first_takes.add(first, r.scene, r.link, r.depth, r.motion, r.headset_share);
         // NaN (no probes): not judged, so not in the steady runs' sheet either.
         if (disturbance <= kUnsteadySpeedPct) {
-            m_result.rows_steady.add(best, r.scene, r.link, r.depth);
+            m_result.rows_steady.add(best, r.scene, r.link, r.depth, r.motion, r.headset_share);
             ++m_result.runs_steady;
         }
     }

@@ -1,5 +1,6 @@
 // The correlation sheet's plan: its calibrations and runs in order, and the command line of
 // each take (validation.h).
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 
@@ -27,10 +28,22 @@ std::string safeName(const std::string& s) {
 
 void addRuns(ValidationPlan& plan, const std::string& scene, int rep, size_t calibration) {
     for (const std::string& link : plan.options.links)
-        for (int depth : plan.options.depths) {
-            plan.steps.push_back({PlannedStep::Kind::kRun, plan.runs.size()});
-            plan.runs.push_back({scene, link, depth, rep, calibration});
-        }
+        for (int depth : plan.options.depths)
+            for (const std::string& motion : plan.options.motions)
+                for (double share : plan.options.headset_shares) {
+                    plan.steps.push_back({PlannedStep::Kind::kRun, plan.runs.size()});
+                    plan.runs.push_back({scene, link, depth, motion, share, rep, calibration});
+                }
+}
+
+// A run's motion and share in its folder's name, when not the defaults.
+std::string conditionSuffix(const PlannedRun& r) {
+    std::string s;
+    if (r.motion != "default")
+        s += "_m" + safeName(fs::path(r.motion).stem().string());
+    if (r.headset_share < 1.0)
+        s += fmt::format("_s{:g}", r.headset_share);
+    return s;
 }
 
 size_t addCalibration(ValidationPlan& plan, const std::string& scene, int rep) {
@@ -50,7 +63,8 @@ const char* calibrationPolicyName(CalibrationPolicy policy) {
 }
 
 size_t ValidationPlan::conditions() const {
-    return options.links.size() * options.scenes.size() * options.depths.size();
+    return options.links.size() * options.scenes.size() * options.depths.size() *
+           options.motions.size() * options.headset_shares.size();
 }
 
 ValidationPlan planValidation(const ValidationOptions& options) {
@@ -58,6 +72,17 @@ ValidationPlan planValidation(const ValidationOptions& options) {
     plan.options = options;
     plan.policy = !options.hardware.empty() ? CalibrationPolicy::kGiven : options.calibrate;
     const std::vector<std::string>& scenes = options.scenes;
+    if (!options.calibration_scene.empty()) {  // one calibration predicts every scene
+        size_t c = 0;
+        for (int rep = 0; rep < options.reps; ++rep) {
+            if (rep == 0 || plan.policy == CalibrationPolicy::kPerRep)
+                c = addCalibration(plan, options.calibration_scene,
+                                   plan.policy == CalibrationPolicy::kPerRep ? rep : 0);
+            for (const std::string& scene : scenes)
+                addRuns(plan, scene, rep, c);
+        }
+        return plan;
+    }
     if (plan.policy == CalibrationPolicy::kPerRep) {
         for (int rep = 0; rep < options.reps; ++rep)
             for (const std::string& scene : scenes)
@@ -93,35 +118,47 @@ ChildCommand runTake(const ValidationPlan& plan, size_t run, int take,
     const ValidationOptions& o = plan.options;
     const PlannedRun& r = plan.runs.at(run);
     ChildCommand cmd;
-    cmd.output = (fs::path(o.out) / fmt::format("{}_{}_d{}_r{}{}", safeName(r.scene),
-                                                safeName(r.link), r.depth, r.rep + 1,
-                                                take == 0 ? "" : fmt::format("_t{}", take + 1)))
-                     .string();
+    cmd.output =
+        (fs::path(o.out) / fmt::format("{}_{}_d{}{}_r{}{}", safeName(r.scene), safeName(r.link),
+                                       r.depth, conditionSuffix(r), r.rep + 1,
+                                       take == 0 ? "" : fmt::format("_t{}", take + 1)))
+            .string();
     cmd.log_path = cmd.output + ".log";
     cmd.result_path = (fs::path(cmd.output) / "summary.json").string();
     cmd.line = fmt::format(
         "{} run --scene {} --net {} --pipeline {} --designs {} --frames {} --profile {} "
-        "--hardware {} --no-video --out {} > {} 2>&1",
+        "--hardware {}{}{} --no-video --out {} > {} 2>&1",
         shellQuote(o.executable), shellQuote(r.scene), shellQuote(r.link), r.depth,
         shellQuote(o.designs), o.frames, shellQuote(o.profile), shellQuote(calibration_file),
+        r.motion == "default" ? "" : " --motion " + shellQuote(r.motion),
+        r.headset_share < 1.0 ? fmt::format(" --headset-share {:g}", r.headset_share) : "",
         shellQuote(cmd.output), shellQuote(cmd.log_path));
     return cmd;
 }
 
-std::string findMahimahiTrace(const std::string& file) {
+std::vector<std::string> mahimahiTraceFolders() {
     std::error_code ec;
     std::vector<fs::path> starts = {fs::current_path(ec)};
     if (auto exe = runtime::selfExecutable(); exe)
         starts.push_back(fs::path(*exe).parent_path());
+    std::vector<std::string> out;
     for (const fs::path& start : starts)
         for (fs::path p = start; !p.empty(); p = p.parent_path()) {
-            for (const fs::path& c :
-                 {p / "shared" / "data" / "network" / file, p / "data" / "network" / file})
-                if (fs::exists(c, ec))
-                    return c.string();
+            for (const fs::path& c : {p / "shared" / "data" / "network", p / "data" / "network"})
+                if (fs::is_directory(c, ec) &&
+                    std::find(out.begin(), out.end(), c.string()) == out.end())
+                    out.push_back(c.string());
             if (p == p.parent_path())
                 break;
         }
+    return out;
+}
+
+std::string findMahimahiTrace(const std::string& file) {
+    std::error_code ec;
+    for (const std::string& folder : mahimahiTraceFolders())
+        if (const fs::path c = fs::path(folder) / file; fs::exists(c, ec))
+            return c.string();
     return {};
 }
 

@@ -53,14 +53,14 @@ const json& member(const json& object, const char* key) {
 }
 
 std::string cellKey(const std::string& scene, const std::string& link, int depth,
-                    const std::string& design) {
-    return fmt::format("{}|{}|{}|{}", scene, link, depth, design);
+                    const std::string& motion, double headset_share, const std::string& design) {
+    return fmt::format("{}|{}|{}|{}|{:g}|{}", scene, link, depth, motion, headset_share, design);
 }
 
 }  // namespace
 
 void ValidationRows::add(const json& summary, const std::string& scene, const std::string& link,
-                         int depth) {
+                         int depth, const std::string& motion, double headset_share) {
     const json& designs = member(summary, "designs");
     if (!designs.is_object())
         return;
@@ -68,7 +68,7 @@ void ValidationRows::add(const json& summary, const std::string& scene, const st
         const json& d = it.value();
         if (!d.is_object() || !d.contains("prediction_error_pct"))
             continue;
-        const std::string key = cellKey(scene, link, depth, it.key());
+        const std::string key = cellKey(scene, link, depth, motion, headset_share, it.key());
         auto [slot, added] = m_index.try_emplace(key, m_rows.size());
         if (added) {
             ValidationRow row;
@@ -76,6 +76,8 @@ void ValidationRows::add(const json& summary, const std::string& scene, const st
             row.link = link;
             row.design = it.key();
             row.depth = depth;
+            row.motion = motion;
+            row.headset_share = headset_share;
             m_rows.push_back(std::move(row));
         }
         ValidationRow& r = m_rows[slot->second];
@@ -95,7 +97,8 @@ void ValidationRows::add(const json& summary, const std::string& scene, const st
 }
 
 const ValidationRow* ValidationRows::find(const ValidationRow& row) const {
-    const auto it = m_index.find(cellKey(row.scene, row.link, row.depth, row.design));
+    const auto it = m_index.find(
+        cellKey(row.scene, row.link, row.depth, row.motion, row.headset_share, row.design));
     return it == m_index.end() ? nullptr : &m_rows[it->second];
 }
 
@@ -193,6 +196,16 @@ ValidationStats summariseValidation(const ValidationResult& result) {
     s.fps_first_takes = absError(rows, result.rows_first_takes, &ValidationRow::fps_error_pct);
     s.fps_steady = absError(rows, result.rows_steady, &ValidationRow::fps_error_pct);
     s.mtp_steady = absError(rows, result.rows_steady, &ValidationRow::mtp_error_pct);
+    std::vector<double> every;
+    for (const ValidationRow& r : rows.rows())
+        for (double e : r.fps_error_pct)
+            if (std::isfinite(e))
+                every.push_back(std::fabs(e));
+    s.fps_every_run.cells = every.size();
+    if (!every.empty()) {
+        s.fps_every_run.mean = mean(every);
+        s.fps_every_run.worst = *std::max_element(every.begin(), every.end());
+    }
     std::vector<double> v = result.run_speed_spread_pct;
     if (!v.empty()) {
         std::sort(v.begin(), v.end());
@@ -205,22 +218,50 @@ ValidationStats summariseValidation(const ValidationResult& result) {
 
 namespace {
 
+// The cell's condition beyond scene, link and depth: its motion and headset share when not the
+// defaults.
+std::string conditionLabel(const ValidationRow& r) {
+    std::string s = r.scene;
+    if (r.motion != "default")
+        s += " · " + std::filesystem::path(r.motion).stem().string();
+    if (r.headset_share < 1.0)
+        s += fmt::format(" · share {:g}", r.headset_share);
+    return s;
+}
+
+std::string linkLabel(const std::string& link) {
+    return link.rfind("trace:", 0) == 0
+               ? "trace:" + std::filesystem::path(link.substr(6)).filename().string()
+               : link;
+}
+
+// Every run of every cell: its own error, not the cell's mean.
+std::string everyRunTable(const ValidationRows& rows) {
+    std::string md =
+        "| scene | link | depth | design | run | FPS measured | FPS predicted | FPS error |\n"
+        "|---|---|---|---|---|---|---|---|\n";
+    for (const ValidationRow& r : rows.rows())
+        for (size_t i = 0; i < r.fps_error_pct.size(); ++i)
+            md += fmt::format(
+                "| {} | {} | {} | {} | {} | {} | {} | {} |\n", conditionLabel(r), linkLabel(r.link),
+                r.depth, r.design, i + 1, cell(r.fps_measured.at(i), "{:.1f}"),
+                cell(r.fps_predicted.at(i), "{:.1f}"), cell(r.fps_error_pct[i], "{:+.1f}%"));
+    return md;
+}
+
 std::string markdownTable(const ValidationRows& rows) {
     std::string md = fmt::format(
         "| scene | link | depth | design | FPS measured | FPS predicted | FPS error | MTP error | "
         "bytes error | e1 error | FPS spread over reps | headset cost error | server cost error "
         "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const ValidationRow& r : rows.rows()) {
-        const std::string link_label =
-            r.link.rfind("trace:", 0) == 0
-                ? "trace:" + std::filesystem::path(r.link.substr(6)).filename().string()
-                : r.link;
         md += fmt::format(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", r.scene,
-            link_label, r.depth, r.design, cell(mean(r.fps_measured), "{:.1f}"),
-            cell(mean(r.fps_predicted), "{:.1f}"), cell(mean(r.fps_error_pct), "{:+.1f}%"),
-            cell(mean(r.mtp_error_pct), "{:+.1f}%"), cell(mean(r.bytes_error_pct), "{:+.1f}%"),
-            cell(mean(r.e1_error_deg), "{:+.1f}°"), cell(spread(r.fps_measured), "{:.1f}"),
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            conditionLabel(r), linkLabel(r.link), r.depth, r.design,
+            cell(mean(r.fps_measured), "{:.1f}"), cell(mean(r.fps_predicted), "{:.1f}"),
+            cell(mean(r.fps_error_pct), "{:+.1f}%"), cell(mean(r.mtp_error_pct), "{:+.1f}%"),
+            cell(mean(r.bytes_error_pct), "{:+.1f}%"), cell(mean(r.e1_error_deg), "{:+.1f}°"),
+            cell(spread(r.fps_measured), "{:.1f}"),
             cell(mean(r.headset_cost_error_pct), "{:+.1f}%"),
             cell(mean(r.server_cost_error_pct), "{:+.1f}%"));
     }
@@ -259,6 +300,9 @@ std::string validationMarkdown(const ValidationPlan& plan, const ValidationResul
         "The speed probes moved by a median {} over a run, over 10% in {} of {} runs.\n",
         meanWorst(s.fps_at_probe_speed, "{:.1f}%"), cell(s.run_speed_spread_median_pct, "{:.1f}%"),
         s.runs_unsteady, result.run_speed_spread_pct.size());
+    md += fmt::format(
+        "Every run on its own (not a cell's mean over repetitions): FPS {} over {} runs.\n\n{}",
+        meanWorst(s.fps_every_run, "{:.1f}%"), s.fps_every_run.cells, everyRunTable(result.rows));
     if (result.stop_signal != 0)
         md += fmt::format("Stopped by a signal: the sheet has the {} runs that ended of {}.\n",
                           result.runs_counted, plan.runs.size());
@@ -273,6 +317,8 @@ json rowsJson(const ValidationRows& rows) {
         out.push_back({{"scene", r.scene},
                        {"link", r.link},
                        {"depth", r.depth},
+                       {"motion", r.motion},
+                       {"headset_share", r.headset_share},
                        {"design", r.design},
                        {"fps_measured", r.fps_measured},
                        {"fps_predicted", r.fps_predicted},
@@ -333,6 +379,11 @@ json validationJson(const ValidationPlan& plan, const ValidationResult& result) 
             {"fps_abs_error_pct_worst_steady_runs", s.fps_steady.worst},
             {"mtp_abs_error_pct_mean_steady_runs", s.mtp_steady.mean},
             {"fps_abs_error_pct_worst_first_takes", s.fps_first_takes.worst},
+            {"fps_abs_error_pct_mean_every_run", s.fps_every_run.mean},
+            {"fps_abs_error_pct_worst_every_run", s.fps_every_run.worst},
+            {"calibration_scene", plan.options.calibration_scene},
+            {"motions", plan.options.motions},
+            {"headset_shares", plan.options.headset_shares},
             {"rows", rowsJson(result.rows)}};
 }
 

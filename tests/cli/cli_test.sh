@@ -332,5 +332,40 @@ if run_ok "validate --reps 2 --calibrate once --dry-run" validate --dry-run --re
     fi
 fi
 
+# qvr sweep: bad options exit 2 with a message; a dry run draws the same conditions from a seed.
+expect_error "sweep --conditions 0" sweep --conditions 0 --dry-run --out "$tmp/sw"
+expect_error "sweep --share-min 0" sweep --share-min 0 --dry-run --out "$tmp/sw"
+expect_error "sweep --rate-min over --rate-max" sweep --rate-min 50 --rate-max 5 --dry-run --out "$tmp/sw"
+expect_error "sweep --fixed-grid 0.5" sweep --fixed-grid 2,0.5 --dry-run --out "$tmp/sw"
+expect_error "sweep --designs without qvr" sweep --designs sw,ffr --dry-run --out "$tmp/sw"
+expect_error "sweep --traces /nonexistent" sweep --traces /nonexistent.down --dry-run --out "$tmp/sw"
+expect_error "sweep --motions /nonexistent" sweep --motions /nonexistent.bvh --dry-run --out "$tmp/sw"
+"$QVR" sweep --repeats 21 --dry-run --out "$tmp/sw" >/dev/null 2>&1
+rc=$?
+[ $rc -eq 2 ] && pass "sweep --repeats 21 exits 2" || fail "sweep --repeats 21 exits 2" "exit $rc"
+if run_ok "sweep --dry-run draws its conditions" sweep --dry-run --seed 5 --conditions 3 --scenes builtin:room --motions default --traces "" --out "$tmp/sw"; then
+    cp "$tmp/out.json" "$tmp/sweep1.txt"
+    if run_ok "sweep --dry-run again" sweep --dry-run --seed 5 --conditions 3 --scenes builtin:room --motions default --traces "" --out "$tmp/sw" &&
+        cmp -s "$tmp/out.json" "$tmp/sweep1.txt" &&
+        [ "$(grep -c 'builtin:room | rate:' "$tmp/out.json")" -eq 3 ] &&
+        grep -q 'fixed:20' "$tmp/out.json"; then
+        pass "sweep draws the same 3 conditions from the same seed"
+    else
+        fail "sweep draws the same 3 conditions from the same seed" "$(head -c 600 "$tmp/out.json")"
+    fi
+fi
+# qvr validate out of sample: one scene calibrated for two, motions and headset shares.
+expect_error "validate --headset-shares 1.5" validate --headset-shares 1.5 --dry-run --out "$tmp/val"
+expect_error "validate --motions /nonexistent" validate --motions /nonexistent.bvh --dry-run --out "$tmp/val"
+if run_ok "validate --calibration-scene --dry-run" validate --dry-run --links rate:2.5 --scenes builtin:room,openarena:oa_dm5 --calibration-scene builtin:room --headset-shares 1,0.5 --depths 2 --out "$tmp/val"; then
+    if [ "$(grep -c ' calibrate --scene' "$tmp/out.json")" -eq 1 ] &&
+        [ "$(grep -c ' run --scene' "$tmp/out.json")" -eq 4 ] &&
+        [ "$(grep -c -- '--headset-share 0.5' "$tmp/out.json")" -eq 2 ]; then
+        pass "validate --calibration-scene predicts two scenes at two shares with one calibration"
+    else
+        fail "validate --calibration-scene" "$(head -c 900 "$tmp/out.json")"
+    fi
+fi
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

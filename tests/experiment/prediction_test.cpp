@@ -180,6 +180,28 @@ TEST(PredictDesign, ChargesTheLinksDelayAndTheProbesSpeed) {
     EXPECT_GT(fast.at_probe_speed->mtp_ms_mean, fast.calibrated->metrics.mtp_ms_mean);
 }
 
+TEST(PredictDesign, AHeadsetShareStretchesTheHeadsetsCostsOnly) {
+    const WorkloadTrace trace = flatTrace(60);
+    const RuntimeCosts costs = flatCosts();
+    ModelSettings settings;
+    settings.net = "rate:100";
+    const DesignPrediction whole =
+        predictDesign(trace, {"local", std::nullopt, {}, {}}, costs, settings, std::nullopt);
+    settings.headset_share = 0.5;
+    const DesignPrediction half =
+        predictDesign(trace, {"local", std::nullopt, {}, {}}, costs, settings, std::nullopt);
+    // The same as the costs at half the headset's speed, set by hand.
+    settings.headset_share = 1.0;
+    const DesignPrediction by_hand = predictDesign(trace, {"local", std::nullopt, {}, {}},
+                                                   costs.atSpeed(2.0, 1.0), settings, std::nullopt);
+    ASSERT_TRUE(whole.calibrated && half.calibrated && by_hand.calibrated);
+    EXPECT_LT(half.calibrated->metrics.fps_mean, 0.6 * whole.calibrated->metrics.fps_mean);
+    EXPECT_DOUBLE_EQ(half.calibrated->metrics.fps_mean, by_hand.calibrated->metrics.fps_mean);
+    RunOptions plan;
+    plan.headset_share = 0.4;
+    EXPECT_DOUBLE_EQ(modelSettings(plan).headset_share, 0.4);
+}
+
 TEST(PredictDesign, PaperHardwareOnlyWithANetworkAndNothingForAnUnknownDesign) {
     const WorkloadTrace trace = flatTrace(30);
     ModelSettings settings;

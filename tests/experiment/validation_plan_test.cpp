@@ -107,3 +107,40 @@ TEST(ValidationPlan, ALongLinkKeepsItsLastFortyCharactersInTheFolderName) {
 
 }  // namespace
 }  // namespace qvr::experiment
+
+namespace qvr::experiment {
+namespace {
+
+TEST(ValidationPlan, OneSceneCalibratedPredictsEveryScenesMotionsAndShares) {
+    ValidationOptions o = twoScenes(2, CalibrationPolicy::kPerRep);
+    o.depths = {2};
+    o.links = {"rate:2.5"};
+    o.motions = {"default", "/m/01_03.bvh"};
+    o.headset_shares = {1.0, 0.5};
+    o.calibration_scene = "builtin:room";
+    const ValidationPlan plan = planValidation(o);
+    EXPECT_EQ(plan.conditions(), 8u);         // 2 scenes × 2 motions × 2 shares
+    ASSERT_EQ(plan.calibrations.size(), 2u);  // the one scene, per repetition
+    ASSERT_EQ(plan.runs.size(), 16u);
+    for (const PlannedCalibration& c : plan.calibrations)
+        EXPECT_EQ(c.scene, "builtin:room");
+    for (const PlannedRun& r : plan.runs)
+        EXPECT_EQ(plan.calibrations[r.calibration].rep, r.rep);
+    EXPECT_EQ(plan.runs.back().scene, "openarena:oa_dm5");
+    // A run away from the defaults says so in its command and folder.
+    const PlannedRun& last = plan.runs[7];
+    EXPECT_EQ(last.motion, "/m/01_03.bvh");
+    EXPECT_EQ(last.headset_share, 0.5);
+    const ChildCommand cmd = runTake(plan, 7, 0, "cal.toml");
+    EXPECT_NE(cmd.line.find("--motion '/m/01_03.bvh'"), std::string::npos) << cmd.line;
+    EXPECT_NE(cmd.line.find("--headset-share 0.5"), std::string::npos) << cmd.line;
+    EXPECT_NE(cmd.output.find("_m01_03_s0.5_r1"), std::string::npos) << cmd.output;
+    const ChildCommand first = runTake(plan, 0, 0, "cal.toml");
+    EXPECT_EQ(first.line.find("--motion"), std::string::npos) << first.line;
+    EXPECT_EQ(first.line.find("--headset-share"), std::string::npos) << first.line;
+    o.calibrate = CalibrationPolicy::kOnce;
+    EXPECT_EQ(planValidation(o).calibrations.size(), 1u);
+}
+
+}  // namespace
+}  // namespace qvr::experiment

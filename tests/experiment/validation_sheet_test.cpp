@@ -236,3 +236,36 @@ TEST(ValidationSheet, ExitStatus) {
 
 }  // namespace
 }  // namespace qvr::experiment
+
+namespace qvr::experiment {
+namespace {
+
+TEST(ValidationStats, EveryRunsErrorBesideTheCellsMeans) {
+    ValidationResult result;
+    // One cell: +20 then −4 (mean +8); the same scene at another motion and share is its own.
+    result.rows.add(summaryOf({{"fixed:10", design(20.0)}}), "s", "l", 2);
+    result.rows.add(summaryOf({{"fixed:10", design(-4.0)}}), "s", "l", 2);
+    result.rows.add(summaryOf({{"fixed:10", design(30.0)}}), "s", "l", 2, "/m/01_03.bvh", 0.5);
+    ASSERT_EQ(result.rows.rows().size(), 2u);
+    EXPECT_EQ(result.rows.rows()[1].headset_share, 0.5);
+    const ValidationStats s = summariseValidation(result);
+    EXPECT_DOUBLE_EQ(s.fps.worst, 30.0);
+    EXPECT_DOUBLE_EQ(s.fps.mean, 19.0);  // (8 + 30) / 2 over cells
+    EXPECT_EQ(s.fps_every_run.cells, 3u);
+    EXPECT_DOUBLE_EQ(s.fps_every_run.mean, 18.0);  // (20 + 4 + 30) / 3 over runs
+    ValidationPlan plan;
+    const std::string md = validationMarkdown(plan, result);
+    EXPECT_NE(md.find("Every run on its own (not a cell's mean over repetitions): FPS 18.0% "
+                      "(30.0%) over 3 runs."),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| s | l | 2 | fixed:10 | 2 | 60.0 | 55.0 | -4.0% |"), std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| s · 01_03 · share 0.5 | l | 2 | fixed:10 | 1 |"), std::string::npos) << md;
+    const json j = validationJson(plan, result);
+    EXPECT_DOUBLE_EQ(j["fps_abs_error_pct_worst_every_run"].get<double>(), 30.0);
+    EXPECT_EQ(j["rows"][1]["motion"], "/m/01_03.bvh");
+}
+
+}  // namespace
+}  // namespace qvr::experiment

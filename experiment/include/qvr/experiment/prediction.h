@@ -89,6 +89,9 @@ struct ModelSettings {
     double remote_timeout_ms = 250.0;
     int warmup_frames = 0;
     bool record_scanout = false;
+    // The headset's CFS share of its core (--headset-share): its busy time stretches by 1 / share
+    // in wall time, so the model takes the headset's costs at that speed.
+    double headset_share = 1.0;
 };
 ModelSettings modelSettings(const RunOptions& plan);
 

@@ -40,7 +40,13 @@ struct ValidationOptions {
     std::vector<std::string> links;                   // `qvr run --net` specs
     std::vector<std::string> scenes;
     std::vector<int> depths;  // frames in flight
-    int frames = 40;          // per design per run
+    // Head motions (`qvr run --motion`) and headset shares (`--headset-share`) of every run.
+    std::vector<std::string> motions = {"default"};
+    std::vector<double> headset_shares = {1.0};
+    // When set, the one scene calibrated: every scene's runs are predicted with its calibration
+    // (out of sample for the others). Empty: each scene is calibrated on itself.
+    std::string calibration_scene;
+    int frames = 40;  // per design per run
     int reps = 1;
     // A calibration or run taken again, up to this many times, when its speed probes say the
     // machine was not steady over it; the steadiest take counts.
@@ -62,6 +68,8 @@ struct PlannedCalibration {
 struct PlannedRun {
     std::string scene, link;
     int depth = 1;
+    std::string motion = "default";
+    double headset_share = 1.0;
     int rep = 0;             // 0-based
     size_t calibration = 0;  // the index in ValidationPlan::calibrations that predicts it
 };
@@ -78,7 +86,7 @@ struct ValidationPlan {
     std::vector<PlannedCalibration> calibrations;
     std::vector<PlannedRun> runs;
     std::vector<PlannedStep> steps;  // in the order they are taken
-    size_t conditions() const;       // links × scenes × depths
+    size_t conditions() const;       // links × scenes × depths × motions × shares
 };
 
 // The sheet's steps, in order: with kPerRep each repetition calibrates each scene just before
@@ -133,6 +141,8 @@ public:
 struct ValidationRow {
     std::string scene, link, design;
     int depth = 0;
+    std::string motion = "default";
+    double headset_share = 1.0;
     std::vector<double> fps_measured, fps_predicted;
     std::vector<double> fps_error_pct, mtp_error_pct, bytes_error_pct, e1_error_deg;
     // Each side's own cost against the model's ("Stage errors"): a host that changed speed
@@ -148,14 +158,14 @@ class ValidationRows {
 public:
     // Every design of a run's summary.json that has a prediction.
     void add(const nlohmann::json& summary, const std::string& scene, const std::string& link,
-             int depth);
+             int depth, const std::string& motion = "default", double headset_share = 1.0);
     const std::vector<ValidationRow>& rows() const { return m_rows; }
-    // The cell of `row`'s scene, link, depth and design (nullptr: none).
+    // The cell of `row`'s scene, link, depth, motion, share and design (nullptr: none).
     const ValidationRow* find(const ValidationRow& row) const;
 
 private:
     std::vector<ValidationRow> m_rows;
-    std::map<std::string, size_t> m_index;  // scene|link|depth|design
+    std::map<std::string, size_t> m_index;  // scene|link|depth|motion|share|design
 };
 
 struct CalibrationRecord {
@@ -214,6 +224,7 @@ AbsError absError(const ValidationRows& order, const ValidationRows& table,
 
 struct ValidationStats {
     AbsError fps, mtp, bytes, e1, fps_at_probe_speed;
+    AbsError fps_every_run;    // over single runs, not cells' means (cells: runs)
     AbsError fps_first_takes;  // what the retakes changed
     // Where the machine held its calibration's speed.
     AbsError fps_steady, mtp_steady;
@@ -239,5 +250,7 @@ int runValidation(const ValidationOptions& options, ChildRunner& runner, std::FI
 // A Mahimahi trace of the shared data: searched upward from the working directory and the
 // executable's folder for shared/data/network/FILE or data/network/FILE (empty: none).
 std::string findMahimahiTrace(const std::string& file);
+// The folders findMahimahiTrace searches that exist, nearest first.
+std::vector<std::string> mahimahiTraceFolders();
 
 }  // namespace qvr::experiment

@@ -1,0 +1,219 @@
+// The sweep taken: each condition's takes through a ConditionRunner, every run read from its
+// summary.json, and each condition's verdicts from the medians of its takes (sweep.h).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "qvr/core/shell_quote.h"
+#include "qvr/experiment/sweep.h"
+
+namespace qvr::experiment {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n == 0 ? 0.0 : n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+bool isFixedLabel(const std::string& design) {
+    return design == "ffr" || design.rfind("fixed:", 0) == 0;
+}
+
+// One condition's readings by design: every take's.
+using ByDesign = std::map<std::string, std::vector<const DesignReading*>>;
+
+std::optional<double> medianOf(const ByDesign& by, const std::string& design,
+                               double DesignReading::*field) {
+    const auto it = by.find(design);
+    if (it == by.end() || it->second.empty())
+        return std::nullopt;
+    std::vector<double> v;
+    for (const DesignReading* r : it->second)
+        v.push_back(r->*field);
+    return median(v);
+}
+
+std::optional<double> ratio(std::optional<double> a, std::optional<double> b) {
+    if (!a || !b || *b <= 0.0)
+        return std::nullopt;
+    return *a / *b;
+}
+
+// The fixed design (ffr is fixed:5) with the highest FPS in the condition's first take.
+std::pair<std::string, double> bestFixedOf(const std::vector<SweepRow>& rows, int condition) {
+    std::pair<std::string, double> best{"", 0.0};
+    for (const SweepRow& r : rows)
+        if (r.condition == condition && r.take == 0 && isFixedLabel(r.reading.design) &&
+            r.reading.fps > best.second)
+            best = {r.reading.design, r.reading.fps};
+    return best;
+}
+
+}  // namespace
+
+std::optional<double> DesignReading::fpsErrorPct() const {
+    if (!predicted_fps || fps <= 0.0)
+        return std::nullopt;
+    return 100.0 * (*predicted_fps - fps) / fps;
+}
+
+std::vector<DesignReading> readingsFromSummary(const json& summary,
+                                               const std::vector<std::string>& designs) {
+    std::vector<DesignReading> out;
+    if (!summary.is_object() || !summary.contains("designs") || !summary["designs"].is_object())
+        return out;
+    const json& all = summary["designs"];
+    const auto num = [](const json& j, const char* key) {
+        return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
+    };
+    for (const std::string& name : designs) {
+        if (!all.contains(name) || !all[name].is_object())
+            continue;
+        const json& d = all[name];
+        DesignReading r;
+        r.design = name;
+        r.fps = num(d, "fps_mean");
+        r.mtp_ms_p99 = num(d, "mtp_ms_p99");
+        r.bytes_per_frame = num(d, "bytes_per_frame_mean");
+        r.e1_deg = num(d, "e1_deg_mean");
+        if (d.contains("predicted") && d["predicted"].is_object() &&
+            d["predicted"].contains("fps_mean") && d["predicted"]["fps_mean"].is_number())
+            r.predicted_fps = d["predicted"]["fps_mean"].get<double>();
+        out.push_back(std::move(r));
+    }
+    return out;
+}
+
+ChildCommand ProcessConditionRunner::command(const SweepCondition& c,
+                                             const std::vector<std::string>& designs,
+                                             const std::string& tag) const {
+    const SweepOptions& o = m_options;
+    ChildCommand cmd;
+    cmd.output = (fs::path(o.out) / tag).string();
+    cmd.log_path = cmd.output + ".log";
+    cmd.result_path = (fs::path(cmd.output) / "summary.json").string();
+    cmd.line = fmt::format(
+        "{} run --scene {} --motion {} --seed {} --net {} --headset-share {:g} --designs {} "
+        "--frames {} --profile {}{} --no-video --quality-every 0 --quiet --out {} > {} 2>&1",
+        shellQuote(o.executable), shellQuote(c.scene), shellQuote(c.motion), c.gaze_seed,
+        shellQuote(c.link), c.headset_share, shellQuote(fmt::format("{}", fmt::join(designs, ","))),
+        o.frames, shellQuote(o.profile),
+        o.hardware.empty() ? "" : " --hardware " + shellQuote(o.hardware), shellQuote(cmd.output),
+        shellQuote(cmd.log_path));
+    return cmd;
+}
+
+ConditionRun ProcessConditionRunner::run(const SweepCondition& c,
+                                         const std::vector<std::string>& designs,
+                                         const std::string& tag) {
+    const ChildCommand cmd = command(c, designs, tag);
+    ChildOutcome outcome = m_children.run(cmd);
+    ConditionRun out;
+    // A run that exits 1 (a design never showed the server's layers) still wrote its summary.
+    if (outcome.result.is_null() && outcome.exit_code == 1) {
+        std::ifstream f(cmd.result_path);
+        outcome.result = json::parse(f, nullptr, false);
+    }
+    out.designs = readingsFromSummary(outcome.result, designs);
+    out.ok = !out.designs.empty();
+    if (!out.ok || outcome.exit_code != 0)
+        out.note = fmt::format("exit {}, see {}", outcome.exit_code, cmd.log_path);
+    return out;
+}
+
+std::vector<ConditionVerdict> conditionVerdicts(const SweepOptions& options,
+                                                const SweepResult& result) {
+    std::vector<ConditionVerdict> out;
+    for (const SweepCondition& c : result.conditions) {
+        ByDesign by;
+        for (const SweepRow& r : result.rows)
+            if (r.condition == c.index)
+                by[r.reading.design].push_back(&r.reading);
+        if (by.empty())
+            continue;
+        ConditionVerdict v;
+        v.condition = c.index;
+        v.link_mbps = linkMeanMbps(c.link);
+        std::tie(v.best_fixed, v.best_fixed_fps) = bestFixedOf(result.rows, c.index);
+        const auto fps = [&](const std::string& d) { return medianOf(by, d, &DesignReading::fps); };
+        v.qvr_over_best = ratio(fps("qvr"), fps(v.best_fixed));
+        v.qvr_over_ffr = ratio(fps("qvr"), fps("ffr"));
+        v.qvr_over_aimd = ratio(fps("qvr"), fps("aimd"));
+        v.mtp_p99_over_best = ratio(medianOf(by, "qvr", &DesignReading::mtp_ms_p99),
+                                    medianOf(by, v.best_fixed, &DesignReading::mtp_ms_p99));
+        std::vector<std::string> spread_designs = options.adaptive;
+        if (!v.best_fixed.empty() && std::find(spread_designs.begin(), spread_designs.end(),
+                                               v.best_fixed) == spread_designs.end())
+            spread_designs.push_back(v.best_fixed);
+        for (const std::string& d : spread_designs) {
+            const auto it = by.find(d);
+            if (it == by.end() || it->second.size() < 2)
+                continue;
+            std::vector<double> f;
+            for (const DesignReading* r : it->second)
+                f.push_back(r->fps);
+            const double m = median(f);
+            if (m > 0.0)
+                v.spread_pct.emplace_back(d, 100.0 *
+                                                 (*std::max_element(f.begin(), f.end()) -
+                                                  *std::min_element(f.begin(), f.end())) /
+                                                 m);
+        }
+        out.push_back(std::move(v));
+    }
+    return out;
+}
+
+SweepResult executeSweep(const SweepOptions& o, ConditionRunner& runner, std::FILE* out) {
+    const auto t0 = std::chrono::steady_clock::now();
+    SweepResult result;
+    result.conditions = drawConditions(o.space, o.seed, o.conditions);
+    for (const SweepCondition& c : result.conditions) {
+        std::string best;
+        for (int take = 0; take <= o.repeats && runner.stopSignal() == 0; ++take) {
+            const std::vector<std::string> designs = takeDesigns(o, c.index, take, best);
+            const std::string tag = fmt::format("c{:02}_{}", c.index + 1,
+                                                take == 0 ? "grid" : fmt::format("r{}", take + 1));
+            fmt::print(out, "  condition {}/{} {} | {} | share {:g} | {} | take {}/{} ...",
+                       c.index + 1, o.conditions, c.scene, c.link, c.headset_share,
+                       fs::path(c.motion).stem().string(), take + 1, o.repeats + 1);
+            std::fflush(out);
+            const ConditionRun run = runner.run(c, designs, tag);
+            if (runner.stopSignal() != 0) {
+                fmt::print(out, " stopped\n");
+                result.stop_signal = runner.stopSignal();
+                break;
+            }
+            if (!run.ok) {
+                ++result.failed_runs;
+                fmt::print(out, " failed ({})\n", run.note);
+                if (take == 0)
+                    break;  // no grid: no best fixed to repeat
+                continue;
+            }
+            for (const DesignReading& r : run.designs)
+                result.rows.push_back({c.index, take, r});
+            if (take == 0)
+                best = bestFixedOf(result.rows, c.index).first;
+            fmt::print(out, " done{}\n", take == 0 ? fmt::format(", best fixed {}", best) : "");
+        }
+        if (result.stop_signal != 0)
+            break;
+    }
+    result.verdicts = conditionVerdicts(o, result);
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return result;
+}
+
+}  // namespace qvr::experiment

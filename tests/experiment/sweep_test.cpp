@@ -1,0 +1,261 @@
+// The sweep without processes: the conditions a seed draws, the designs of each take, the
+// options checked, summary.json read, and a whole sweep through a fake runner with its ratios
+// and criteria.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "qvr/experiment/sweep.h"
+
+namespace qvr::experiment {
+namespace {
+
+SweepSpace space() {
+    SweepSpace s;
+    s.traces = {"trace:/a.down", "trace:/b.down@2"};
+    s.scenes = {"builtin:room", "openarena:oa_dm5", "openarena:oa_dm1", "x.glb"};
+    s.motions = {"m1.bvh", "m2.bvh", "m3.bvh"};
+    return s;
+}
+
+TEST(SweepDraw, TheSameSeedDrawsTheSameConditionsAndAnotherSeedOthers) {
+    const auto a = drawConditions(space(), 7, 20);
+    const auto b = drawConditions(space(), 7, 20);
+    const auto c = drawConditions(space(), 8, 20);
+    ASSERT_EQ(a.size(), 20u);
+    int same_as_c = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i].index, static_cast<int>(i));
+        EXPECT_EQ(a[i].link, b[i].link);
+        EXPECT_EQ(a[i].scene, b[i].scene);
+        EXPECT_EQ(a[i].motion, b[i].motion);
+        EXPECT_EQ(a[i].headset_share, b[i].headset_share);
+        EXPECT_EQ(a[i].gaze_seed, b[i].gaze_seed);
+        same_as_c += a[i].link == c[i].link && a[i].gaze_seed == c[i].gaze_seed;
+    }
+    EXPECT_LT(same_as_c, 3);
+    // The first conditions do not depend on how many are drawn.
+    EXPECT_EQ(drawConditions(space(), 7, 3)[2].link, a[2].link);
+}
+
+TEST(SweepDraw, ConditionsCoverTheSpaceAndStayInsideIt) {
+    const SweepSpace s = space();
+    std::set<std::string> scenes, motions, traces;
+    int constant = 0, full = 0, slow = 0, fast = 0;
+    for (const SweepCondition& c : drawConditions(s, 1, 400)) {
+        scenes.insert(c.scene);
+        motions.insert(c.motion);
+        EXPECT_GE(c.headset_share, 0.3 - 1e-9);
+        EXPECT_LE(c.headset_share, 1.0);
+        full += c.headset_share == 1.0;
+        if (c.link.rfind("rate:", 0) == 0) {
+            ++constant;
+            const double mbps = std::stod(c.link.substr(5));
+            EXPECT_GE(mbps, 0.995);
+            EXPECT_LE(mbps, 200.5);
+            slow += mbps <= 3.0;
+            fast += mbps >= 50.0;
+        } else {
+            traces.insert(c.link);
+        }
+    }
+    EXPECT_EQ(scenes.size(), 4u);
+    EXPECT_EQ(motions.size(), 3u);
+    EXPECT_EQ(traces.size(), 2u);
+    EXPECT_GT(constant, 180);  // 60% of 400 on average
+    EXPECT_LT(constant, 300);
+    EXPECT_GT(full, 60);  // a quarter at the whole core
+    // Log-spaced: as many below 3 Mbit/s as above 50 (ln 3 ≈ ln 200 − ln 50 + 0.3).
+    EXPECT_GT(slow, constant / 8);
+    EXPECT_GT(fast, constant / 8);
+}
+
+TEST(SweepPlan, EachTakeRunsItsDesignsRotatedByConditionAndTake) {
+    SweepOptions o;
+    o.adaptive = {"qvr", "sw", "ffr"};
+    o.fixed_grid_deg = {2, 10};
+    const auto grid0 = takeDesigns(o, 0, 0, "");
+    EXPECT_EQ(grid0, (std::vector<std::string>{"qvr", "sw", "ffr", "fixed:2", "fixed:10"}));
+    const auto grid1 = takeDesigns(o, 1, 0, "");
+    EXPECT_EQ(grid1, (std::vector<std::string>{"sw", "ffr", "fixed:2", "fixed:10", "qvr"}));
+    const auto rep = takeDesigns(o, 0, 1, "fixed:10");
+    EXPECT_EQ(rep, (std::vector<std::string>{"sw", "ffr", "fixed:10", "qvr"}));
+    // ffr as the best fixed is not run twice.
+    EXPECT_EQ(takeDesigns(o, 0, 3, "ffr").size(), 3u);
+}
+
+TEST(SweepPlan, BadOptionsAreRefusedWithTheirName) {
+    SweepArgs a = defaultSweepArgs();
+    a.scenes = "builtin:room";
+    a.motions = "default";
+    a.traces = "";
+    ASSERT_TRUE(sweepOptions(a)) << sweepOptions(a).error();
+    const auto refused = [&](auto change, const std::string& what) {
+        SweepArgs b = a;
+        change(b);
+        const auto o = sweepOptions(b);
+        ASSERT_FALSE(o);
+        EXPECT_NE(o.error().find(what), std::string::npos) << o.error();
+    };
+    refused([](SweepArgs& b) { b.conditions = 0; }, "--conditions");
+    refused([](SweepArgs& b) { b.repeats = -1; }, "--repeats");
+    refused([](SweepArgs& b) { b.share_min = 0.01; }, "--share-min");
+    refused([](SweepArgs& b) { b.share_max = 1.5; }, "--share-max");
+    refused([](SweepArgs& b) { b.rate_min_mbps = 300.0; }, "--rate-min");
+    refused([](SweepArgs& b) { b.fixed_grid = "2,x"; }, "--fixed-grid");
+    refused([](SweepArgs& b) { b.fixed_grid = "2,2"; }, "--fixed-grid");
+    refused([](SweepArgs& b) { b.fixed_grid = ""; }, "--fixed-grid");
+    refused([](SweepArgs& b) { b.designs = "sw,ffr"; }, "qvr");
+    refused([](SweepArgs& b) { b.designs = "qvr,fixed:10"; }, "--fixed-grid");
+    refused([](SweepArgs& b) { b.traces = "/nonexistent.down"; }, "--traces");
+    refused([](SweepArgs& b) { b.scenes = "/nonexistent.glb"; }, "--scenes");
+    refused([](SweepArgs& b) { b.motions = "/nonexistent.bvh"; }, "--motions");
+    // A design the runtime does not know is left out and named, not fatal.
+    SweepArgs b = a;
+    b.designs = "qvr,nonesuch,sw";
+    const auto o = sweepOptions(b);
+    ASSERT_TRUE(o);
+    EXPECT_EQ(o->adaptive, (std::vector<std::string>{"qvr", "sw"}));
+    ASSERT_EQ(o->skipped_designs.size(), 1u);
+    EXPECT_NE(o->skipped_designs[0].find("nonesuch"), std::string::npos);
+}
+
+TEST(SweepPlan, TracesComeFromFilesFoldersAndSpecsWithTheirMeans) {
+    const std::filesystem::path dir = testing::TempDir() + "/qvr_sweep_traces";
+    std::filesystem::create_directories(dir);
+    {
+        std::ofstream f(dir / "one.down");  // 2 packets a ms: 24 Mbit/s
+        for (int ms = 1; ms <= 100; ++ms)
+            f << ms << "\n" << ms << "\n";
+    }
+    SweepArgs a = defaultSweepArgs();
+    a.scenes = "builtin:room";
+    a.motions = "default";
+    a.traces = dir.string() + ",trace:" + (dir / "one.down").string() + "@2";
+    const auto o = sweepOptions(a);
+    ASSERT_TRUE(o) << o.error();
+    ASSERT_EQ(o->space.traces.size(), 2u);
+    EXPECT_NEAR(*linkMeanMbps(o->space.traces[0]), 24.0, 1e-9);
+    EXPECT_NEAR(*linkMeanMbps(o->space.traces[1]), 2.0, 1e-9);
+    EXPECT_NEAR(*linkMeanMbps("rate:2.5"), 2.5, 1e-9);
+    EXPECT_FALSE(linkMeanMbps("none"));
+    std::filesystem::remove_all(dir);
+}
+
+TEST(SweepRead, ReadsTheDesignsOfASummaryInTheOrderAsked) {
+    const auto summary = nlohmann::json::parse(R"({"designs": {
+        "qvr": {"fps_mean": 40, "mtp_ms_p99": 50, "bytes_per_frame_mean": 9000,
+                "e1_deg_mean": 12.5, "predicted": {"fps_mean": 44}},
+        "fixed:10": {"fps_mean": 30, "mtp_ms_p99": 60, "bytes_per_frame_mean": 7000,
+                     "e1_deg_mean": 10}}})");
+    const auto r = readingsFromSummary(summary, {"fixed:10", "aimd", "qvr"});
+    ASSERT_EQ(r.size(), 2u);
+    EXPECT_EQ(r[0].design, "fixed:10");
+    EXPECT_FALSE(r[0].fpsErrorPct());
+    EXPECT_EQ(r[1].design, "qvr");
+    EXPECT_DOUBLE_EQ(r[1].e1_deg, 12.5);
+    EXPECT_NEAR(*r[1].fpsErrorPct(), 10.0, 1e-9);
+    EXPECT_TRUE(readingsFromSummary(nullptr, {"qvr"}).empty());
+}
+
+// FPS per design from a table; the prediction 5% high; MTP p99 1000 / FPS.
+class FakeRunner final : public ConditionRunner {
+public:
+    std::map<std::string, double> fps;
+    std::vector<std::vector<std::string>> calls;
+    ConditionRun run(const SweepCondition& c, const std::vector<std::string>& designs,
+                     const std::string& tag) override {
+        calls.push_back(designs);
+        tags.push_back(tag);
+        ConditionRun out;
+        out.ok = true;
+        for (const std::string& d : designs) {
+            DesignReading r;
+            r.design = d;
+            r.fps = fps.at(d) * (c.index == 1 ? 0.5 : 1.0) * (calls.size() % 2 ? 1.0 : 1.1);
+            r.mtp_ms_p99 = 1000.0 / r.fps;
+            r.predicted_fps = 1.05 * r.fps;
+            out.designs.push_back(r);
+        }
+        return out;
+    }
+    std::vector<std::string> tags;
+};
+
+TEST(SweepRun, RepeatsTheBestFixedAndJudgesTheRatios) {
+    SweepOptions o;
+    o.conditions = 2;
+    o.repeats = 2;
+    o.adaptive = {"qvr", "sw", "ffr", "aimd"};
+    o.fixed_grid_deg = {2, 10, 20};
+    o.space.scenes = {"builtin:room"};
+    o.space.traces = {"trace:/x/a.down"};
+    o.space.trace_odds = 1.0;
+    FakeRunner runner;
+    runner.fps = {{"qvr", 38.0},     {"sw", 30.0},       {"ffr", 20.0},     {"aimd", 35.0},
+                  {"fixed:2", 15.0}, {"fixed:10", 40.0}, {"fixed:20", 33.0}};
+    std::FILE* null = std::fopen("/dev/null", "w");
+    const SweepResult r = executeSweep(o, runner, null);
+    std::fclose(null);
+    ASSERT_EQ(runner.calls.size(), 6u);  // 2 conditions × (grid + 2 repeats)
+    EXPECT_EQ(runner.calls[0].size(), 7u);
+    EXPECT_EQ(runner.calls[1].size(), 5u);  // the adaptive four and fixed:10
+    EXPECT_NE(std::find(runner.calls[1].begin(), runner.calls[1].end(), "fixed:10"),
+              runner.calls[1].end());
+    EXPECT_NE(runner.calls[0].front(), runner.calls[3].front());  // rotated per condition
+    EXPECT_EQ(runner.tags[0], "c01_grid");
+    EXPECT_EQ(runner.tags[2], "c01_r3");
+    EXPECT_EQ(r.rows.size(), 2u * (7 + 5 + 5));
+    ASSERT_EQ(r.verdicts.size(), 2u);
+    const ConditionVerdict& v = r.verdicts[0];
+    EXPECT_EQ(v.best_fixed, "fixed:10");
+    EXPECT_NEAR(*v.qvr_over_best, 0.95, 1e-9);  // the same factor on both in every take
+    EXPECT_NEAR(*v.qvr_over_ffr, 1.9, 1e-9);
+    EXPECT_NEAR(*v.qvr_over_aimd, 38.0 / 35.0, 1e-9);
+    EXPECT_NEAR(*v.mtp_p99_over_best, 40.0 / 38.0, 1e-9);
+    ASSERT_FALSE(v.spread_pct.empty());
+    EXPECT_NEAR(v.spread_pct[0].second, 10.0, 1e-6);  // 1.0 and 1.1 around a median of 1.0
+    std::map<std::string, bool> pass;
+    for (const SweepCriterion& c : sweepCriteria(r))
+        pass[c.name] = c.pass;
+    EXPECT_TRUE(pass.at("qvr >= 0.90x best fixed on all"));
+    EXPECT_TRUE(pass.at("qvr >= ffr on all"));
+    EXPECT_TRUE(pass.at("qvr ahead of aimd on average"));
+    EXPECT_TRUE(pass.at("qvr MTP p99 <= 1.10x best fixed's"));
+    EXPECT_TRUE(pass.at("model FPS error mean <= 10%"));
+    EXPECT_FALSE(pass.at("at least 16 conditions"));
+    const std::string md = sweepMarkdown(o, r);
+    EXPECT_NE(md.find("PASS qvr >= ffr on all"), std::string::npos);
+    EXPECT_NE(md.find("| 1 | builtin:room | trace:a.down |"), std::string::npos) << md;
+    EXPECT_NE(sweepCsv(r).find("1,builtin:room,"), std::string::npos);
+    EXPECT_EQ(sweepJson(o, r)["runs"].size(), r.rows.size());
+}
+
+TEST(SweepRun, FailsTheCriteriaWhereQvrFallsBehind) {
+    SweepOptions o;
+    o.conditions = 1;
+    o.repeats = 1;
+    o.adaptive = {"qvr", "ffr"};
+    o.fixed_grid_deg = {10};
+    FakeRunner runner;
+    runner.fps = {{"qvr", 30.0}, {"ffr", 32.0}, {"fixed:10", 40.0}};
+    std::FILE* null = std::fopen("/dev/null", "w");
+    const SweepResult r = executeSweep(o, runner, null);
+    std::fclose(null);
+    std::map<std::string, SweepCriterion> by;
+    for (const SweepCriterion& c : sweepCriteria(r))
+        by[c.name] = c;
+    EXPECT_FALSE(by.at("qvr >= 0.95x best fixed on >= 90% of conditions").pass);
+    EXPECT_FALSE(by.at("qvr >= 0.90x best fixed on all").pass);
+    EXPECT_FALSE(by.at("qvr >= ffr on all").pass);
+    EXPECT_FALSE(by.at("qvr MTP p99 <= 1.10x best fixed's").pass);
+    EXPECT_FALSE(by.at("qvr ahead of aimd on average").pass);
+    EXPECT_EQ(by.at("qvr ahead of aimd on average").detail, "not measured (no aimd runs)");
+}
+
+}  // namespace
+}  // namespace qvr::experiment
