@@ -10,14 +10,12 @@
 #include <string>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
-
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/video_codec.h"
-#include "qvr/runtime/chrome_trace.h"
 #include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
+#include "qvr/runtime/session_outputs.h"
 #include "qvr/scene/scene_loader.h"
 
 namespace qvr::cli {
@@ -89,108 +87,23 @@ Expected<HeadsetConfig> headsetConfig(const ClientCmdOptions& o) {
     return hc;
 }
 
-nlohmann::json clientSummaryJson(const ClientCmdOptions& o, const HeadsetResult& result) {
-    const DesignSummary& s = result.summary;
-    const HeadsetStats& st = result.stats;
-    return {{"design", s.design},
-            {"frames", s.frames},
-            {"frames_requested", o.frames},
-            // telemetry.csv's times are ns after this steady-clock (CLOCK_MONOTONIC) instant, so
-            // other tools can place their own events on its timeline
-            {"clock_origin_ns", result.origin_ns},
-            {"interrupted", g_client_stop.load()},
-            {"fps_mean", s.fps_mean},
-            {"mtp_ms_mean", s.mtp_ms_mean},
-            {"mtp_ms_p99", s.mtp_ms_p99},
-            {"bytes_per_frame_mean", s.bytes_per_frame_mean},
-            {"e1_deg_mean", s.e1_deg_mean},
-            {"frames_displayed", s.frames_displayed},
-            {"frames_reused", s.frames_reused},
-            {"frames_fallback_local", s.frames_fallback_local},
-            {"connects", st.connects},
-            {"connect_failures", st.connect_failures},
-            {"server_proof_failures", st.net.server_proof_failures},
-            {"incompatible_refusals", st.net.incompatible_refusals},
-            {"media_drops", st.net.media_drops.total()},
-            {"media_forged", st.net.media_drops[net::WireError::kBadMac]},
-            {"media_replayed", st.net.media_drops[net::WireError::kReplayed]},
-            {"control_drops", st.net.control_drops.total()},
-            {"control_forged", st.net.control_forged},
-            {"control_replayed", st.net.control_replayed},
-            {"key_frame_requests", st.key_frame_requests},
-            {"nacks_sent", st.net.assembler.nacks},
-            {"packets_nacked", st.net.assembler.packets_nacked},
-            {"packets_recovered", st.net.assembler.packets_recovered},
-            {"fec_recoveries", st.net.assembler.fec_recoveries},
-            {"fec_packets_recovered", st.net.assembler.fec_packets_recovered},
-            {"fec_parity_received", st.net.assembler.fec_parity_received},
-            {"fec_parity_unused", st.net.assembler.fec_parity_unused},
-            {"streams_lost", st.streams_lost},
-            {"late_frames", st.late_frames},
-            {"keepalives_sent", st.net.keepalives_sent},
-            {"silent_server_frames", st.silent_server_frames}};
+std::string telemetryPath(const ClientCmdOptions& o) {
+    return (std::filesystem::path(o.out) / "telemetry.csv").string();
 }
 
-// trace.json: the headset's stages, and the server's from `stamps` (a server on this machine:
-// qvr server --stamps-csv F); its description goes into the summary `j`.
-Status writeClientTrace(const ClientCmdOptions& o, double refresh_hz, const HeadsetResult& result,
-                        const std::vector<ServerFrameStamps>& stamps, nlohmann::json& j) {
-    const std::filesystem::path out(o.out);
-    auto trace =
-        writeChromeTrace((out / "trace.json").string(),
-                         {{o.design, result.origin_ns, refresh_hz, &result.frames}}, stamps);
-    if (!trace)
-        return makeError(trace.error());
-    j["trace"] = {{"path", "trace.json"},
-                  {"frames", result.frames.size()},
-                  {"first_frame", result.frames.empty() ? 0 : result.frames.front().frame},
-                  {"events", trace->events},
-                  {"server_frames", trace->server_frames_matched},
-                  {"server_offset_ms", trace->offset.offset_ns * 1e-6},
-                  {"server_offset_bound_ms", trace->offset.bound_ns * 1e-6}};
-    return {};
-}
-
-void printClientReport(const HeadsetResult& result) {
-    const DesignSummary& s = result.summary;
-    const HeadsetStats& st = result.stats;
-    fmt::print(
-        "qvr client: {} fps {:.1f}, MTP {:.1f} ms (p99 {:.1f}), {:.0f} B/frame, e1 {:.1f} deg, "
-        "{} displayed, {} reused, {} local fallback; {} connects, {} failed\n",
-        s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean, s.e1_deg_mean,
-        s.frames_displayed, s.frames_reused, s.frames_fallback_local, st.connects,
-        st.connect_failures);
-    if (st.connects == 0 && st.net.server_proof_failures > 0)
-        std::fprintf(stderr, "qvr client: the server did not prove the pre-shared key\n");
-    if (st.net.control_forged + st.net.control_replayed > 0)
-        std::fprintf(stderr,
-                     "qvr client: %llu forged and %llu replayed control messages ended "
-                     "connections\n",
-                     static_cast<unsigned long long>(st.net.control_forged),
-                     static_cast<unsigned long long>(st.net.control_replayed));
-}
-
-// Runs the session, each frame's telemetry row written to `telemetry` as the frame finishes
-// (only the newest frames stay in memory, for trace.json), so a session of any length runs in
-// flat memory.
+// Runs the session with telemetry.csv written as frames finish; SIGINT/SIGTERM end it at the
+// next frame boundary and keep what was measured.
 Expected<HeadsetResult> runSession(const ClientCmdOptions& o, HeadsetConfig& hc,
                                    const HeadsetInputs& inputs, std::ofstream& telemetry) {
-    telemetry << telemetryCsvHeader();
-    hc.frame_sink = [&telemetry, &o](const FrameTelemetry& t) {
-        telemetry << telemetryCsvRow(o.design, t);
-    };
     g_client_stop.store(false);
     std::signal(SIGINT, onClientSignal);
     std::signal(SIGTERM, onClientSignal);
     auto result = runHeadset(hc, inputs.scene, inputs.bvh, inputs.traces);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
-    if (result) {
-        telemetry.close();
-        if (!telemetry)
-            return makeError("error writing '" +
-                             (std::filesystem::path(o.out) / "telemetry.csv").string() + "'");
-    }
+    if (result)
+        if (Status st = finishTelemetryCsv(telemetryPath(o), telemetry); !st)
+            return makeError(st.error());
     return result;
 }
 
@@ -210,10 +123,9 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: %s\n", inputs.error().c_str());
         return 2;
     }
-    const std::string telemetry_path = (std::filesystem::path(o.out) / "telemetry.csv").string();
-    std::ofstream telemetry(telemetry_path);
-    if (!telemetry) {
-        std::fprintf(stderr, "qvr client: cannot write '%s'\n", telemetry_path.c_str());
+    std::ofstream telemetry;
+    if (Status st = startTelemetryCsv(telemetryPath(o), o.design, telemetry, *hc); !st) {
+        std::fprintf(stderr, "qvr client: %s\n", st.error().c_str());
         return 2;
     }
     auto result = runSession(o, *hc, *inputs, telemetry);
@@ -221,7 +133,6 @@ int runClient(const ClientCmdOptions& o) {
         std::fprintf(stderr, "qvr client: %s\n", result.error().c_str());
         return 1;
     }
-    nlohmann::json j = clientSummaryJson(o, *result);
     // The server's stamps are read after the session (the server has stopped or flushed); a
     // file that went bad meanwhile costs the server's rows on the timeline, not the session.
     std::vector<ServerFrameStamps> stamps;
@@ -234,12 +145,14 @@ int runClient(const ClientCmdOptions& o) {
             std::fprintf(stderr, "qvr client: --server-stamps: %s\n", read.error().c_str());
         stamps_bad = !read;
     }
-    if (Status st = writeClientTrace(o, hc->profile.refresh_hz, *result, stamps, j); !st) {
+    const ClientSession session{o.design, o.frames, g_client_stop.load(), hc->profile.refresh_hz};
+    if (Status st = writeClientOutputs(o.out, session, *result, stamps); !st) {
         std::fprintf(stderr, "qvr client: %s\n", st.error().c_str());
         return 1;
     }
-    std::ofstream(std::filesystem::path(o.out) / "summary.json") << j.dump(2) << "\n";
-    printClientReport(*result);
+    fmt::print("{}", clientReportLine(*result));
+    for (const std::string& warning : clientWarnings(result->stats))
+        std::fprintf(stderr, "qvr client: %s\n", warning.c_str());
     if (g_client_stop.load()) {
         std::fprintf(stderr, "qvr client: interrupted: kept %zu of %d frames in %s\n",
                      result->frames.size(), o.frames, o.out.c_str());

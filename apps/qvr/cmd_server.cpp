@@ -5,24 +5,21 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
 #include <optional>
 #include <string>
 #include <thread>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
-
 #include "cli_parse.h"
 #include "commands.h"
 #include "qvr/codec/video_codec.h"
 #include "qvr/net/agones_sdk.h"
 #include "qvr/net/link_emulator.h"
 #include "qvr/runtime/affinity.h"
-#include "qvr/runtime/chrome_trace.h"
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
+#include "qvr/runtime/session_outputs.h"
 #include "qvr/scene/scene_loader.h"
 
 namespace qvr::cli {
@@ -57,29 +54,6 @@ struct ServerCmdOptions {
     bool agones = false;  // report Ready / Health / Shutdown to Agones' SDK sidecar
 };
 
-using StampsFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
-
-// Per-frame stamps for timelines (qvr run's trace.json): one line per layer sent, on this
-// process's steady clock; bounded so a long-running server cannot fill the disk.
-Status attachStampsCsv(const std::string& path, RenderServerConfig& cfg, StampsFile& stamps) {
-    stamps.reset(std::fopen(path.c_str(), "w"));
-    if (!stamps)
-        return makeError("--stamps-csv: cannot write '" + path + "'");
-    std::fputs(kServerStampsHeader, stamps.get());
-    cfg.on_frame = [f = stamps.get(), lines = int64_t{0}](const ServerFrameStamps& st) mutable {
-        for (const ServerFrameStamps::Layer& l : st.layers) {
-            if (++lines > kMaxServerStampLines)
-                return;
-            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", st.client, st.frame_id,
-                       st.client_send_ns, st.queued_ns, st.start_ns, st.end_ns, l.stream_id,
-                       l.render_start_ns, l.render_end_ns, l.encode_end_ns, l.sent_ns);
-        }
-        // Whole frames on disk: a client on this machine reads the file while we run.
-        std::fflush(f);
-    };
-    return {};
-}
-
 // The server's settings from the options (each checked when parsed); an error when the key,
 // the scene or the stamps file cannot be had.
 Expected<RenderServerConfig> serverConfig(const ServerCmdOptions& o, StampsFile& stamps) {
@@ -111,8 +85,8 @@ Expected<RenderServerConfig> serverConfig(const ServerCmdOptions& o, StampsFile&
     gl.lod_error_px = o.lod_px;
     cfg.renderer = glRendererFactory(gl);
     if (!o.stamps_csv.empty())
-        if (Status st = attachStampsCsv(o.stamps_csv, cfg, stamps); !st)
-            return makeError(st.error());
+        if (Status st = attachServerStampsCsv(o.stamps_csv, cfg, stamps); !st)
+            return makeError("--stamps-csv: " + st.error());
     return cfg;
 }
 
@@ -128,119 +102,6 @@ void serveUntilStopped(double duration_s) {
                 duration_s)
             break;
     }
-}
-
-nlohmann::json serverStatsJson(const RenderServerStats& s, int core) {
-    return {{"requests", s.requests},
-            {"requests_dropped", s.requests_dropped},
-            {"requests_invalid", s.requests_invalid},
-            {"frames_rendered", s.frames_rendered},
-            {"layers_rendered", s.layers_rendered},
-            {"periphery_passes", s.periphery_passes},
-            {"streams_sent", s.streams_sent},
-            {"stream_send_failures", s.stream_send_failures},
-            {"render_failures", s.render_failures},
-            {"encode_failures", s.encode_failures},
-            {"key_frame_requests", s.key_frame_requests},
-            {"render_ms_total", s.render_ms_total},
-            {"encode_ms_total", s.encode_ms_total},
-            {"readback_ms_total", s.readback_ms_total},
-            {"send_ms_total", s.send_ms_total},
-            {"connections", s.net.connections},
-            {"clients_accepted", s.net.clients_accepted},
-            {"auth_failures", s.net.auth_failures},
-            {"handshake_timeouts", s.net.handshake_timeouts},
-            {"refused_full", s.net.refused_full},
-            {"pending_evicted", s.net.pending_evicted},
-            {"idle_timeouts", s.net.idle_timeouts},
-            {"keepalives", s.net.keepalives},
-            {"protocol_errors", s.net.protocol_errors},
-            {"version_mismatches", s.net.version_mismatches},
-            {"settings_refusals", s.net.settings_refusals},
-            {"route_failures", s.net.route_failures},
-            {"control_forged", s.net.control_forged},
-            {"control_replayed", s.net.control_replayed},
-            {"nacks", s.net.nacks},
-            {"packets_retransmitted", s.net.packets_retransmitted},
-            {"bytes_retransmitted", s.net.bytes_retransmitted},
-            {"retransmissions_refused", s.net.retransmissions_refused},
-            {"fec_frames", s.net.fec_frames},
-            {"fec_parity_packets", s.net.fec_parity_packets},
-            {"fec_parity_bytes", s.net.fec_parity_bytes},
-            {"client_loss_ppm", s.net.client_loss_ppm},
-            {"control_drops", s.net.control_drops.total()},
-            {"link",
-             {{"packets_in", s.net.link.packets_in},
-              {"packets_delivered", s.net.link.packets_delivered},
-              {"dropped_loss", s.net.link.dropped_loss},
-              {"dropped_queue", s.net.link.dropped_queue},
-              {"dropped_burst", s.net.link.dropped_burst},
-              {"reordered", s.net.link.reordered},
-              {"duplicated", s.net.link.duplicated},
-              {"spiked", s.net.link.spiked}}},
-            {"core", core}};
-}
-
-// One row per served frame: per-layer pixels, triangles, render, read-back, encode and send.
-Status writeServerFramesCsv(const std::string& path,
-                            const std::vector<ServerFrameRecord>& records) {
-    std::ofstream f(path);
-    f << "client,frame,e1_deg,received_ns,start_ns,done_ns";
-    for (int sid = 0; sid < 4; ++sid)
-        f << fmt::format(
-            ",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
-            "send_ms{0},bytes{0}",
-            sid);
-    f << "\n";
-    for (const ServerFrameRecord& r : records) {
-        f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg, r.received_ns,
-                         r.start_ns, r.done_ns);
-        for (size_t sid = 0; sid < 4; ++sid)
-            f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{}", r.pixels[sid],
-                             r.triangles[sid], r.render_ms[sid], r.readback_ms[sid],
-                             r.encode_ms[sid], r.send_ms[sid], r.bytes[sid]);
-        f << "\n";
-    }
-    if (!f)
-        return makeError("cannot write '" + path + "'");
-    return {};
-}
-
-void printServerStats(const RenderServerStats& s) {
-    fmt::print(
-        "qvr server: {} requests ({} dropped, {} invalid), {} frames, {} streams sent, {} auth "
-        "failures, {} malformed control messages\n",
-        s.requests, s.requests_dropped, s.requests_invalid, s.frames_rendered, s.streams_sent,
-        s.net.auth_failures, s.net.control_drops.total());
-    fmt::print(
-        "qvr server: {} connections, {} sessions; {} handshake timeouts, {} idle timeouts, {} "
-        "evicted, {} refused full, {} protocol errors, {} version / {} settings refusals, {} "
-        "media ports unverified; {} forged / {} replayed control messages; {} NACKs, {} packets "
-        "retransmitted\n",
-        s.net.connections, s.net.clients_accepted, s.net.handshake_timeouts, s.net.idle_timeouts,
-        s.net.pending_evicted, s.net.refused_full, s.net.protocol_errors, s.net.version_mismatches,
-        s.net.settings_refusals, s.net.route_failures, s.net.control_forged, s.net.control_replayed,
-        s.net.nacks, s.net.packets_retransmitted);
-}
-
-// Writes --stats-json and --frames-csv once the server has stopped.
-int writeServerOutputs(const ServerCmdOptions& o, const RenderServerStats& s,
-                       const std::vector<ServerFrameRecord>& frame_records) {
-    if (!o.stats_json.empty()) {
-        std::ofstream f(o.stats_json);
-        f << serverStatsJson(s, o.core).dump(2) << "\n";
-        if (!f) {
-            std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
-            return 1;
-        }
-    }
-    if (!o.frames_csv.empty()) {
-        if (Status st = writeServerFramesCsv(o.frames_csv, frame_records); !st) {
-            std::fprintf(stderr, "qvr server: %s\n", st.error().c_str());
-            return 1;
-        }
-    }
-    return 0;
 }
 
 // --agones (docs/DEPLOY.md): Health pings every kAgonesHealthPeriodMs while the server serves,
@@ -322,9 +183,12 @@ int runServer(const ServerCmdOptions& o) {
     const std::vector<ServerFrameRecord> frame_records = (*server)->frameRecords();
     if (stamps && std::fflush(stamps.get()) != 0)
         std::fprintf(stderr, "qvr server: error writing '%s'\n", o.stamps_csv.c_str());
-    if (const int rc = writeServerOutputs(o, s, frame_records); rc != 0)
-        return rc;
-    printServerStats(s);
+    if (Status st = writeServerOutputs({o.stats_json, o.frames_csv}, s, o.core, frame_records);
+        !st) {
+        std::fprintf(stderr, "qvr server: %s\n", st.error().c_str());
+        return 1;
+    }
+    fmt::print("{}", serverStatsReport(s));
     if (!served) {
         std::fprintf(stderr, "qvr server: %s\n", served.error().c_str());
         return 1;
