@@ -4,7 +4,6 @@
 #if defined(QVR_HAVE_COMPOSE)
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -12,7 +11,7 @@
 
 #include "commands.h"
 #include "options.h"
-#include "qvr/compose/png_io.h"
+#include "qvr/compose/layer_files.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/compose/uca.h"
 #include "qvr/foveation/layer_plan.h"
@@ -48,32 +47,6 @@ bool parseNumbers(const std::string& text, double* v, int n, double limit) {
             return false;
     }
     return true;
-}
-
-const char* kEyeNames[2] = {"left", "right"};
-const char* kLayerNames[3] = {"fovea", "middle", "outer"};
-
-ImageRgba8& layerOf(EyeLayerImages& e, int k) {
-    return k == 0 ? e.fovea : (k == 1 ? e.middle : e.outer);
-}
-const LayerRect& rectOf(const EyeLayers& e, int k) {
-    return k == 0 ? e.fovea : (k == 1 ? e.middle : e.outer);
-}
-
-std::string layerPath(const std::string& dir, int eye, int k) {
-    return (std::filesystem::path(dir) / fmt::format("{}_{}.png", kEyeNames[eye], kLayerNames[k]))
-        .string();
-}
-
-ImageRgba8 sideBySide(const std::array<ImageRgba8, 2>& eyes) {
-    ImageRgba8 out(eyes[0].width() * 2, eyes[0].height());
-    for (int y = 0; y < out.height(); ++y) {
-        for (int eye = 0; eye < 2; ++eye) {
-            const uint8_t* src = eyes[static_cast<size_t>(eye)].row(y);
-            std::copy(src, src + eyes[0].strideElems(), out.row(y) + eye * eyes[0].strideElems());
-        }
-    }
-    return out;
 }
 
 }  // namespace
@@ -129,61 +102,36 @@ static Registered registerCompose(CLI::App& app) {
         Pose render_pose, display_pose;
         render_pose.orientation = quatFromEulerDeg({render[0], render[1], render[2]});
         display_pose.orientation = quatFromEulerDeg({display[0], display[1], display[2]});
-        LayerFrame frame;
-        if (opts->layers_dir.empty()) {
-            frame = makeTestPatternFrame(*profile, plan, render_pose, 0,
-                                         renderTestPattern(profile->width_px, profile->height_px));
-        } else {
-            frame.plan = plan;
-            frame.render_pose = render_pose;
-            for (int eye = 0; eye < 2; ++eye) {
-                for (int k = 0; k < 3; ++k) {
-                    if (rectOf(plan.eyes[static_cast<size_t>(eye)], k).empty())
-                        continue;
-                    auto img = readPng(layerPath(opts->layers_dir, eye, k));
-                    if (!img) {
-                        std::fprintf(stderr, "qvr compose: %s\n", img.error().c_str());
-                        return 2;
-                    }
-                    layerOf(frame.eyes[static_cast<size_t>(eye)], k) = std::move(*img);
-                }
-            }
+        auto frame =
+            opts->layers_dir.empty()
+                ? makeTestPatternFrame(*profile, plan, render_pose, 0,
+                                       renderTestPattern(profile->width_px, profile->height_px))
+                : readLayerPngs(opts->layers_dir, plan, render_pose);
+        if (!frame) {
+            std::fprintf(stderr, "qvr compose: %s\n", frame.error().c_str());
+            return 2;
         }
-        if (Status st = validateFrame(*profile, frame); !st) {
+        if (Status st = validateFrame(*profile, *frame); !st) {
             std::fprintf(stderr, "qvr compose: %s\n", st.error().c_str());
             return 2;
         }
         if (!opts->write_layers_dir.empty()) {
-            std::error_code ec;
-            std::filesystem::create_directories(opts->write_layers_dir, ec);
-            for (int eye = 0; eye < 2; ++eye) {
-                for (int k = 0; k < 3; ++k) {
-                    const ImageRgba8& img = layerOf(frame.eyes[static_cast<size_t>(eye)], k);
-                    if (img.empty())
-                        continue;
-                    if (Status st = writePng(layerPath(opts->write_layers_dir, eye, k), img); !st) {
-                        std::fprintf(stderr, "qvr compose: %s\n", st.error().c_str());
-                        return 1;
-                    }
-                }
+            if (Status st = writeLayerPngs(opts->write_layers_dir, *frame); !st) {
+                std::fprintf(stderr, "qvr compose: %s\n", st.error().c_str());
+                return 1;
             }
         }
         ComposeOptions copts;
         copts.simd = !opts->scalar;
         Compositor compositor(*profile, copts);
         std::array<ImageRgba8, 2> out;
-        auto report = opts->two_pass ? compositor.composeTwoPass(frame, display_pose, out)
-                                     : compositor.compose(frame, display_pose, out);
+        auto report = opts->two_pass ? compositor.composeTwoPass(*frame, display_pose, out)
+                                     : compositor.compose(*frame, display_pose, out);
         if (!report) {
             std::fprintf(stderr, "qvr compose: %s\n", report.error().c_str());
             return 2;
         }
-        const std::filesystem::path out_path(opts->out);
-        if (out_path.has_parent_path()) {
-            std::error_code ec;
-            std::filesystem::create_directories(out_path.parent_path(), ec);
-        }
-        if (Status st = writePng(opts->out, sideBySide(out)); !st) {
+        if (Status st = writeSideBySidePng(opts->out, out); !st) {
             std::fprintf(stderr, "qvr compose: %s\n", st.error().c_str());
             return 1;
         }
