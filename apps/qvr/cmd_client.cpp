@@ -10,12 +10,13 @@
 #include <string>
 
 #include <fmt/format.h>
+
 #include "cli_parse.h"
+#include "command_error.h"
 #include "commands.h"
-#include "qvr/codec/video_codec.h"
-#include "qvr/runtime/headset_client.h"
 #include "qvr/runtime/session.h"
 #include "qvr/runtime/session_outputs.h"
+#include "qvr/runtime/session_settings.h"
 #include "qvr/scene/scene_loader.h"
 
 namespace qvr::cli {
@@ -36,65 +37,34 @@ void onClientSignal(int) {
 }
 
 struct ClientCmdOptions {
+    HeadsetSettings settings;
     std::string connect = "127.0.0.1:7400";
-    std::string key;
-    std::string key_file;
     std::string scene = "builtin:room";
-    std::string profile = "default";
     std::string motion = "default";
     std::string gaze = "model";
-    std::string design = "qvr";
-    std::string codec = "x264";
-    int frames = 300;
-    int core = -1;
     uint64_t seed = 1;
     std::string out = "qvr-client";
     std::string server_stamps;
-    float lod_px = 1.0f;
 };
 
 // The headset's settings from the options (each checked when parsed); an error when the key
 // cannot be had.
-Expected<HeadsetConfig> headsetConfig(const ClientCmdOptions& o) {
-    auto key = keyFromOptions(o.key, o.key_file);
-    if (!key)
-        return makeError(key.error());
-    std::string host, why;
-    uint16_t port = 0;
-    if (!parseHostPort(o.connect, host, port, why))
+Expected<HeadsetConfig> clientConfig(ClientCmdOptions o) {
+    std::string why;
+    if (!parseHostPort(o.connect, o.settings.host, o.settings.port, why))
         return makeError("--connect: " + why);
-    auto design = parseDesign(o.design, DesignScope::Runtime);
-    if (!design)
-        return makeError("--design: " + design.error());
-    auto profile = runtimeProfileByName(o.profile);
-    if (!profile)
-        return makeError("--profile: " + profile.error());
-    HeadsetConfig hc;
-    hc.design = design->design;
-    hc.fixed_e1_deg = design->fixed_e1_deg;
-    hc.profile = *profile;
-    hc.codec.backend = o.codec;
-    hc.host = host;
-    hc.port = port;
-    hc.key = *key;
-    hc.frames = o.frames;
-    hc.core = o.core;
-    GlRendererOptions gl;
-    gl.lod_error_px = o.lod_px;
-    hc.renderer = glRendererFactory(gl);
-    hc.stop = &g_client_stop;
-    hc.keep_frames = kClientFramesKept;
+    auto hc = headsetConfig(o.settings);
+    if (hc) {
+        hc->stop = &g_client_stop;
+        hc->keep_frames = kClientFramesKept;
+    }
     return hc;
-}
-
-std::string telemetryPath(const ClientCmdOptions& o) {
-    return (std::filesystem::path(o.out) / "telemetry.csv").string();
 }
 
 // Runs the session with telemetry.csv written as frames finish; SIGINT/SIGTERM end it at the
 // next frame boundary and keep what was measured.
-Expected<HeadsetResult> runSession(const ClientCmdOptions& o, HeadsetConfig& hc,
-                                   const HeadsetInputs& inputs, std::ofstream& telemetry) {
+Expected<HeadsetResult> runSession(HeadsetConfig& hc, const HeadsetInputs& inputs,
+                                   const std::string& telemetry_path, std::ofstream& telemetry) {
     g_client_stop.store(false);
     std::signal(SIGINT, onClientSignal);
     std::signal(SIGTERM, onClientSignal);
@@ -102,75 +72,51 @@ Expected<HeadsetResult> runSession(const ClientCmdOptions& o, HeadsetConfig& hc,
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     if (result)
-        if (Status st = finishTelemetryCsv(telemetryPath(o), telemetry); !st)
+        if (Status st = finishTelemetryCsv(telemetry_path, telemetry); !st)
             return makeError(st.error());
     return result;
 }
 
 int runClient(const ClientCmdOptions& o) {
-    auto hc = headsetConfig(o);
-    if (!hc) {
-        std::fprintf(stderr, "qvr client: %s\n", hc.error().c_str());
-        return 2;
-    }
-    if (std::string why; !makeOutputDir(o.out, why)) {
-        std::fprintf(stderr, "qvr client: --out: %s\n", why.c_str());
-        return 2;
-    }
-    auto inputs =
-        loadHeadsetInputs(o.scene, o.motion, o.gaze, hc->profile.refresh_hz, o.frames, o.seed);
-    if (!inputs) {
-        std::fprintf(stderr, "qvr client: %s\n", inputs.error().c_str());
-        return 2;
-    }
+    auto hc = clientConfig(o);
+    if (!hc)
+        return fail("client", hc.error(), 2);
+    if (std::string why; !makeOutputDir(o.out, why))
+        return fail("client", "--out: " + why, 2);
+    auto inputs = loadHeadsetInputs(o.scene, o.motion, o.gaze, hc->profile.refresh_hz,
+                                    o.settings.frames, o.seed);
+    if (!inputs)
+        return fail("client", inputs.error(), 2);
+    const std::string telemetry_path = (std::filesystem::path(o.out) / "telemetry.csv").string();
     std::ofstream telemetry;
-    if (Status st = startTelemetryCsv(telemetryPath(o), o.design, telemetry, *hc); !st) {
-        std::fprintf(stderr, "qvr client: %s\n", st.error().c_str());
-        return 2;
-    }
-    auto result = runSession(o, *hc, *inputs, telemetry);
-    if (!result) {
-        std::fprintf(stderr, "qvr client: %s\n", result.error().c_str());
-        return 1;
-    }
-    // The server's stamps are read after the session (the server has stopped or flushed); a
-    // file that went bad meanwhile costs the server's rows on the timeline, not the session.
-    std::vector<ServerFrameStamps> stamps;
-    bool stamps_bad = false;
-    if (!o.server_stamps.empty()) {
-        auto read = readServerStamps(o.server_stamps);
-        if (read)
-            stamps = std::move(*read);
-        else
-            std::fprintf(stderr, "qvr client: --server-stamps: %s\n", read.error().c_str());
-        stamps_bad = !read;
-    }
-    const ClientSession session{o.design, o.frames, g_client_stop.load(), hc->profile.refresh_hz};
-    if (Status st = writeClientOutputs(o.out, session, *result, stamps); !st) {
-        std::fprintf(stderr, "qvr client: %s\n", st.error().c_str());
-        return 1;
-    }
+    if (Status st = startTelemetryCsv(telemetry_path, o.settings.design, telemetry, *hc); !st)
+        return fail("client", st.error(), 2);
+    auto result = runSession(*hc, *inputs, telemetry_path, telemetry);
+    if (!result)
+        return fail("client", result.error(), 1);
+    const ServerStampsRead stamps = readServerStampsAfterSession(o.server_stamps);
+    if (!stamps.error.empty())
+        std::fprintf(stderr, "qvr client: --server-stamps: %s\n", stamps.error.c_str());
+    const ClientSession session{o.settings.design, o.settings.frames, g_client_stop.load(),
+                                hc->profile.refresh_hz};
+    if (Status st = writeClientOutputs(o.out, session, *result, stamps.stamps); !st)
+        return fail("client", st.error(), 1);
     fmt::print("{}", clientReportLine(*result));
     for (const std::string& warning : clientWarnings(result->stats))
         std::fprintf(stderr, "qvr client: %s\n", warning.c_str());
     if (g_client_stop.load()) {
         std::fprintf(stderr, "qvr client: interrupted: kept %zu of %d frames in %s\n",
-                     result->frames.size(), o.frames, o.out.c_str());
+                     result->frames.size(), o.settings.frames, o.out.c_str());
         return 130;
     }
-    return stamps_bad ? 2 : 0;
+    return stamps.error.empty() ? 0 : 2;
 }
 
 // --server-stamps: a readable file that, once it has a first line, starts with the stamps
 // header (the server writes the file while this client runs, so it may still be empty).
 std::string serverStampsError(std::string& path) {
-    if (std::string why = readableFile()(path); !why.empty())
-        return why;
-    std::ifstream in(path);
-    std::string line;
-    if (std::getline(in, line) && !in.eof() && line + "\n" != kServerStampsHeader)
-        return "'" + path + "' is not a server stamps file (qvr server --stamps-csv): its header";
-    return {};
+    std::string why = readableFile()(path);
+    return why.empty() ? serverStampsHeaderError(path) : why;
 }
 
 }  // namespace
@@ -188,13 +134,13 @@ static Registered registerClient(CLI::App& app) {
             },
             "HOST:PORT", "HOST_PORT"))
         ->capture_default_str();
-    addKeyOptions(cmd, o->key, o->key_file);
+    addKeyOptions(cmd, o->settings.key, o->settings.key_file);
     cmd->add_option("--scene", o->scene, "Scene")->capture_default_str();
-    addProfileOption(cmd, o->profile, ProfileNames::kRuntime);
+    addProfileOption(cmd, o->settings.profile, ProfileNames::kRuntime);
     cmd->add_option("--motion", o->motion, "Head motion: default, a .bvh, a pose CSV, still")
         ->capture_default_str();
     addGazeSourceOption(cmd, o->gaze);
-    cmd->add_option("--design", o->design, "local, remote, ffr, fixed:E, sw or qvr")
+    cmd->add_option("--design", o->settings.design, "local, remote, ffr, fixed:E, sw or qvr")
         ->check(CLI::Validator(
             [](std::string& name) -> std::string {
                 auto d = parseDesign(name, DesignScope::Runtime);
@@ -202,10 +148,10 @@ static Registered registerClient(CLI::App& app) {
             },
             "DESIGN", "DESIGN"))
         ->capture_default_str();
-    addCodecOption(cmd, o->codec);
-    addFramesOption(cmd, o->frames, 1, 1'000'000, "Frames to run");
-    addLodOption(cmd, o->lod_px);
-    addCoreOption(cmd, o->core, "Pin the headset loop to this core (-1: no)");
+    addCodecOption(cmd, o->settings.codec);
+    addFramesOption(cmd, o->settings.frames, 1, 1'000'000, "Frames to run");
+    addLodOption(cmd, o->settings.lod_px);
+    addCoreOption(cmd, o->settings.core, "Pin the headset loop to this core (-1: no)");
     addSeedOption(cmd, o->seed, "Gaze model seed");
     cmd->add_option("--server-stamps", o->server_stamps,
                     "The server's --stamps-csv file: its stages go on trace.json's timeline")

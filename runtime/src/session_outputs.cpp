@@ -95,6 +95,26 @@ Status writeClientOutputs(const std::filesystem::path& out, const ClientSession&
     return {};
 }
 
+ServerStampsRead readServerStampsAfterSession(const std::string& path) {
+    ServerStampsRead read;
+    if (path.empty())
+        return read;
+    auto stamps = readServerStamps(path);
+    if (stamps)
+        read.stamps = std::move(*stamps);
+    else
+        read.error = stamps.error();
+    return read;
+}
+
+std::string serverStampsHeaderError(const std::string& path) {
+    std::ifstream in(path);
+    std::string line;
+    if (std::getline(in, line) && !in.eof() && line + "\n" != kServerStampsHeader)
+        return "'" + path + "' is not a server stamps file (qvr server --stamps-csv): its header";
+    return {};
+}
+
 std::string clientReportLine(const HeadsetResult& result) {
     const DesignSummary& s = result.summary;
     const HeadsetStats& st = result.stats;

@@ -53,6 +53,19 @@ Status writeClientOutputs(const std::filesystem::path& out, const ClientSession&
                           const HeadsetResult& result,
                           const std::vector<ServerFrameStamps>& stamps);
 
+// The server's stamps for trace.json (`qvr server --stamps-csv`, a server on this machine), read
+// after the session, when the server has stopped or flushed: a file that went bad meanwhile
+// costs the server's rows on the timeline, not the session, and `error` says why they are
+// missing. An empty path reads nothing.
+struct ServerStampsRead {
+    std::vector<ServerFrameStamps> stamps;
+    std::string error;
+};
+ServerStampsRead readServerStampsAfterSession(const std::string& path);
+// Why `path` is not a stamps file by its first line (empty when it is, or has no whole first
+// line yet: the server writes it while the client runs).
+std::string serverStampsHeaderError(const std::string& path);
+
 // The line `qvr client` prints at the end, and the warnings it prints on stderr.
 std::string clientReportLine(const HeadsetResult& result);
 std::vector<std::string> clientWarnings(const HeadsetStats& st);
