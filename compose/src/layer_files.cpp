@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "qvr/compose/png_io.h"
+#include "qvr/compose/test_pattern.h"
 
 namespace qvr {
 
@@ -48,6 +49,19 @@ Expected<LayerFrame> readLayerPngs(const std::string& dir, const LayerPlan& plan
             layerOf(frame.eyes[static_cast<size_t>(eye)], k) = std::move(*img);
         }
     }
+    return frame;
+}
+
+Expected<LayerFrame> layerFrameFrom(const std::string& dir, const HmdProfile& profile,
+                                    const LayerPlan& plan, const Pose& render_pose) {
+    auto frame = dir.empty()
+                     ? makeTestPatternFrame(profile, plan, render_pose, 0,
+                                            renderTestPattern(profile.width_px, profile.height_px))
+                     : readLayerPngs(dir, plan, render_pose);
+    if (!frame)
+        return frame;
+    if (Status st = validateFrame(profile, *frame); !st)
+        return makeError(st.error());
     return frame;
 }
 

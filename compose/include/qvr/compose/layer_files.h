@@ -19,6 +19,11 @@ std::string layerPngPath(const std::string& dir, int eye, int layer);
 // checked by validateFrame, not here.
 Expected<LayerFrame> readLayerPngs(const std::string& dir, const LayerPlan& plan,
                                    const Pose& render_pose);
+// The frame to compose: the layers read from `dir` (readLayerPngs), or the built-in test pattern
+// rendered for `plan` when `dir` is empty; an error when a file cannot be read or a layer's
+// size does not fit the plan (validateFrame).
+Expected<LayerFrame> layerFrameFrom(const std::string& dir, const HmdProfile& profile,
+                                    const LayerPlan& plan, const Pose& render_pose);
 // Every non-empty layer of `frame` written into `dir` (made when missing).
 Status writeLayerPngs(const std::string& dir, const LayerFrame& frame);
 
