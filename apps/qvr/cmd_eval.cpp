@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include <fmt/format.h>
 
+#include "command_error.h"
 #include "commands.h"
 #include "options.h"
 #include "qvr/sim/benches.h"
@@ -20,18 +20,15 @@ namespace qvr::cli {
 namespace {
 
 struct EvalCliOptions {
-    int frames = 400;
-    int jobs = 2;
-    std::string out;
+    EvalOptions eval;  // frames, jobs, out_dir, vsync_paced
     EvalInputs inputs;
-    bool vsync = false;
 };
 
 std::string joinArgs(const EvalCliOptions& o) {
-    std::string s =
-        fmt::format("qvr eval --suite {} --codec-model {} --frames {} --jobs {} --out {}",
-                    o.inputs.suite, o.inputs.codec_model, o.frames, o.jobs, o.out);
-    if (o.vsync)
+    std::string s = fmt::format(
+        "qvr eval --suite {} --codec-model {} --frames {} --jobs {} --out {}", o.inputs.suite,
+        o.inputs.codec_model, o.eval.frames, o.eval.jobs, o.eval.out_dir);
+    if (o.eval.vsync_paced)
         s += " --vsync";
     if (!o.inputs.mahimahi.empty())
         s += " --mahimahi";
@@ -41,37 +38,27 @@ std::string joinArgs(const EvalCliOptions& o) {
 }
 
 int runEval(const EvalCliOptions& o) {
-    if (Status st = selectEvalSuite(o.inputs); !st) {
-        std::fprintf(stderr, "qvr eval: %s\n", st.error().c_str());
-        return 2;
-    }
+    if (Status st = selectEvalSuite(o.inputs); !st)
+        return fail("eval", st.error(), 2);
     fmt::print("suite: {}\n", suiteBenchNamesList());
     auto codec = evalCodecModel(o.inputs);
-    if (!codec) {
-        std::fprintf(stderr, "qvr eval: %s\n", codec.error().c_str());
-        return 2;
-    }
-    EvalOptions opts;
+    if (!codec)
+        return fail("eval", codec.error(), 2);
+    EvalOptions opts = o.eval;
     opts.hardware_path = o.inputs.hardware;
     opts.codec_model = *codec;
     opts.mahimahi_traces = o.inputs.mahimahi;
     opts.benches = o.inputs.benches;
-    opts.frames = o.frames;
-    opts.jobs = o.jobs;
-    opts.vsync_paced = o.vsync;
-    opts.out_dir = o.out;
     opts.command_line = joinArgs(o);
     if (isatty(fileno(stderr)) != 0)
         opts.progress = evalProgressBar(stderr);
     const auto t0 = std::chrono::steady_clock::now();
     auto result = runEvaluation(opts);
-    if (!result) {
-        std::fprintf(stderr, "qvr eval: %s\n", result.error().c_str());
-        return 1;
-    }
+    if (!result)
+        return fail("eval", result.error(), 1);
     const double secs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    fmt::print("{}", evalSummaryText(*result, secs, o.out));
+    fmt::print("{}", evalSummaryText(*result, secs, o.eval.out_dir));
     return 0;
 }
 
@@ -82,9 +69,9 @@ static Registered registerEval(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "eval",
         "Run the paper's experiments (Fig. 12-15, Table 4) on the recorded (or synthetic) suite");
-    addFramesOption(cmd, o->frames, 30, 100000,
+    addFramesOption(cmd, o->eval.frames, 30, 100000,
                     "Frames per run (30..100000); Fig. 14 always gets at least 300");
-    cmd->add_option("--jobs", o->jobs, "Runs simulated in parallel (threads)")
+    cmd->add_option("--jobs", o->eval.jobs, "Runs simulated in parallel (threads)")
         ->check(CLI::Range(1, 256))
         ->capture_default_str();
     cmd->add_option("--bench", o->inputs.benches,
@@ -108,10 +95,10 @@ static Registered registerEval(CLI::App& app) {
                     "Mahimahi capacity traces (e.g. ../shared/data/network/*.down) to replay, "
                     "rescaled to 100 Mbps, for ffr, dfr and qvr")
         ->check(readableFile());
-    cmd->add_flag("--vsync", o->vsync,
+    cmd->add_flag("--vsync", o->eval.vsync_paced,
                   "Pace every run to the HMD's vsync: frames start at most once per refresh and "
                   "are shown at the next vsync (MTP runs to it)");
-    cmd->add_option("--out", o->out,
+    cmd->add_option("--out", o->eval.out_dir,
                     "Output folder: CSV + PNG per experiment, summary.json, report.html")
         ->required()
         ->check(outputFolder());

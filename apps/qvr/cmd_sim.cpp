@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "command_error.h"
 #include "commands.h"
 #include "options.h"
 #include "qvr/sim/benches.h"
@@ -35,52 +36,29 @@ struct SimOptions {
 // The runtime pipeline model (sim/runtime_model.h): frames.csv and summary.json of its own.
 int runRuntimeSim(const SimOptions& o, Design design, const HardwareConfig& hw,
                   const WorkloadTrace& trace) {
-    if (design == Design::Static) {
-        std::fprintf(stderr, "qvr sim: the runtime pipeline has no static design\n");
-        return 2;
-    }
-    RuntimeSimConfig cfg;
-    cfg.design = design;
-    cfg.costs = hw.runtime;
-    cfg.pipeline_depth = o.depth;
-    cfg.wait_limit_ms = o.wait_limit_ms;
-    cfg.frames = o.frames;
-    double delay_ms = 0.0;
-    auto link = makeRuntimeLink(o.net, &delay_ms);
-    if (!link) {
-        std::fprintf(stderr, "qvr sim: --net: %s\n", link.error().c_str());
-        return 2;
-    }
-    cfg.costs.link_delay_ms += delay_ms;
-    const RuntimeRunResult run = simulateRuntime(trace, cfg, **link);
-    const RuntimeSimSetting setting{o.net, o.depth};
-    if (Status st = writeRuntimeSimOutputs(o.out, run, setting); !st) {
-        std::fprintf(stderr, "qvr sim: %s\n", st.error().c_str());
-        return 1;
-    }
-    fmt::print("{}", runtimeSimReport(run.summary, trace.header.name, setting, o.out));
+    const RuntimeSimSetting setting{o.net, o.depth, o.wait_limit_ms, o.frames};
+    auto run = simulateRuntimePipeline(trace, design, hw, setting);
+    if (!run)
+        return fail("sim", run.error(), 2);
+    if (Status st = writeRuntimeSimOutputs(o.out, *run, setting); !st)
+        return fail("sim", st.error(), 1);
+    fmt::print("{}", runtimeSimReport(run->summary, trace.header.name, setting, o.out));
     return 0;
 }
 
 int runSim(const SimOptions& o) {
-    if (o.bench.empty() == o.trace.empty()) {
-        std::fprintf(stderr, "qvr sim: give exactly one of --bench NAME or --trace FILE\n");
-        return 2;
-    }
+    if (o.bench.empty() == o.trace.empty())
+        return fail("sim", "give exactly one of --bench NAME or --trace FILE", 2);
     auto design = designByName(o.design);
-    if (!design) {
-        std::fprintf(stderr, "qvr sim: %s\n", design.error().c_str());
-        return 2;
-    }
+    if (!design)
+        return fail("sim", design.error(), 2);
     auto net = networkSpecByName(o.pipeline == "runtime" ? std::string("wifi") : o.net);
     auto link = net ? makeLink(*net, o.seed) : makeError(net.error());
     auto trace =
         link ? simWorkload(o.bench, o.trace, o.frames, o.codec_model) : makeError(link.error());
     auto hardware = trace ? simHardware(o.hardware, o.gpu_mhz) : makeError(trace.error());
-    if (!hardware) {
-        std::fprintf(stderr, "qvr sim: %s\n", hardware.error().c_str());
-        return 2;
-    }
+    if (!hardware)
+        return fail("sim", hardware.error(), 2);
     if (o.pipeline == "runtime" || (o.pipeline.empty() && hardware->runtime_pipeline))
         return runRuntimeSim(o, *design, *hardware, *trace);
     SimConfig cfg;
@@ -92,10 +70,8 @@ int runSim(const SimOptions& o) {
         std::fprintf(stderr, "qvr sim: the trace has %zu frames; simulating all of them\n",
                      trace->frames.size());
     const RunResult run = simulate(*trace, cfg, **link);
-    if (Status st = writeSimRunOutputs(o.out, run); !st) {
-        std::fprintf(stderr, "qvr sim: %s\n", st.error().c_str());
-        return 1;
-    }
+    if (Status st = writeSimRunOutputs(o.out, run); !st)
+        return fail("sim", st.error(), 1);
     fmt::print("{}", simRunReport(run.summary, o.out));
     return 0;
 }

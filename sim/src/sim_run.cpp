@@ -76,6 +76,25 @@ std::string simRunReport(const RunSummary& s, const std::string& out) {
     return t;
 }
 
+Expected<RuntimeRunResult> simulateRuntimePipeline(const WorkloadTrace& trace, Design design,
+                                                   const HardwareConfig& hw,
+                                                   const RuntimeSimSetting& setting) {
+    if (design == Design::Static)
+        return makeError("the runtime pipeline has no static design");
+    RuntimeSimConfig cfg;
+    cfg.design = design;
+    cfg.costs = hw.runtime;
+    cfg.pipeline_depth = setting.pipeline_depth;
+    cfg.wait_limit_ms = setting.wait_limit_ms;
+    cfg.frames = setting.frames;
+    double delay_ms = 0.0;
+    auto link = makeRuntimeLink(setting.net, &delay_ms);
+    if (!link)
+        return makeError("--net: " + link.error());
+    cfg.costs.link_delay_ms += delay_ms;
+    return simulateRuntime(trace, cfg, **link);
+}
+
 Status writeRuntimeSimOutputs(const std::filesystem::path& out, const RuntimeRunResult& run,
                               const RuntimeSimSetting& setting) {
     if (Status st = makeFolder(out); !st)

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include "qvr/sim/benches.h"
 #include "qvr/sim/eval_setup.h"
 
@@ -37,7 +39,7 @@ TEST(SimRun, WritesTheRuntimePipelinesFramesAndSummary) {
     run.summary.requests_dropped = 1;
     const fs::path out =
         fs::temp_directory_path() / ("qvr-simrun-" + std::to_string(getpid())) / "deeper";
-    ASSERT_TRUE(writeRuntimeSimOutputs(out, run, {"lte", 1}));
+    ASSERT_TRUE(writeRuntimeSimOutputs(out, run, {"lte", 1, 250.0, 2}));
     std::ifstream in(out / "summary.json");
     const nlohmann::json j = nlohmann::json::parse(in);
     EXPECT_EQ(j["pipeline"], "runtime");
@@ -51,9 +53,25 @@ TEST(SimRun, WritesTheRuntimePipelinesFramesAndSummary) {
     for (std::string line; std::getline(csv, line);)
         ++lines;
     EXPECT_EQ(lines, 3);
-    const std::string report = runtimeSimReport(run.summary, "b", {"lte", 1}, out.string());
+    const std::string report =
+        runtimeSimReport(run.summary, "b", {"lte", 1, 250.0, 2}, out.string());
     EXPECT_EQ(report.rfind("qvr on b | runtime pipeline, 1 in flight | lte | 2 frames\n", 0), 0u);
     fs::remove_all(out.parent_path());
+}
+
+TEST(SimRun, TheRuntimePipelineRefusesTheStaticDesignAndABadLink) {
+    auto w = simWorkload("grid", "", 20, "auto");
+    ASSERT_TRUE(w);
+    const HardwareConfig hw = defaultHardware(500.0);
+    auto st = simulateRuntimePipeline(*w, Design::Static, hw, {"wifi", 2, 250.0, 20});
+    ASSERT_FALSE(st);
+    EXPECT_EQ(st.error(), "the runtime pipeline has no static design");
+    auto bad = simulateRuntimePipeline(*w, Design::Qvr, hw, {"dialup", 2, 250.0, 20});
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().rfind("--net: ", 0), 0u);
+    auto run = simulateRuntimePipeline(*w, Design::Qvr, hw, {"wifi", 2, 250.0, 20});
+    ASSERT_TRUE(run) << run.error();
+    EXPECT_EQ(run->frames.size(), 20u);
 }
 
 TEST(EvalSetup, RefusesAnUnknownSuiteAndBench) {

@@ -30,9 +30,16 @@ std::string simRunReport(const RunSummary& s, const std::string& out);
 
 // The runtime pipeline's run: frames.csv and summary.json of its own in `out`.
 struct RuntimeSimSetting {
-    std::string net;
+    std::string net;  // a link spec (makeRuntimeLink)
     int pipeline_depth = 2;
+    double wait_limit_ms = 250.0;
+    int frames = 300;
 };
+// The runtime pipeline over `trace` with the hardware file's calibrated costs, the link's delay
+// added to theirs; an error for the static design (the runtime has none) or a bad link.
+Expected<RuntimeRunResult> simulateRuntimePipeline(const WorkloadTrace& trace, Design design,
+                                                   const HardwareConfig& hw,
+                                                   const RuntimeSimSetting& setting);
 Status writeRuntimeSimOutputs(const std::filesystem::path& out, const RuntimeRunResult& run,
                               const RuntimeSimSetting& setting);
 std::string runtimeSimReport(const RuntimeSummary& s, const std::string& bench,
