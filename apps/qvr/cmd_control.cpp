@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "command_error.h"
 #include "commands.h"
 #include "options.h"
 #include "qvr/controller/control_report.h"
@@ -26,23 +27,17 @@ struct ControlOptions {
 
 int runControlCommand(ControlOptions o) {
     auto trace = controlWorkload(o.trace, o.bench, o.plan.frames);
-    if (!trace) {
-        std::fprintf(stderr, "qvr control: %s\n", trace.error().c_str());
-        return 2;
-    }
+    if (!trace)
+        return fail("control", trace.error(), 2);
     if (o.plan.throughput_mbps <= 0.0) {
         auto mbps = effectiveThroughputMbps(o.net);
-        if (!mbps) {
-            std::fprintf(stderr, "qvr control: --net: %s\n", mbps.error().c_str());
-            return 2;
-        }
+        if (!mbps)
+            return fail("control", "--net: " + mbps.error(), 2);
         o.plan.throughput_mbps = *mbps;
     }
     auto report = runControl(*trace, o.plan);
-    if (!report) {
-        std::fprintf(stderr, "qvr control: %s\n", report.error().c_str());
-        return 2;
-    }
+    if (!report)
+        return fail("control", report.error(), 2);
     if (o.json)
         std::printf("%s\n", controlReportJson(*report).c_str());
     else
