@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include "qvr/controller/liwc.h"
+#include "qvr/core/link_efficiency.h"
 #include "qvr/workload/synthetic.h"
 
 namespace {
@@ -20,7 +21,7 @@ struct Fixture {
               spec.frames = 256;
               return generateSyntheticWorkload(spec);
           }()),
-          truth(trace.header, GpuModel{}, 200e6 * 0.688) {
+          truth(trace.header, GpuModel{}, 200e6 * calibratedLinkEfficiency()) {
         // Pre-compute each frame's measurement at 12° so the benchmark times only LIWC.
         for (const auto& f : trace.frames) {
             const LayerPlan plan = truth.planner().plan(f.gaze, 12.0);

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "qvr/experiment/host.h"
+#include "qvr/runtime/session_outputs.h"
 
 namespace qvr::experiment {
 
@@ -200,37 +201,22 @@ nlohmann::json errorPctJson(const PredictionError& e) {
     return j;
 }
 
-// The measured summary and the headset's counters.
+// The measured summary and the headset's counters (their shared keys: runtime/session_outputs.h).
 nlohmann::json measuredJson(const DesignSummary& s, const HeadsetStats& st) {
-    return {{"fps_mean", s.fps_mean},
-            {"mtp_ms_mean", s.mtp_ms_mean},
-            {"mtp_ms_p99", s.mtp_ms_p99},
-            {"bytes_per_frame_mean", s.bytes_per_frame_mean},
-            {"e1_deg_mean", s.e1_deg_mean},
-            {"frames_displayed", s.frames_displayed},
-            {"frames_reused", s.frames_reused},
-            {"frames", s.frames},
-            {"frames_fallback_local", s.frames_fallback_local},
-            {"t_local_ms_mean", s.t_local_ms_mean},
-            {"t_remote_ms_mean", s.t_remote_ms_mean},
-            {"uca_ms_mean", s.uca_ms_mean},
-            {"wall_s", s.wall_s},
-            {"warmup_frames", s.warmup_frames},
-            {"startup_mtp_ms_max", s.startup_mtp_ms_max},
-            {"startup_unfinished", s.startup_unfinished},
-            {"streams_decoded", st.streams_decoded},
-            {"streams_lost", st.streams_lost},
-            {"decode_failures", st.decode_failures},
-            {"late_frames", st.late_frames},
-            {"key_frame_requests", st.key_frame_requests + st.net.key_frame_requests_sent},
-            {"fec_recoveries", st.net.assembler.fec_recoveries},
-            {"fec_packets_recovered", st.net.assembler.fec_packets_recovered},
-            {"nacks_sent", st.net.assembler.nacks},
-            {"packets_recovered", st.net.assembler.packets_recovered},
-            {"media_forged", st.net.media_drops[net::WireError::kBadMac]},
-            {"media_replayed", st.net.media_drops[net::WireError::kReplayed]},
-            {"media_drops", st.net.media_drops.total()},
-            {"client_core", st.core}};
+    nlohmann::json j = designSummaryJson(s);
+    j.update(headsetCountersJson(st));
+    j.update({{"t_local_ms_mean", s.t_local_ms_mean},
+              {"t_remote_ms_mean", s.t_remote_ms_mean},
+              {"uca_ms_mean", s.uca_ms_mean},
+              {"wall_s", s.wall_s},
+              {"warmup_frames", s.warmup_frames},
+              {"startup_mtp_ms_max", s.startup_mtp_ms_max},
+              {"startup_unfinished", s.startup_unfinished},
+              {"streams_decoded", st.streams_decoded},
+              {"decode_failures", st.decode_failures},
+              {"key_frame_requests", st.key_frame_requests + st.net.key_frame_requests_sent},
+              {"client_core", st.core}});
+    return j;
 }
 
 nlohmann::json speedJson(const DesignResult& d) {
@@ -304,14 +290,11 @@ nlohmann::json traceJson(const RunOutcome& o) {
     if (!o.trace)
         return nlohmann::json::object();
     const ChromeTraceInfo& t = *o.trace;
-    return {{"path", "trace.json"},
-            {"events", t.events},
-            {"frames", t.frames_written},
-            {"frames_left_out", t.frames_left_out},
-            {"server_frames", t.server_frames_matched},
-            {"server_offset_ms", t.offset.offset_ns * 1e-6},
-            {"server_offset_bound_ms", t.offset.bound_ns * 1e-6},
-            {"offset_requests", t.offset.requests}};
+    nlohmann::json j = chromeTraceJson(t);
+    j.update({{"frames", t.frames_written},
+              {"frames_left_out", t.frames_left_out},
+              {"offset_requests", t.offset.requests}});
+    return j;
 }
 
 nlohmann::json bestFixedJson(const BestFixed& bf) {

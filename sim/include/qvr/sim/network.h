@@ -12,21 +12,10 @@
 #include <vector>
 
 #include "qvr/core/expected.h"
+#include "qvr/core/link_efficiency.h"
 #include "qvr/core/mahimahi.h"
 
 namespace qvr {
-
-// One row of Table 1: the static design's background size and its measured T_remote on Wi-Fi.
-struct Table1Row {
-    const char* app;
-    double background_bytes;  // KB as printed, taken as 1000 bytes
-    double t_remote_ms;
-};
-const std::vector<Table1Row>& table1Rows();
-
-// The share of nominal capacity a frame's payload gets (protocol headers, MAC contention,
-// codec framing), fitted by least squares over Table 1 at Wi-Fi's 200 Mbps: T = bits / (η·C).
-double calibratedLinkEfficiency();
 
 // Radio energy as Huang et al. (MobiSys 2012) model an active interface: P = α·R + β, so a
 // transfer of b bits at goodput R costs b·(α + β/R).
