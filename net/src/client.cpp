@@ -65,6 +65,9 @@ const char* byeText(ByeReason r) {
         case ByeReason::kRouteUnverified:
             return "could not verify that we receive media at our UDP port (no probe arrived or "
                    "none was answered: a firewall or NAT in the way?)";
+        case ByeReason::kOverCapacity:
+            return "is at capacity: one more headset would take its headsets below its "
+                   "frame-rate floor (qvr server --min-fps); try another server";
     }
     return "said bye";
 }
@@ -166,9 +169,14 @@ struct Client::Impl::Handshake {
         ++impl.stats.incompatible_refusals;
     }
 
-    // Why the server said bye; a refusal of our version or settings is counted as permanent.
+    // Why the server said bye; a refusal of our version or settings, or for capacity, is
+    // counted as permanent.
     Error byeError(ByeReason reason) {
         std::string text = "the server " + std::string(byeText(reason));
+        if (reason == ByeReason::kOverCapacity) {
+            std::lock_guard lock(impl.mutex);
+            ++impl.stats.capacity_refusals;
+        }
         if (reason == ByeReason::kVersionMismatch || reason == ByeReason::kCodecMismatch ||
             reason == ByeReason::kProfileMismatch) {
             countIncompatible();

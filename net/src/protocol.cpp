@@ -290,6 +290,8 @@ std::string_view byeReasonName(ByeReason r) {
             return "display profile mismatch";
         case ByeReason::kRouteUnverified:
             return "media port not verified";
+        case ByeReason::kOverCapacity:
+            return "over capacity";
     }
     return "?";
 }
