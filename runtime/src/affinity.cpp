@@ -16,6 +16,15 @@ int onlineCores() {
     return n > 0 ? static_cast<int>(n) : 1;
 }
 
+int allowedCores() {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof(set), &set) != 0)
+        return onlineCores();
+    const int n = CPU_COUNT(&set);
+    return n > 0 ? n : onlineCores();
+}
+
 Status pinCurrentThread(int core) {
     if (core < 0 || core >= CPU_SETSIZE)
         return makeError(fmt::format("core {} is out of range", core));

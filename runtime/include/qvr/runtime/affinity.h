@@ -10,6 +10,9 @@
 namespace qvr::runtime {
 
 int onlineCores();
+// The cores the calling thread may run on (sched_getaffinity: `taskset`, a container's cpuset,
+// `--core`); onlineCores() when the mask cannot be read.
+int allowedCores();
 // Pins the calling thread to `core` (0-based); an error when the core does not exist or the
 // kernel refuses.
 Status pinCurrentThread(int core);
