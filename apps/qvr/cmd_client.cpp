@@ -111,6 +111,7 @@ nlohmann::json clientSummaryJson(const ClientCmdOptions& o, const HeadsetResult&
             {"connect_failures", st.connect_failures},
             {"server_proof_failures", st.net.server_proof_failures},
             {"incompatible_refusals", st.net.incompatible_refusals},
+            {"capacity_refusals", st.net.capacity_refusals},
             {"media_drops", st.net.media_drops.total()},
             {"media_forged", st.net.media_drops[net::WireError::kBadMac]},
             {"media_replayed", st.net.media_drops[net::WireError::kReplayed]},

@@ -24,6 +24,7 @@
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
+#include "qvr/sim/hardware.h"
 
 namespace qvr::cli {
 
@@ -47,6 +48,9 @@ struct ServerCmdOptions {
     std::string net = "none";
     std::string codec = "x264";
     int core = -1;
+    int workers = 0;
+    double min_fps = 0.0;
+    std::string calibration;
     double duration_s = 0.0;
     std::string stats_json;
     std::string stamps_csv;
@@ -103,6 +107,16 @@ Expected<RenderServerConfig> serverConfig(const ServerCmdOptions& o, StampsFile&
     cfg.profile = *profile;
     cfg.codec.backend = o.codec;
     cfg.core = o.core;
+    cfg.workers = o.workers;
+    cfg.admission.min_fps = o.min_fps;
+    if (!o.calibration.empty()) {
+        auto hw = loadHardwareConfig(o.calibration, 500.0);
+        if (!hw || hw->runtime.speed_reference_server_ms <= 0.0)
+            return makeError("--calibration: " +
+                             (hw ? "no runtime.speed_reference_server_ms in '" + o.calibration + "'"
+                                 : hw.error()));
+        cfg.admission.frame_cost_ms = hw->runtime.speed_reference_server_ms;
+    }
     cfg.one_pass_periphery = o.one_pass_periphery;
     cfg.holes.enabled = !o.no_holes;
     if (o.frames_csv.empty())
@@ -228,7 +242,9 @@ int writeServerOutputs(const ServerCmdOptions& o, const RenderServerStats& s,
                        const std::vector<ServerFrameRecord>& frame_records) {
     if (!o.stats_json.empty()) {
         std::ofstream f(o.stats_json);
-        f << serverStatsJson(s, o.core).dump(2) << "\n";
+        nlohmann::json j = serverStatsJson(s, o.core);
+        j.update(serverPoolJson(s));  // "workers", "admission", "sessions"
+        f << j.dump(2) << "\n";
         if (!f) {
             std::fprintf(stderr, "qvr server: cannot write '%s'\n", o.stats_json.c_str());
             return 1;
@@ -353,6 +369,18 @@ static Registered registerServer(CLI::App& app) {
     addCodecOption(cmd, o->codec);
     addCoreOption(cmd, o->core, "Pin the server (all its threads) to this core (-1: no)");
     addLodOption(cmd, o->lod_px);
+    cmd->add_option("--workers", o->workers,
+                    "Render workers (0: one per core the server may use; 1 with --core)")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
+    cmd->add_option("--min-fps", o->min_fps,
+                    "Refuse a headset that would take the admitted ones below this frame rate "
+                    "(0: off; docs/RUNTIME.md)")
+        ->check(finiteRange(0.0, 1000.0))
+        ->capture_default_str();
+    cmd->add_option("--calibration", o->calibration,
+                    "Hardware file (qvr calibrate) whose server frame time admission starts from")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit")
         ->check(writableFile());
     cmd->add_option("--stamps-csv", o->stamps_csv,

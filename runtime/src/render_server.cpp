@@ -112,6 +112,7 @@ struct SessionState {
     std::array<std::unique_ptr<VideoEncoder>, net::kMaxStreams> encoders;
 };
 using Queued = SessionState::Queued;
+using Encoders = std::array<std::unique_ptr<VideoEncoder>, net::kMaxStreams>;
 
 bool layerFits(const HmdProfile& profile, const LayerRect& l) {
     if (l.empty())
@@ -174,12 +175,18 @@ struct RenderServer::Impl final : net::ServerHandler {
         sessions.push_back(std::move(s));
     }
     void onClientGone(net::ClientId id) override {
+        Encoders released;  // destroyed after the lock (x264 takes its time)
         std::lock_guard lock(mutex);
         auto it = clients.find(id);
         if (it == clients.end())
             return;
-        it->second->ended_ns = clock->nowNs();
-        it->second->stats.connected = false;
+        SessionState& s = *it->second;
+        s.ended_ns = clock->nowNs();
+        s.stats.connected = false;
+        // An ended session keeps its counters, not its encoders (a worker serving its last
+        // frame lets them go when it is done).
+        if (!s.in_service)
+            released = std::exchange(s.encoders, {});
         clients.erase(it);
         // Forget the oldest ended sessions beyond the bound.
         for (++ended_sessions; ended_sessions > kMaxEndedSessions; --ended_sessions)
@@ -305,13 +312,17 @@ struct RenderServer::Impl final : net::ServerHandler {
         ServerFrameStamps stamps;
         while (std::shared_ptr<SessionState> state = next(id, q)) {
             serve(*renderer, images, id, *state, q.request, q.queued_ns, stamps);
+            Encoders released;
+            bool more = false;
             {
                 std::lock_guard lock(mutex);
                 state->in_service = false;
-                if (state->pending.empty())
-                    continue;
+                if (state->ended_ns != 0)
+                    released = std::exchange(state->encoders, {});
+                more = !state->pending.empty();
             }
-            cv.notify_one();  // its next frame may go to another worker
+            if (more)
+                cv.notify_one();  // its next frame may go to another worker
         }
     }
 

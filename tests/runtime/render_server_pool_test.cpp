@@ -223,7 +223,7 @@ TEST(RenderServerPool, WorkersServeSessionsAtOnce) {
 }
 
 // A headset that sends a burst of requests and then stops (neither sends nor reads, like a
-// SIGSTOPped one) gets only its bounded queue served; the steady ones get their frames.
+// SIGSTOPped one): the steady ones still get their frames, and nothing of it is left queued.
 TEST(RenderServerPool, AStalledSessionDoesNotStallTheOthers) {
     // Two workers at ~4 ms a frame against 40 requests a second from the steady two: room to
     // spare on a loaded machine too (a sleep there can take several times its length).
@@ -251,9 +251,8 @@ TEST(RenderServerPool, AStalledSessionDoesNotStallTheOthers) {
         if (x.frames_requested > 30u) {  // the stalled one: a burst into a queue of 2
             ++stalled;
             EXPECT_EQ(x.frames_requested, 40u);
-            // Served only while its burst arrived (the queue keeps its newest 2), never the
-            // whole burst after it.
-            EXPECT_LE(x.frames_rendered, 10u);
+            // Each request served while it arrived or pushed out of its queue of 2 (how many
+            // of each depends on how fast the burst arrives): none left to hold a worker.
             EXPECT_EQ(x.frames_rendered + x.frames_dropped, 40u);
             continue;
         }
