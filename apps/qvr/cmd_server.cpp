@@ -20,6 +20,7 @@
 #include "qvr/runtime/session_outputs.h"
 #include "qvr/runtime/session_settings.h"
 #include "qvr/scene/scene_loader.h"
+#include "qvr/sim/hardware.h"
 
 namespace qvr::cli {
 
@@ -37,6 +38,7 @@ struct ServerCmdOptions {
     ServerSettings settings;
     std::string scene = "builtin:room";
     double duration_s = 0.0;
+    std::string calibration;  // hardware file whose server frame time admission starts from
     std::string stats_json;
     std::string stamps_csv;
     std::string frames_csv;
@@ -47,6 +49,14 @@ struct ServerCmdOptions {
 // the profile, the link or the stamps file cannot be had.
 Expected<RenderServerConfig> serverConfig(ServerCmdOptions o, StampsFile& stamps) {
     o.settings.keep_frame_records = !o.frames_csv.empty();
+    if (!o.calibration.empty()) {
+        auto hw = loadHardwareConfig(o.calibration, 500.0);
+        if (!hw || hw->runtime.speed_reference_server_ms <= 0.0)
+            return makeError("--calibration: " +
+                             (hw ? "no runtime.speed_reference_server_ms in '" + o.calibration + "'"
+                                 : hw.error()));
+        o.settings.frame_cost_ms = hw->runtime.speed_reference_server_ms;
+    }
     auto cfg = renderServerConfig(o.settings);
     if (!cfg)
         return cfg;
@@ -136,6 +146,18 @@ static Registered registerServer(CLI::App& app) {
     addCodecOption(cmd, o->settings.codec);
     addCoreOption(cmd, o->settings.core, "Pin the server (all its threads) to this core (-1: no)");
     addLodOption(cmd, o->settings.lod_px);
+    cmd->add_option("--workers", o->settings.workers,
+                    "Render workers (0: one per core the server may use; 1 with --core)")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
+    cmd->add_option("--min-fps", o->settings.min_fps,
+                    "Refuse a headset that would take the admitted ones below this frame rate "
+                    "(0: off; docs/RUNTIME.md)")
+        ->check(finiteRange(0.0, 1000.0))
+        ->capture_default_str();
+    cmd->add_option("--calibration", o->calibration,
+                    "Hardware file (qvr calibrate) whose server frame time admission starts from")
+        ->check(readableFile());
     cmd->add_option("--stats-json", o->stats_json, "Write the server's counters here on exit")
         ->check(writableFile());
     cmd->add_option("--stamps-csv", o->stamps_csv,

@@ -1,6 +1,7 @@
 #include "qvr/core/cpu_cores.h"
 
 #include <sched.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -14,6 +15,9 @@ std::vector<int> allowedCores() {
         for (int c = 0; c < CPU_SETSIZE; ++c)
             if (CPU_ISSET(c, &set))
                 cores.push_back(c);
+    if (cores.empty())  // the mask could not be read: every online core
+        for (long c = 0; c < sysconf(_SC_NPROCESSORS_ONLN); ++c)
+            cores.push_back(static_cast<int>(c));
     return cores;
 }
 

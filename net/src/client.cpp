@@ -141,9 +141,14 @@ struct Client::Impl::Handshake {
         ++impl.stats.incompatible_refusals;
     }
 
-    // Why the server said bye; a refusal of our version or settings is counted as permanent.
+    // Why the server said bye; a refusal of our version or settings, or for capacity, is
+    // counted as permanent.
     Error byeError(ByeReason reason) {
         std::string text = "the server " + std::string(byeReasonClientText(reason));
+        if (reason == ByeReason::kOverCapacity) {
+            std::lock_guard lock(impl.mutex);
+            ++impl.stats.capacity_refusals;
+        }
         if (reason == ByeReason::kVersionMismatch || reason == ByeReason::kCodecMismatch ||
             reason == ByeReason::kProfileMismatch) {
             countIncompatible();

@@ -294,7 +294,10 @@ constexpr ByeReasonRow kByeReasons[] = {
      "refused our display profile (profile mismatch)"},
     {ByeReason::kRouteUnverified, "media port not verified",
      "could not verify that we receive media at our UDP port (no probe arrived or none was "
-     "answered: a firewall or NAT in the way?)"}};
+     "answered: a firewall or NAT in the way?)"},
+    {ByeReason::kOverCapacity, "over capacity",
+     "is at capacity: one more headset would take its headsets below its frame-rate floor (qvr "
+     "server --min-fps); try another server"}};
 static_assert(std::size(kByeReasons) == kMaxByeReason + 1u);
 
 constexpr EnumName<WireError> kWireErrors[] = {{WireError::kNone, "none"},

@@ -285,21 +285,17 @@ struct Session : std::enable_shared_from_this<Session> {
             close();
             return false;
         }
-        bool full = false;
+        int admitted = 0;
         {
             std::lock_guard lock(server.mutex);
             --server.pending;
             pending = false;
-            if (static_cast<int>(server.clients.size()) + server.routing >=
-                server.options.max_clients) {
+            admitted = static_cast<int>(server.clients.size()) + server.routing;
+            if (admitted >= server.options.max_clients) {
                 ++server.stats.refused_full;
-                full = true;
-            } else {
-                ++server.routing;
-                state = State::kAwaitRoute;
             }
         }
-        if (full) {
+        if (admitted >= server.options.max_clients) {
             refuse(ByeReason::kServerFull);
             return false;
         }
@@ -309,6 +305,19 @@ struct Session : std::enable_shared_from_this<Session> {
         reader.seal(keys.client_to_server);
         sealer.start(keys.server_to_client);
         route_key = keys.route;
+        // Only this thread changes clients and routing, so `admitted` still holds here. The
+        // refusal is sealed: only a key holder learns the server's load.
+        if (const Admission a = server.handler.onAdmission(admitted); !a.admit) {
+            count([](ServerStats& st) { ++st.refused_capacity; });
+            report("refused a headset over capacity: " + a.why, false);
+            refuse(ByeReason::kOverCapacity);
+            return false;
+        }
+        {
+            std::lock_guard lock(server.mutex);
+            ++server.routing;
+            state = State::kAwaitRoute;
+        }
         route_token = randomRouteToken();
         // Media will go only to the address that authenticated, at the port it named — once
         // the client shows it receives there.

@@ -16,20 +16,6 @@ int onlineCores() {
     return n > 0 ? static_cast<int>(n) : 1;
 }
 
-std::vector<int> allowedCores() {
-    std::vector<int> cores;
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    if (sched_getaffinity(0, sizeof(set), &set) == 0)
-        for (int c = 0; c < CPU_SETSIZE; ++c)
-            if (CPU_ISSET(c, &set))
-                cores.push_back(c);
-    if (cores.empty())
-        for (int c = 0; c < onlineCores(); ++c)
-            cores.push_back(c);
-    return cores;
-}
-
 Status pinCurrentThread(int core) {
     if (core < 0 || core >= CPU_SETSIZE)
         return makeError(fmt::format("core {} is out of range", core));

@@ -288,7 +288,8 @@ private:
             if (proof_failures > m_proof_failures_seen)
                 m_last_connect_try_ns = now_ns + int64_t(kKeyMismatchBackoffMs) * 1'000'000;
             m_proof_failures_seen = proof_failures;
-            if (m_client->stats().incompatible_refusals > 0)
+            if (m_client->stats().incompatible_refusals > 0 ||
+                m_client->stats().capacity_refusals > 0)
                 m_refusal = st.error();
         }
     }
@@ -825,7 +826,7 @@ private:
     int64_t m_last_finish_ns = 0;
     size_t m_depth = 1;
     uint64_t m_proof_failures_seen = 0;
-    std::string m_refusal;  // why the server refused our settings, empty while it has not
+    std::string m_refusal;  // why the server refused our settings or for capacity; empty: not
 
 public:
     const std::string& refusal() const { return m_refusal; }

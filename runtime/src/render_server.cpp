@@ -1,7 +1,9 @@
-// The render server: a bounded request queue per headset, one render thread that renders,
-// encodes and sends each periphery layer as soon as it is ready (paper Fig. 7's parallel streams).
+// The render server: a bounded request queue per headset, a pool of render workers that take
+// ready headsets in turn and render, encode and send each periphery layer as soon as it is ready
+// (paper Fig. 7's parallel streams), and admission by the server's cost per headset-frame.
 #include "qvr/runtime/render_server.h"
 
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <deque>
@@ -10,6 +12,7 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "qvr/render/gl_renderer.h"
 #include "qvr/render/periphery_pass.h"
@@ -30,18 +33,86 @@ RendererFactory nullRendererFactory() {
     return []() -> Expected<std::unique_ptr<Renderer>> { return makeNullRenderer(); };
 }
 
+double sustainedFps(int headsets, int workers, double frame_cost_ms, double refresh_hz) {
+    if (headsets <= 0 || frame_cost_ms <= 0.0)
+        return refresh_hz;
+    const double share = std::min(1.0, double(std::max(workers, 1)) / double(headsets));
+    return std::min(refresh_hz, 1000.0 / frame_cost_ms * share);
+}
+
+std::string admissionRefusal(const AdmissionConfig& a, int admitted, int workers,
+                             double frame_cost_ms, double refresh_hz) {
+    if (a.min_fps <= 0.0)
+        return {};
+    const int headsets = admitted + 1;
+    if (frame_cost_ms <= 0.0) {
+        if (headsets <= std::max(workers, 1))
+            return {};
+        return fmt::format(
+            "{} headsets on {} workers, and no cost per headset-frame known to hold {:g} fps "
+            "(no calibration, fewer than {} frames served)",
+            headsets, workers, a.min_fps, a.measure_frames);
+    }
+    const double fps = sustainedFps(headsets, workers, frame_cost_ms, refresh_hz);
+    if (fps >= a.min_fps)
+        return {};
+    return fmt::format(
+        "{} headsets would get {:.1f} fps each at {:.2f} ms a headset-frame on {} workers, below "
+        "the floor of {:g} fps",
+        headsets, fps, frame_cost_ms, workers, a.min_fps);
+}
+
+nlohmann::json serverPoolJson(const RenderServerStats& s) {
+    nlohmann::json sessions = nlohmann::json::array();
+    for (const SessionStats& x : s.sessions) {
+        const auto mean = [&](double total) {
+            return x.frames_rendered > 0 ? total / double(x.frames_rendered) : 0.0;
+        };
+        sessions.push_back(
+            {{"client", x.client},
+             {"connected", x.connected},
+             {"connected_s", x.connected_s},
+             {"frames_requested", x.frames_requested},
+             {"frames_dropped", x.frames_dropped},
+             {"frames_rendered", x.frames_rendered},
+             {"frames_encoded", x.frames_encoded},
+             {"frames_sent", x.frames_sent},
+             {"fps_sent", x.connected_s > 0.0 ? double(x.frames_sent) / x.connected_s : 0.0},
+             {"streams_sent", x.streams_sent},
+             {"stream_send_failures", x.stream_send_failures},
+             {"render_ms_mean", mean(x.render_ms_total)},
+             {"encode_ms_mean", mean(x.encode_ms_total)},
+             {"service_ms_mean", mean(x.service_ms_total)},
+             {"queue_ms_mean", mean(x.queue_ms_total)}});
+    }
+    return {{"workers", s.workers},
+            {"admission",
+             {{"min_fps", s.min_fps},
+              {"frame_cost_ms", s.frame_cost_ms},
+              {"frame_cost_source", s.frame_cost_source},
+              {"refused_capacity", s.net.refused_capacity}}},
+            {"sessions", std::move(sessions)}};
+}
+
 namespace {
 
-struct ClientState {
+struct SessionState {
     struct Queued {
         net::FrameRequest request;
         int64_t queued_ns = 0;
     };
-    std::deque<Queued> pending;  // guarded by Impl::mutex
+    // Guarded by Impl::mutex.
+    std::deque<Queued> pending;
+    bool in_service = false;  // a worker is serving one of its frames (and holds its encoders)
+    int64_t admitted_ns = 0;
+    int64_t ended_ns = 0;  // 0 while connected
+    SessionStats stats;
     std::atomic<uint8_t> key_frame_mask{0};
-    // Touched by the render thread only.
+    // Used only by the worker that has the session in service: the mutex hands them over.
     std::array<std::unique_ptr<VideoEncoder>, net::kMaxStreams> encoders;
 };
+using Queued = SessionState::Queued;
+using Encoders = std::array<std::unique_ptr<VideoEncoder>, net::kMaxStreams>;
 
 bool layerFits(const HmdProfile& profile, const LayerRect& l) {
     if (l.empty())
@@ -58,6 +129,13 @@ bool planFits(const HmdProfile& profile, const LayerPlan& plan) {
     return true;
 }
 
+int workerCount(const RenderServerConfig& c) {
+    constexpr int kMaxWorkers = 64;
+    if (c.workers > 0)
+        return std::min(c.workers, kMaxWorkers);
+    return c.core >= 0 ? 1 : std::clamp(static_cast<int>(allowedCores().size()), 1, kMaxWorkers);
+}
+
 }  // namespace
 
 struct RenderServer::Impl final : net::ServerHandler {
@@ -65,27 +143,55 @@ struct RenderServer::Impl final : net::ServerHandler {
     Clock* clock = &SteadyClock::instance();  // config.clock, or the steady clock
     std::shared_ptr<const Scene> scene;
     std::unique_ptr<net::Server> server;
-    std::thread render_thread;
+    int worker_count = 1;
+    std::vector<std::thread> workers;
 
     mutable std::mutex mutex;
     std::condition_variable cv;
-    std::map<net::ClientId, std::shared_ptr<ClientState>> clients;
+    std::map<net::ClientId, std::shared_ptr<SessionState>> clients;
+    // Every session in admission order, the ended ones too (at most kMaxEndedSessions).
+    std::deque<std::shared_ptr<SessionState>> sessions;
+    size_t ended_sessions = 0;
     net::ClientId last_served = 0;
     bool stopping = false;
     RenderServerStats stats;
     std::deque<ServerFrameRecord> records;  // guarded by mutex
+    // The measured service time per headset-frame: the mean of the first measure_frames, then
+    // a moving average over about as many.
+    uint64_t cost_frames = 0;
+    double cost_ms = 0.0;
+    std::mutex on_frame_mutex;  // config.on_frame is called one worker at a time
 
-    // Start-up handshake with the render thread.
-    bool ready = false;
+    // Start-up handshake with the workers.
+    int ready_workers = 0;
     std::string start_error;
 
     void onClientConnected(net::ClientId id) override {
+        auto s = std::make_shared<SessionState>();
+        s->stats.client = id;
+        s->admitted_ns = clock->nowNs();
         std::lock_guard lock(mutex);
-        clients[id] = std::make_shared<ClientState>();
+        clients[id] = s;
+        sessions.push_back(std::move(s));
     }
     void onClientGone(net::ClientId id) override {
+        Encoders released;  // destroyed after the lock (x264 takes its time)
         std::lock_guard lock(mutex);
-        clients.erase(id);
+        auto it = clients.find(id);
+        if (it == clients.end())
+            return;
+        SessionState& s = *it->second;
+        s.ended_ns = clock->nowNs();
+        s.stats.connected = false;
+        // An ended session keeps its counters, not its encoders (a worker serving its last
+        // frame lets them go when it is done).
+        if (!s.in_service)
+            released = std::exchange(s.encoders, {});
+        clients.erase(it);
+        // Forget the oldest ended sessions beyond the bound.
+        for (++ended_sessions; ended_sessions > kMaxEndedSessions; --ended_sessions)
+            sessions.erase(std::find_if(sessions.begin(), sessions.end(),
+                                        [](const auto& x) { return x->ended_ns != 0; }));
     }
     void onFrameRequest(net::ClientId id, const net::FrameRequest& request) override {
         {
@@ -94,11 +200,13 @@ struct RenderServer::Impl final : net::ServerHandler {
             auto it = clients.find(id);
             if (it == clients.end())
                 return;
-            auto& q = it->second->pending;
-            q.push_back({request, clock->nowNs()});
-            while (q.size() > std::max<size_t>(config.max_pending_requests, 1)) {
-                q.pop_front();
+            SessionState& s = *it->second;
+            ++s.stats.frames_requested;
+            s.pending.push_back({request, clock->nowNs()});
+            while (s.pending.size() > std::max<size_t>(config.max_pending_requests, 1)) {
+                s.pending.pop_front();
                 ++stats.requests_dropped;
+                ++s.stats.frames_dropped;
             }
         }
         cv.notify_one();
@@ -111,49 +219,67 @@ struct RenderServer::Impl final : net::ServerHandler {
             it->second->key_frame_mask.fetch_or(request.stream_mask);
     }
 
-    // The next request, round robin over headsets; false when stopping.
-    bool next(net::ClientId& id, std::shared_ptr<ClientState>& state, net::FrameRequest& req,
-              int64_t& queued_ns) {
+    // The cost admission goes by, and where it came from. Under mutex.
+    std::pair<double, const char*> frameCostLocked() const {
+        const AdmissionConfig& a = config.admission;
+        if (a.measure_frames > 0 && cost_frames >= uint64_t(a.measure_frames))
+            return {cost_ms, "measured"};
+        if (a.frame_cost_ms > 0.0)
+            return {a.frame_cost_ms, "calibration"};
+        return {0.0, "none"};
+    }
+
+    net::Admission onAdmission(int admitted) override {
+        std::lock_guard lock(mutex);
+        const double cost = frameCostLocked().first;
+        std::string why = admissionRefusal(config.admission, admitted, worker_count, cost,
+                                           config.profile.refresh_hz);
+        return {why.empty(), std::move(why)};
+    }
+
+    // The next frame to serve: the first ready session (a request queued, no worker on it)
+    // after the one served last, in session order — round robin; null when stopping.
+    std::shared_ptr<SessionState> next(net::ClientId& id, Queued& q) {
         std::unique_lock lock(mutex);
         for (;;) {
             if (stopping)
-                return false;
-            auto pick = clients.upper_bound(last_served);
-            for (size_t n = 0; n < clients.size(); ++n) {
-                if (pick == clients.end())
-                    pick = clients.begin();
-                if (!pick->second->pending.empty()) {
-                    id = pick->first;
-                    state = pick->second;
-                    req = state->pending.front().request;
-                    queued_ns = state->pending.front().queued_ns;
-                    state->pending.pop_front();
-                    last_served = id;
-                    return true;
-                }
-                ++pick;
+                return nullptr;
+            auto it = clients.upper_bound(last_served);
+            for (size_t n = 0; n < clients.size(); ++n, ++it) {
+                if (it == clients.end())
+                    it = clients.begin();
+                SessionState& s = *it->second;
+                if (s.in_service || s.pending.empty())
+                    continue;
+                id = it->first;
+                q = std::move(s.pending.front());
+                s.pending.pop_front();
+                s.in_service = true;
+                last_served = id;
+                return it->second;
             }
             cv.wait(lock);
         }
     }
 
-    // One request being served: what the render thread stamps and counts while it works.
+    // One request being served: what a worker stamps and counts while it works.
     struct Work {
         net::ClientId id = 0;
-        ClientState* state = nullptr;
+        SessionState* state = nullptr;
         const net::FrameRequest* req = nullptr;
         uint8_t key_mask = 0;
         ServerFrameRecord rec;
         RenderServerStats delta;
+        int layers_planned = 0, layers_encoded = 0;
         int64_t render_start_ns = 0, render_end_ns = 0;
     };
-    // The render thread's images, reused from request to request.
+    // A worker's images, reused from request to request.
     struct Images {
         ImageRgba8 image, outer, scratch;
     };
 
-    // Pins the thread, makes the renderer and uploads the scene, then tells start() how it
-    // went; null when it failed.
+    // Pins the thread, makes the worker's renderer and uploads the scene, then tells start()
+    // how it went; null when it failed.
     std::unique_ptr<Renderer> startRenderer() {
         if (config.core >= 0) {
             if (auto st = pinCurrentThread(config.core); !st)
@@ -164,9 +290,9 @@ struct RenderServer::Impl final : net::ServerHandler {
             renderer ? (*renderer)->upload(*scene) : Status(makeError(renderer.error()));
         {
             std::lock_guard lock(mutex);
-            if (!upload)
+            if (!upload && start_error.empty())
                 start_error = upload.error();
-            ready = true;
+            ++ready_workers;
         }
         cv.notify_all();
         if (!upload)
@@ -174,22 +300,34 @@ struct RenderServer::Impl final : net::ServerHandler {
         return std::move(*renderer);
     }
 
-    void renderLoop() {
+    // A worker: its own renderer (an OpenGL context is current on one thread) serving whichever
+    // session is ready next.
+    void workerLoop() {
         std::unique_ptr<Renderer> renderer = startRenderer();
         if (!renderer)
             return;
         Images images;
         net::ClientId id = 0;
-        std::shared_ptr<ClientState> state;
-        net::FrameRequest req;
-        int64_t queued_ns = 0;
+        Queued q;
         ServerFrameStamps stamps;
-        while (next(id, state, req, queued_ns))
-            serve(*renderer, images, id, *state, req, queued_ns, stamps);
+        while (std::shared_ptr<SessionState> state = next(id, q)) {
+            serve(*renderer, images, id, *state, q.request, q.queued_ns, stamps);
+            Encoders released;
+            bool more = false;
+            {
+                std::lock_guard lock(mutex);
+                state->in_service = false;
+                if (state->ended_ns != 0)
+                    released = std::exchange(state->encoders, {});
+                more = !state->pending.empty();
+            }
+            if (more)
+                cv.notify_one();  // its next frame may go to another worker
+        }
     }
 
     // Renders, encodes and sends every layer of one request.
-    void serve(Renderer& r, Images& images, net::ClientId id, ClientState& state,
+    void serve(Renderer& r, Images& images, net::ClientId id, SessionState& state,
                const net::FrameRequest& req, int64_t queued_ns, ServerFrameStamps& stamps) {
         stamps.client = id;
         stamps.frame_id = req.frame_id;
@@ -210,6 +348,7 @@ struct RenderServer::Impl final : net::ServerHandler {
         if (!planFits(config.profile, plan)) {
             std::lock_guard lock(mutex);
             ++stats.requests_invalid;
+            ++state.stats.frames_dropped;
             return;
         }
         w.key_mask = state.key_frame_mask.exchange(0);
@@ -222,6 +361,7 @@ struct RenderServer::Impl final : net::ServerHandler {
         }
         if (config.on_frame) {
             stamps.end_ns = clock->nowNs();
+            std::lock_guard lock(on_frame_mutex);
             config.on_frame(stamps);
         }
         w.rec.done_ns = clock->nowNs();
@@ -231,6 +371,7 @@ struct RenderServer::Impl final : net::ServerHandler {
     // An eye's middle and outer layers from one geometry pass.
     void renderEyeInOnePass(Renderer& r, Images& images, const LayerPlan& plan, int eye, Work& w,
                             ServerFrameStamps& stamps) {
+        w.layers_planned += 2;
         w.render_start_ns = clock->nowNs();
         auto rs = renderPeriphery(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye),
                                   images.image, images.outer, images.scratch);
@@ -259,6 +400,7 @@ struct RenderServer::Impl final : net::ServerHandler {
                 layer == net::Layer::kMiddle ? LayerKind::kMiddle : LayerKind::kOuter;
             if (layerOf(layers, kind).empty())
                 continue;
+            ++w.layers_planned;
             w.render_start_ns = clock->nowNs();
             auto rs = renderLayer(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye), kind,
                                   images.image, CameraOptions{}, config.holes);
@@ -279,7 +421,8 @@ struct RenderServer::Impl final : net::ServerHandler {
         }
     }
 
-    // Encodes one layer with its stream's encoder and hands it to the transport.
+    // Encodes one layer with its stream's encoder and hands it to the transport, which never
+    // blocks: a session whose media queue is full loses this stream, not the worker's time.
     void send(Work& w, ServerFrameStamps& stamps, uint8_t sid, const ImageRgba8& layer_image) {
         auto& enc = w.state->encoders[sid];
         if (!enc) {
@@ -297,6 +440,7 @@ struct RenderServer::Impl final : net::ServerHandler {
             ++w.delta.encode_failures;
             return;
         }
+        ++w.layers_encoded;
         w.delta.encode_ms_total += encoded->encode_ms;
         w.rec.encode_ms[sid] += encoded->encode_ms;
         w.rec.bytes[sid] += static_cast<int64_t>(encoded->bytes.size());
@@ -315,7 +459,30 @@ struct RenderServer::Impl final : net::ServerHandler {
         w.delta.send_ms_total += send_ms;
     }
 
-    // Keeps the frame's record and adds its counts to the server's.
+    // Adds the served frame to its session's counters and the measured cost. Under mutex.
+    void countSessionFrame(const Work& w) {
+        const RenderServerStats& d = w.delta;
+        SessionStats& s = w.state->stats;
+        const bool rendered = int(d.layers_rendered) == w.layers_planned;
+        const bool encoded = rendered && w.layers_encoded == w.layers_planned;
+        s.frames_rendered += rendered ? 1 : 0;
+        s.frames_encoded += encoded ? 1 : 0;
+        s.frames_sent += encoded && int(d.streams_sent) == w.layers_planned ? 1 : 0;
+        s.streams_sent += d.streams_sent;
+        s.stream_send_failures += d.stream_send_failures;
+        s.render_ms_total += d.render_ms_total;
+        s.encode_ms_total += d.encode_ms_total;
+        const double service_ms = double(w.rec.done_ns - w.rec.start_ns) * 1e-6;
+        s.service_ms_total += service_ms;
+        s.queue_ms_total += double(w.rec.start_ns - w.rec.received_ns) * 1e-6;
+        const int n = std::max(config.admission.measure_frames, 1);
+        ++cost_frames;
+        const double weight =
+            cost_frames <= uint64_t(n) ? 1.0 / double(cost_frames) : 2.0 / (double(n) + 1.0);
+        cost_ms += weight * (service_ms - cost_ms);
+    }
+
+    // Keeps the frame's record and adds its counts to the server's and its session's.
     void record(const Work& w) {
         const RenderServerStats& delta = w.delta;
         std::lock_guard lock(mutex);
@@ -334,6 +501,37 @@ struct RenderServer::Impl final : net::ServerHandler {
         stats.encode_ms_total += delta.encode_ms_total;
         stats.readback_ms_total += delta.readback_ms_total;
         stats.send_ms_total += delta.send_ms_total;
+        countSessionFrame(w);
+    }
+
+    // Asks every worker to stop and joins them.
+    void stopWorkers() {
+        {
+            std::lock_guard lock(mutex);
+            stopping = true;
+        }
+        cv.notify_all();
+        for (std::thread& t : workers)
+            if (t.joinable())
+                t.join();
+    }
+
+    // Starts the workers and waits until each has its renderer; an error when one has none.
+    Status startWorkers() {
+        worker_count = workerCount(config);
+        stats.workers = worker_count;
+        for (int i = 0; i < worker_count; ++i)
+            workers.emplace_back([this] { workerLoop(); });
+        std::string error;
+        {
+            std::unique_lock lock(mutex);
+            cv.wait(lock, [this] { return ready_workers == worker_count; });
+            error = start_error;
+        }
+        if (error.empty())
+            return {};
+        stopWorkers();
+        return makeError(error);
     }
 };
 
@@ -353,23 +551,11 @@ Expected<std::unique_ptr<RenderServer>> RenderServer::start(RenderServerConfig c
                                                          hp.width_px, hp.height_px, hp.refresh_hz);
     impl->scene = std::move(scene);
     Impl* p = impl.get();
-    impl->render_thread = std::thread([p] { p->renderLoop(); });
-    {
-        std::unique_lock lock(p->mutex);
-        p->cv.wait(lock, [p] { return p->ready; });
-    }
-    if (!p->start_error.empty()) {
-        p->render_thread.join();
-        return makeError("render server: " + p->start_error);
-    }
+    if (Status st = p->startWorkers(); !st)
+        return makeError("render server: " + st.error());
     auto server = net::Server::start(p->config.net, *p);
     if (!server) {
-        {
-            std::lock_guard lock(p->mutex);
-            p->stopping = true;
-        }
-        p->cv.notify_all();
-        p->render_thread.join();
+        p->stopWorkers();
         return makeError("render server: " + server.error());
     }
     p->server = std::move(*server);
@@ -385,13 +571,7 @@ RenderServer::~RenderServer() {
 void RenderServer::stop() {
     if (!m_impl)
         return;
-    {
-        std::lock_guard lock(m_impl->mutex);
-        m_impl->stopping = true;
-    }
-    m_impl->cv.notify_all();
-    if (m_impl->render_thread.joinable())
-        m_impl->render_thread.join();
+    m_impl->stopWorkers();
     if (m_impl->server)
         m_impl->server->stop();
 }
@@ -403,8 +583,20 @@ uint16_t RenderServer::port() const {
 RenderServerStats RenderServer::stats() const {
     RenderServerStats s;
     {
-        std::lock_guard lock(m_impl->mutex);
-        s = m_impl->stats;
+        const Impl& m = *m_impl;
+        std::lock_guard lock(m.mutex);
+        s = m.stats;
+        const auto [cost_ms, source] = m.frameCostLocked();
+        s.frame_cost_ms = cost_ms;
+        s.frame_cost_source = source;
+        s.min_fps = m.config.admission.min_fps;
+        const int64_t now_ns = m.clock->nowNs();
+        for (const auto& x : m.sessions) {
+            SessionStats st = x->stats;
+            st.connected_s =
+                double((x->ended_ns != 0 ? x->ended_ns : now_ns) - x->admitted_ns) * 1e-9;
+            s.sessions.push_back(st);
+        }
     }
     if (m_impl->server)
         s.net = m_impl->server->stats();

@@ -48,6 +48,7 @@ nlohmann::json clientSummaryJson(const ClientSession& session, const HeadsetResu
               {"connect_failures", st.connect_failures},
               {"server_proof_failures", st.net.server_proof_failures},
               {"incompatible_refusals", st.net.incompatible_refusals},
+              {"capacity_refusals", st.net.capacity_refusals},
               {"control_drops", st.net.control_drops.total()},
               {"control_forged", st.net.control_forged},
               {"control_replayed", st.net.control_replayed},
@@ -218,7 +219,9 @@ Status writeServerOutputs(const ServerOutputs& outputs, const RenderServerStats&
                           const std::vector<ServerFrameRecord>& records) {
     if (!outputs.stats_json.empty()) {
         std::ofstream f(outputs.stats_json);
-        f << serverStatsJson(s, core).dump(2) << "\n";
+        nlohmann::json j = serverStatsJson(s, core);
+        j.update(serverPoolJson(s));  // "workers", "admission", "sessions"
+        f << j.dump(2) << "\n";
         if (!f)
             return makeError("cannot write '" + outputs.stats_json + "'");
     }

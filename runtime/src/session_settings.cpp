@@ -41,6 +41,10 @@ Expected<RenderServerConfig> renderServerConfig(const ServerSettings& s) {
     cfg.profile = shared->profile;
     cfg.codec.backend = s.codec;
     cfg.core = s.core;
+    cfg.workers = s.workers;
+    cfg.admission.min_fps = s.min_fps;
+    if (s.frame_cost_ms > 0.0)
+        cfg.admission.frame_cost_ms = s.frame_cost_ms;
     cfg.one_pass_periphery = s.one_pass_periphery;
     cfg.holes.enabled = !s.no_holes;
     if (!s.keep_frame_records)

@@ -442,6 +442,75 @@ TEST(NetTransport, MismatchedSettingsAreRefusedWithTheReasonOnBothSides) {
     EXPECT_EQ(client.stats().incompatible_refusals, 0u);
 }
 
+// A handler that admits `capacity` sessions and refuses the next, as the render server's
+// admission by frame-rate floor does.
+class CappedServer : public EchoServer {
+public:
+    explicit CappedServer(int capacity) : EchoServer(1000), m_capacity(capacity) {}
+    Admission onAdmission(int admitted) override {
+        {
+            std::lock_guard lock(m_asked_mutex);
+            m_asked.push_back(admitted);
+        }
+        if (admitted < m_capacity)
+            return {};
+        return {false, "a test's capacity of " + std::to_string(m_capacity)};
+    }
+    std::vector<int> asked() {
+        std::lock_guard lock(m_asked_mutex);
+        return m_asked;
+    }
+
+private:
+    int m_capacity;
+    std::mutex m_asked_mutex;
+    std::vector<int> m_asked;
+};
+
+// Over capacity: a sealed Bye(over capacity) after authentication, named by the client and
+// counted on both sides as permanent; the admitted session is untouched.
+TEST(NetTransport, AHeadsetOverCapacityIsRefusedWithItsReason) {
+    CappedServer handler(1);
+    ServerOptions o;
+    std::mutex mutex;
+    std::vector<std::string> refusals;
+    o.on_refusal = [&](const std::string& why) {
+        std::lock_guard lock(mutex);
+        refusals.push_back(why);
+    };
+    auto server = startServer(handler, o);
+    Client first(clientOptions());
+    ASSERT_TRUE(first.connect("127.0.0.1", server->port()).ok()) << first.lastError().error();
+    Client second(clientOptions());
+    const Status st = second.connect("127.0.0.1", server->port());
+    ASSERT_FALSE(st.ok());
+    EXPECT_NE(st.error().find("at capacity"), std::string::npos) << st.error();
+    EXPECT_NE(st.error().find("--min-fps"), std::string::npos) << st.error();
+    EXPECT_EQ(second.stats().capacity_refusals, 1u);
+    EXPECT_EQ(second.stats().incompatible_refusals, 0u);
+    EXPECT_EQ(second.stats().control_forged, 0u);  // the Bye came sealed and verified
+    EXPECT_EQ(server->stats().refused_capacity, 1u);
+    EXPECT_EQ(server->stats().clients_accepted, 1u);
+    EXPECT_EQ(handler.connected.load(), 1);
+    EXPECT_EQ(handler.asked(), (std::vector<int>{0, 1}));
+    {
+        std::lock_guard lock(mutex);
+        ASSERT_EQ(refusals.size(), 1u);
+        EXPECT_NE(refusals[0].find("over capacity: a test's capacity of 1"), std::string::npos)
+            << refusals[0];
+    }
+    // The admitted one is still served.
+    ASSERT_TRUE(first.sendFrameRequest(request(1)).ok());
+    EXPECT_EQ(receive(first, 0, 1000, 4, 5s).streams, 4);
+    // Its slot freed, the next headset is admitted.
+    first.disconnect();
+    const auto deadline = std::chrono::steady_clock::now() + 2s;
+    while (!server->clients().empty() && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(5ms);
+    Client third(clientOptions());
+    EXPECT_TRUE(third.connect("127.0.0.1", server->port()).ok()) << third.lastError().error();
+}
+
 // A server of another protocol version: the client names the reason and counts the refusal.
 TEST(NetTransport, ClientNamesAServerOfAnotherVersion) {
     asio::io_context io;

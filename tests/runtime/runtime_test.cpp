@@ -26,6 +26,7 @@
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
 #include "qvr/scene/scene_loader.h"
+#include "slow_renderer.h"
 
 namespace qvr::runtime {
 namespace {
@@ -365,23 +366,6 @@ TEST(Runtime, AStalledServerDoesNotStallTheDisplay) {
         fresh_tail += r.frames[i].reused ? 0 : 1;
     EXPECT_GT(fresh_tail, 30);
 }
-
-// A renderer that takes at least delay per layer: a server slower than the wait limit.
-class SlowRenderer final : public Renderer {
-public:
-    explicit SlowRenderer(std::chrono::milliseconds delay)
-        : m_inner(makeNullRenderer()), m_delay(delay) {}
-    std::string name() const override { return "slow-null"; }
-    Status upload(const Scene& scene) override { return m_inner->upload(scene); }
-    Expected<RenderStats> render(const RenderView& view, ImageRgba8& out) override {
-        std::this_thread::sleep_for(m_delay);
-        return m_inner->render(view, out);
-    }
-
-private:
-    std::unique_ptr<Renderer> m_inner;
-    std::chrono::milliseconds m_delay;
-};
 
 TEST(PendingFrames, TheOldestGoFirstUntilBothBoundsHoldAndTheNewestAlwaysStays) {
     const std::vector<size_t> none;

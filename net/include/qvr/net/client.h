@@ -40,6 +40,9 @@ struct ClientStats {
     // The server refused our protocol version, codec or display profile (or spoke another
     // version): reconnecting cannot help, lastError() says why.
     uint64_t incompatible_refusals = 0;
+    // The server refused us for capacity (Bye(over capacity)): its admitted headsets would fall
+    // below its frame-rate floor; this server will not take us while they stay.
+    uint64_t capacity_refusals = 0;
     uint64_t disconnects = 0;
     // Sealed control from the server (each ends the connection): a tag that does not verify or
     // a plain message after the handshake; a counter that is not the next one.

@@ -24,7 +24,8 @@ namespace qvr::net {
 // 4: every control message after the handshake is sealed (ChaCha20-Poly1305, a key per
 // direction, a message counter as nonce), and the server checks that the client receives at its
 // media port (a sealed UDP probe echoed back) before it sends any media there.
-inline constexpr uint8_t kProtocolVersion = 5;
+// 6: Bye(over capacity) — the server refuses a headset it cannot serve at its frame-rate floor.
+inline constexpr uint8_t kProtocolVersion = 6;
 
 // Limits a decoder enforces before it trusts any length a peer sent.
 inline constexpr size_t kControlHeaderBytes = 8;
@@ -215,8 +216,11 @@ enum class ByeReason : uint8_t {
     kCodecMismatch = 6,    // the client's codec is not the server's
     kProfileMismatch = 7,  // nor its display profile
     kRouteUnverified = 8,  // the client never echoed the probe sent to its media port
+    // One more headset would take the admitted ones below the server's frame-rate floor
+    // (docs/RUNTIME.md §Admission); sent sealed, after authentication.
+    kOverCapacity = 9,
 };
-inline constexpr uint8_t kMaxByeReason = 8;
+inline constexpr uint8_t kMaxByeReason = 9;
 std::string_view byeReasonName(ByeReason r);
 // What the server did, for the client to tell its user after "the server ": "is full", ….
 std::string_view byeReasonClientText(ByeReason r);

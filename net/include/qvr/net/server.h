@@ -62,11 +62,21 @@ struct ServerOptions {
     std::function<void(const std::string&)> on_refusal;
 };
 
+// Whether an authenticated headset may join the `admitted` sessions the server holds (those
+// serving and those whose media port is being checked); why not, for the server's log.
+struct Admission {
+    bool admit = true;
+    std::string why;
+};
+
 // Called on the server's network thread: keep them short (hand work to the render thread),
 // and never call Server::stop() from one (it joins that thread). sendStream() is fine.
 class ServerHandler {
 public:
     virtual ~ServerHandler() = default;
+    // Asked once per authenticated headset with acceptable settings, before it takes a slot;
+    // a refusal ends it with a sealed Bye(over capacity). Calls are serialised (one thread).
+    virtual Admission onAdmission(int /*admitted*/) { return {}; }
     virtual void onClientConnected(ClientId /*client*/) {}
     virtual void onFrameRequest(ClientId /*client*/, const FrameRequest& /*request*/) {}
     virtual void onKeyFrameRequest(ClientId /*client*/, const KeyFrameRequest& /*request*/) {}
@@ -79,6 +89,7 @@ struct ServerStats {
     uint64_t auth_failures = 0;
     uint64_t handshake_timeouts = 0;
     uint64_t refused_full = 0;
+    uint64_t refused_capacity = 0;    // refused by the handler's admission (Bye(over capacity))
     uint64_t pending_evicted = 0;     // unauthenticated connections pushed out by newer ones
     uint64_t idle_timeouts = 0;       // authenticated sessions ended for silence
     uint64_t keepalives = 0;          // KeepAlive messages from clients with nothing else to say

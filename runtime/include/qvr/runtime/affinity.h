@@ -5,14 +5,12 @@
 #include <string>
 #include <vector>
 
+#include "qvr/core/cpu_cores.h"  // allowedCores()
 #include "qvr/core/expected.h"
 
 namespace qvr::runtime {
 
 int onlineCores();
-// The cores this process may run on (its sched_getaffinity mask, ascending): under taskset, a
-// cpuset or a container these are not 0…onlineCores()−1. At least one entry.
-std::vector<int> allowedCores();
 // Pins the calling thread to `core` (0-based); an error when the core does not exist or the
 // kernel refuses.
 Status pinCurrentThread(int core);

@@ -20,6 +20,9 @@ struct ServerSettings {
     std::string net = "none";  // a link spec (core/link_spec.h)
     std::string codec = "x264";
     int core = -1;
+    int workers = 0;             // render workers (0: one per allowed core; 1 with `core`)
+    double min_fps = 0.0;        // admission's frame-rate floor (0: off)
+    double frame_cost_ms = 0.0;  // a calibrated server frame's cost (0: measure it)
     bool one_pass_periphery = false;
     bool no_holes = false;
     float lod_px = 1.0f;
