@@ -68,7 +68,8 @@ Registered registerTraceRecord(CLI::App& parent) {
         ->check(CLI::Range(1, 16))
         ->capture_default_str();
     cmd->add_option("--foreground", o->record.foreground_objects,
-                    "Nearest visible objects that form the static design's foreground")
+                    "Foreground objects for a scene that marks no interactive objects (a model "
+                    "file): the nearest visible ones")
         ->check(CLI::Range(0, 1000))
         ->capture_default_str();
     cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")
