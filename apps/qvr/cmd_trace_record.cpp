@@ -58,7 +58,9 @@ Registered registerTraceRecord(CLI::App& parent) {
     addInt(cmd, "--raster-scale", o->record.raster_scale,
            "CPU z-buffer (overdraw, depth, objects) at 1/N resolution", 1, 16);
     addInt(cmd, "--foreground", o->record.foreground_objects,
-           "Nearest visible objects that form the static design's foreground", 0, 1000);
+           "Foreground objects for a scene that marks no interactive objects (a model file): the "
+           "nearest visible ones",
+           0, 1000);
     cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")
         ->required()
         ->check(writableFile());

@@ -3,30 +3,94 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
 
 namespace qvr {
 
-RemoteSizeTable::RemoteSizeTable(const HmdProfile& profile, double max_e1_deg, double max_gaze_deg)
-    : m_e1_steps(static_cast<int>(std::ceil(max_e1_deg / kE1StepDeg)) + 1),
-      m_gaze_steps(static_cast<int>(std::ceil(max_gaze_deg / kGazeStepDeg)) + 1),
-      m_geometry(profile) {
+namespace {
+
+// The table's cells and their extent, as the constructor fills its members.
+struct Grid {
+    int e1_steps = 0;
+    int gaze_steps = 0;
+    std::vector<PeripheryShape> cells;  // [gaze][e1]
+};
+
+Grid buildGrid(const HmdProfile& profile, double max_e1_deg, double max_gaze_deg) {
+    Grid g;
+    g.e1_steps = static_cast<int>(std::ceil(max_e1_deg / RemoteSizeTable::kE1StepDeg)) + 1;
+    g.gaze_steps = static_cast<int>(std::ceil(max_gaze_deg / RemoteSizeTable::kGazeStepDeg)) + 1;
     const LayerPlanner planner(profile);
-    m_cells.resize(static_cast<size_t>(m_e1_steps) * static_cast<size_t>(m_gaze_steps));
-    m_cover.resize(static_cast<size_t>(m_gaze_steps));
-    for (int gi = 0; gi < m_gaze_steps; ++gi) {
+    g.cells.resize(static_cast<size_t>(g.e1_steps) * static_cast<size_t>(g.gaze_steps));
+    for (int gi = 0; gi < g.gaze_steps; ++gi) {
         // Rows are taken along the diagonal: the average of horizontal and vertical offsets.
-        const double r = gi * kGazeStepDeg / std::sqrt(2.0);
+        const double r = gi * RemoteSizeTable::kGazeStepDeg / std::sqrt(2.0);
         const Gaze gaze{r, r};
-        m_cover[static_cast<size_t>(gi)] = m_geometry.coverEccentricityDeg(gaze);
-        for (int ei = 0; ei < m_e1_steps; ++ei) {
-            const LayerPlan p = planner.plan(gaze, ei * kE1StepDeg);
-            PeripheryShape& c = m_cells[static_cast<size_t>(gi * m_e1_steps + ei)];
+        for (int ei = 0; ei < g.e1_steps; ++ei) {
+            const LayerPlan p = planner.plan(gaze, ei * RemoteSizeTable::kE1StepDeg);
+            PeripheryShape& c = g.cells[static_cast<size_t>(gi * g.e1_steps + ei)];
             c.fovea_pixels = static_cast<double>(p.fovea_pixels);
             c.middle_pixels = static_cast<double>(p.middle_pixels);
             c.outer_pixels = static_cast<double>(p.outer_pixels);
             c.s1 = p.s1;
             c.s2 = p.s2;
         }
+    }
+    return g;
+}
+
+// One grid per profile and range for the whole process: every run of a policy on the same HMD
+// (an evaluation has hundreds) reads the same ~1,600 planned layer layouts, so they are planned
+// once. The key is everything LayerPlanner reads of the profile, and the range.
+std::shared_ptr<const Grid> sharedGrid(const HmdProfile& profile, double max_e1_deg,
+                                       double max_gaze_deg) {
+    using Key = std::tuple<int, int, double, double, double, double, double, double, double, double,
+                           double, double>;
+    const Key key{profile.width_px,
+                  profile.height_px,
+                  profile.fov_h_deg,
+                  profile.fov_v_deg,
+                  profile.acuity.omega0_deg,
+                  profile.acuity.slope,
+                  profile.lens.k1,
+                  profile.lens.k2,
+                  profile.lens.chroma_red_scale,
+                  profile.lens.chroma_blue_scale,
+                  max_e1_deg,
+                  max_gaze_deg};
+    // Bounded: a slope fit makes a new profile per step; past the bound the cache starts over.
+    constexpr size_t kMaxGrids = 64;
+    static std::mutex mutex;
+    static std::map<Key, std::shared_ptr<const Grid>> grids;
+    {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (const auto it = grids.find(key); it != grids.end())
+            return it->second;
+    }
+    // Built outside the lock, so threads asking for other profiles need not wait; two threads
+    // building the same grid build equal grids, and the first stored is kept.
+    auto grid = std::make_shared<const Grid>(buildGrid(profile, max_e1_deg, max_gaze_deg));
+    std::lock_guard<std::mutex> lock(mutex);
+    if (grids.size() >= kMaxGrids)
+        grids.clear();
+    return grids.emplace(key, std::move(grid)).first->second;
+}
+
+}  // namespace
+
+RemoteSizeTable::RemoteSizeTable(const HmdProfile& profile, double max_e1_deg, double max_gaze_deg)
+    : m_geometry(profile) {
+    const std::shared_ptr<const Grid> grid = sharedGrid(profile, max_e1_deg, max_gaze_deg);
+    m_e1_steps = grid->e1_steps;
+    m_gaze_steps = grid->gaze_steps;
+    m_cells = grid->cells;
+    m_cover.resize(static_cast<size_t>(m_gaze_steps));
+    for (int gi = 0; gi < m_gaze_steps; ++gi) {
+        const double r = gi * kGazeStepDeg / std::sqrt(2.0);
+        m_cover[static_cast<size_t>(gi)] = m_geometry.coverEccentricityDeg(Gaze{r, r});
     }
 }
 

@@ -24,6 +24,8 @@
 
 #include "append_batch.h"
 #include "image_decode.h"
+#include "md3.h"
+#include "quake_items.h"
 #include "shader_script.h"
 
 namespace qvr {
@@ -168,7 +170,11 @@ private:
     Status readFaces(Scene& scene);
     Status addPatch(int face_index, const RawFace& f, std::vector<uint32_t>& out, Scene& scene);
     int textureFor(int shader, Scene& scene);
+    int textureForName(const std::string& shader_name, Scene& scene);
     void readEntities(Scene& scene);
+    void addItems(Scene& scene);
+    Status addItemModel(const std::string& md3_path, float scale, const glm::vec3& origin_units,
+                        Scene& scene);
     Status budget(uint64_t more_triangles, int face_index);
 
     std::span<const uint8_t> m_bytes;
@@ -182,6 +188,12 @@ private:
     std::map<std::string, int> m_texture_of_path;
     ShaderLibrary m_shader_library;
     bool m_shader_library_loaded = false;
+    struct ItemEntity {
+        std::string classname;
+        glm::vec3 origin_units{0.0f};
+    };
+    std::vector<ItemEntity> m_items;
+    std::map<std::string, std::vector<detail::Md3Surface>> m_md3_of_path;
     uint64_t m_triangles = 0;
 };
 
@@ -285,6 +297,12 @@ int BspParser::textureFor(int shader, Scene& scene) {
     const uint8_t* rec = m_shaders.data + static_cast<size_t>(shader) * kShaderBytes;
     const std::string shader_name(reinterpret_cast<const char*>(rec),
                                   strnlen(reinterpret_cast<const char*>(rec), 64));
+    const int index = textureForName(shader_name, scene);
+    m_texture_of_shader[shader] = index;
+    return index;
+}
+
+int BspParser::textureForName(const std::string& shader_name, Scene& scene) {
     // The game tries the shader name as an image first, then the shader script's image.
     std::vector<std::string> bases = {stripImageExtension(normalizeGamePath(shader_name))};
     if (!m_shader_library_loaded) {
@@ -320,7 +338,6 @@ int BspParser::textureFor(int shader, Scene& scene) {
         ++m_stats.shaders_without_image;
         m_stats.missing_images.push_back(shader_name);
     }
-    m_texture_of_shader[shader] = index;
     return index;
 }
 
@@ -530,7 +547,9 @@ void BspParser::readEntities(Scene& scene) {
             kv[key] = value;
         }
         const std::string& cls = kv["classname"];
-        if (cls != "info_player_deathmatch" && cls != "info_player_start")
+        const bool spawn = cls == "info_player_deathmatch" || cls == "info_player_start";
+        const bool item = !detail::quakeItemModel(cls).md3_paths.empty();
+        if (!spawn && !item)
             continue;
         float o[3];
         char tail = 0;
@@ -538,6 +557,10 @@ void BspParser::readEntities(Scene& scene) {
             !finite3(o) || std::fabs(o[0]) > kMaxCoordUnits || std::fabs(o[1]) > kMaxCoordUnits ||
             std::fabs(o[2]) > kMaxCoordUnits)
             continue;
+        if (item) {
+            m_items.push_back({cls, glm::vec3(o[0], o[1], o[2])});
+            continue;
+        }
         float angle = 0.0f;
         if (kv.count("angle")) {
             angle = std::strtof(kv["angle"].c_str(), nullptr);
@@ -588,7 +611,57 @@ Expected<Scene> BspParser::run(const std::string& name) {
     if (Status s = readFaces(scene); !s)
         return makeError(s.error());
     readEntities(scene);
+    if (m_opts.load_items && m_files != nullptr)
+        addItems(scene);
     return scene;
+}
+
+// Every item entity's models, unrotated at its origin; a model the game files lack or cannot
+// parse leaves the item out (counted), the level stays drawable.
+void BspParser::addItems(Scene& scene) {
+    for (const ItemEntity& item : m_items) {
+        const detail::QuakeItemModel model = detail::quakeItemModel(item.classname);
+        bool placed = true;
+        for (const std::string& path : model.md3_paths)
+            placed = addItemModel(path, model.scale, item.origin_units, scene).ok() && placed;
+        ++(placed ? m_stats.items_placed : m_stats.items_without_model);
+    }
+}
+
+Status BspParser::addItemModel(const std::string& md3_path, float scale,
+                               const glm::vec3& origin_units, Scene& scene) {
+    auto it = m_md3_of_path.find(md3_path);
+    if (it == m_md3_of_path.end()) {
+        const auto bytes = m_files->read(md3_path);
+        if (!bytes)
+            return makeError(fmt::format("{}: not in the game files", md3_path));
+        auto surfaces = detail::parseMd3(*bytes);
+        if (!surfaces)
+            return makeError(fmt::format("{}: {}", md3_path, surfaces.error()));
+        it = m_md3_of_path.emplace(md3_path, std::move(*surfaces)).first;
+    }
+    for (const detail::Md3Surface& surface : it->second) {
+        if (Status s = budget(surface.indices.size() / 3, -1); !s)
+            return s;
+        const auto base = static_cast<uint32_t>(scene.vertices.size());
+        for (size_t v = 0; v < surface.positions.size(); ++v) {
+            SceneVertex sv;
+            sv.position = quakeToScene(origin_units + scale * surface.positions[v]);
+            const glm::vec3& n = surface.normals[v];
+            sv.normal = glm::vec3(n.x, n.z, -n.y);  // quakeToScene's axes, unscaled
+            sv.uv = surface.uvs[v];
+            scene.vertices.push_back(sv);
+        }
+        std::vector<uint32_t> indices;
+        indices.reserve(surface.indices.size());
+        for (uint32_t i : surface.indices)
+            indices.push_back(base + i);
+        SceneBatch b;
+        b.texture = surface.shader.empty() ? -1 : textureForName(surface.shader, scene);
+        b.interactive = true;
+        detail::appendBatch(scene, b, indices);
+    }
+    return Status::success();
 }
 
 }  // namespace

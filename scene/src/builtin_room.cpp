@@ -223,6 +223,7 @@ public:
                 continue;
             SceneBatch b;
             b.texture = m;
+            b.interactive = m == kLightPiece || m == kDarkPiece;  // the chess pieces
             detail::appendBatch(m_scene, b, idx);
         }
     }

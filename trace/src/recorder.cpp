@@ -180,7 +180,7 @@ public:
           m_geometry(options.profile),
           m_codec(options.codec) {
         m_codec.frame_rate_hz = m_profile.refresh_hz;
-        markFlatObjects();
+        markObjects();
         layOutRaster();
     }
 
@@ -189,7 +189,7 @@ public:
     Expected<WorkloadFrame> frame(int n);
 
 private:
-    void markFlatObjects();
+    void markObjects();
     void layOutRaster();
     void assignRings(const glm::dvec3& gaze_dir);
     Status recordEye(int n, int e, const Pose& head, const glm::dvec3& gaze_dir, WorkloadFrame& f,
@@ -206,7 +206,9 @@ private:
     const DepthRasterizer m_rasterizer;
     const EyeGeometry m_geometry;
     CodecConfig m_codec;
-    std::vector<bool> m_flat;  // per object: architecture, not an interactive object
+    std::vector<bool> m_flat;          // per object: architecture, not an interactive object
+    std::vector<bool> m_interactive;   // per object: part of an interactive batch
+    bool m_marks_interactive = false;  // the scene marks its interactive batches
     // Persistent streams, so P-frames predict from the previous frame as they would on the wire.
     std::array<std::vector<std::unique_ptr<VideoEncoder>>, 2> m_colour_enc;
     std::array<std::vector<std::unique_ptr<VideoEncoder>>, 2> m_lossless_enc;
@@ -220,13 +222,19 @@ private:
     std::array<DepthRaster, 2> m_rasters;
 };
 
-void Recording::markFlatObjects() {
-    m_flat.resize(static_cast<size_t>(m_rasterizer.objectCount()));
+void Recording::markObjects() {
+    const auto n = static_cast<size_t>(m_rasterizer.objectCount());
+    m_flat.resize(n);
+    m_interactive.resize(n);
     for (int id = 0; id < m_rasterizer.objectCount(); ++id) {
         const Aabb& b = m_rasterizer.objectBounds(id);
         const glm::vec3 size = b.max - b.min;
-        m_flat[static_cast<size_t>(id)] =
+        const auto i = static_cast<size_t>(id);
+        m_flat[i] =
             std::min({size.x, size.y, size.z}) < static_cast<float>(m_options.flat_object_m);
+        m_interactive[i] =
+            m_inputs.scene.batches[static_cast<size_t>(m_rasterizer.objectBatch(id))].interactive;
+        m_marks_interactive = m_marks_interactive || m_interactive[i];
     }
 }
 
@@ -285,11 +293,15 @@ WorkloadHeader Recording::header() const {
         "at 1/{} resolution); bpp: x264 {} crf {} keyint {}, one stream per eye and scale, the "
         "full frame box-halved from the scale-1 render, 24-byte frame headers included; "
         "bpp_lossless: {}the same streams at crf 0 (x264 lossless, the paper's setting); static: "
-        "nearest {} visible non-flat objects (batch x {} m cells) by bounds distance, bg = the "
-        "scale-1 frame, depth = 16 bits as two 8-bit planes (high, folded low) at 1/{} resolution",
+        "fg = {} (batch x {} m cells), bg = the scale-1 frame, depth = 16 bits as two 8-bit "
+        "planes (high, folded low) at 1/{} resolution",
         scene.name, m_options.spawn, m_renderer.name(), m_inputs.motion_source,
         m_inputs.gaze_source, r, m_codec.preset, m_codec.crf, m_codec.keyint_frames,
-        m_options.record_lossless ? "" : "not recorded; ", m_options.foreground_objects,
+        m_options.record_lossless ? "" : "not recorded; ",
+        m_marks_interactive
+            ? std::string("every visible object of the interactive batches (items, pieces)")
+            : fmt::format("nearest {} visible non-flat objects by bounds distance",
+                          m_options.foreground_objects),
         m_options.object_cell_m, r);
     h.profile = m_profile;
     h.ring_deg = m_options.ring_deg;
@@ -378,24 +390,27 @@ Status Recording::recordEye(int n, int e, const Pose& head, const glm::dvec3& ga
     return rasterizeEye(n, e, view, f, sizes);
 }
 
-// §6.1's interactive objects: the visible objects nearest the head by bounds distance. Flat
-// pieces (floor, wall and ceiling cells) are architecture, not objects a player interacts with;
-// without this rule the floor under the viewer would always win.
+// The static design's foreground (§2, Table 1: the interactive objects, rendered locally): every
+// visible object of the scene's interactive batches. A scene that marks none falls back to §6.1's
+// reading, the visible objects nearest the head by bounds distance; flat pieces (floor, wall and
+// ceiling cells) are architecture, without this rule the floor under the viewer would always win.
 void Recording::splitStatic(const Pose& head, WorkloadFrame& f) const {
     std::vector<int> visible;
     for (int id = 0; id < m_rasterizer.objectCount(); ++id) {
-        if (m_rasters[0].object_pixels[static_cast<size_t>(id)] +
-                    m_rasters[1].object_pixels[static_cast<size_t>(id)] >
-                0 &&
-            !m_flat[static_cast<size_t>(id)])
+        const auto i = static_cast<size_t>(id);
+        const bool candidate = m_marks_interactive ? m_interactive[i] : !m_flat[i];
+        if (candidate && m_rasters[0].object_pixels[i] + m_rasters[1].object_pixels[i] > 0)
             visible.push_back(id);
     }
-    const size_t k = std::min(visible.size(), static_cast<size_t>(m_options.foreground_objects));
-    std::partial_sort(visible.begin(), visible.begin() + static_cast<std::ptrdiff_t>(k),
-                      visible.end(), [&](int a, int b) {
-                          return distanceToBox(head.position_m, m_rasterizer.objectBounds(a)) <
-                                 distanceToBox(head.position_m, m_rasterizer.objectBounds(b));
-                      });
+    size_t k = visible.size();
+    if (!m_marks_interactive) {
+        k = std::min(k, static_cast<size_t>(m_options.foreground_objects));
+        std::partial_sort(visible.begin(), visible.begin() + static_cast<std::ptrdiff_t>(k),
+                          visible.end(), [&](int a, int b) {
+                              return distanceToBox(head.position_m, m_rasterizer.objectBounds(a)) <
+                                     distanceToBox(head.position_m, m_rasterizer.objectBounds(b));
+                          });
+    }
     double fg_triangles = 0.0, fg_pixels = 0.0;
     for (size_t i = 0; i < k; ++i) {
         for (const DepthRaster& raster : m_rasters) {

@@ -49,6 +49,9 @@ struct SceneBatch {
     int lightmap = -1;  // into Scene::lightmaps, −1 = fully lit
     Aabb bounds;
     bool is_patch = false;  // tessellated Bézier patch (Quake III face type 2)
+    // An object a player interacts with (a game item, a chess piece): the static collaborative
+    // design's foreground (paper §2, Table 1); the rest of the scene is its background.
+    bool interactive = false;
 };
 
 struct SpawnPoint {

@@ -17,6 +17,10 @@ struct SceneLoadOptions {
     int patch_level = 8;
     bool load_textures = true;
     bool load_lightmaps = true;
+    // Quake III levels: place the item entities' models (weapons, ammunition, health, armour,
+    // powerups, flags; frame 0, unrotated, at the entity's origin) as interactive batches.
+    // Off by default: the game draws items itself; a workload recording turns it on.
+    bool load_items = false;
     // Textures larger than this are halved until they fit (0 = keep full size).
     int max_texture_px = 1024;
     // Lightmap brightening: each RGB byte is shifted left by this many bits and rescaled
@@ -34,6 +38,8 @@ struct SceneLoadOptions {
 // What a parse skipped, for `qvr scene info` and tests.
 struct BspStats {
     int faces = 0;
+    int items_placed = 0;         // item entities drawn (load_items)
+    int items_without_model = 0;  // item entities whose model the game files lack
     int faces_drawn = 0;
     int faces_sky_or_nodraw = 0;  // SURF_SKY / SURF_NODRAW / SURF_SKIP / SURF_HINT shaders
     int faces_bad_shader = 0;     // shader index outside the texture lump

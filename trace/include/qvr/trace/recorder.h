@@ -41,14 +41,22 @@ struct RecordOptions {
     // The CPU raster (overdraw, depth, object coverage) runs at 1/raster_scale resolution.
     int raster_scale = 2;
     double object_cell_m = 1.0;  // objects = batches split by cells of this size
-    int foreground_objects = 1;  // the nearest visible objects form the static design's foreground
+    // The static design's foreground (§2, Table 1): every visible object of the scene's
+    // interactive batches (a level's items, the room's chess pieces); a scene that marks none
+    // (a model file) takes this many nearest visible non-flat objects instead.
+    int foreground_objects = 1;
     double flat_object_m = 0.1;  // objects thinner than this on some axis are architecture
     CodecConfig codec;
     // The paper's codec setting (§2.3: "streamed with lossless H.264"), measured beside `codec`
     // as its own persistent streams per eye and scale: `codec` with CRF 0, which x264 codes
     // losslessly (of the 4:2:0 image it is given). Off: the trace has no bpp_lossless.
     bool record_lossless = true;
-    SceneLoadOptions scene_options;
+    // Levels are loaded with their items, the interactive objects the static design renders.
+    SceneLoadOptions scene_options = [] {
+        SceneLoadOptions o;
+        o.load_items = true;
+        return o;
+    }();
 };
 
 struct RecordProgress {
