@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "qvr/compose/uca.h"
+#include "qvr/controller/aimd.h"
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
 #include "qvr/core/silence.h"
@@ -68,10 +69,49 @@ struct PendingFrame {
     // last stream arrived if that was later (the server renders one frame at a time, so with
     // frames in flight a request waits in its queue). T_remote is measured from here.
     int64_t service_start_ns = 0;
-    int64_t last_rx_ns = 0;  // the newest packet of any of its streams
+    int64_t last_rx_ns = 0;   // the newest packet of any of its streams
+    int64_t first_rx_ns = 0;  // the oldest packet of any of its streams (0: none yet)
+    int packets = 0;
     std::array<double, net::kMaxStreams> bytes{};
     bool complete() const { return expected != 0 && (decoded & expected) == expected; }
     bool broken() const { return (failed & expected) != 0; }
+};
+
+// The link's rate as the headset sees it: each complete frame's bytes over the time its packets
+// held the link (from its first packet, or from the previous frame's last if that came later —
+// the link was still busy with it), summed over the newest kFrames frames. Unlike the server's
+// ack-based estimate (first send to last ack), a frame's wait behind the one before it on the
+// link is not counted as its own transmission. LIWC's X(e1) = bytes / this rate.
+class LinkRateMeter {
+public:
+    void add(const PendingFrame& p, int64_t previous_last_rx_ns) {
+        double bytes = 0.0;
+        for (double b : p.bytes)
+            bytes += b;
+        if (p.first_rx_ns <= 0 || p.last_rx_ns <= 0 || bytes <= 0.0 || p.packets < 2)
+            return;
+        const bool queued = p.first_rx_ns <= previous_last_rx_ns;
+        const int64_t start_ns = queued ? previous_last_rx_ns : p.first_rx_ns;
+        if (p.last_rx_ns <= start_ns)
+            return;
+        // From its own first packet, that packet's transmission is not in the span.
+        const double sent = queued ? bytes : bytes * double(p.packets - 1) / double(p.packets);
+        m_frames.push_back({sent * 8.0, double(p.last_rx_ns - start_ns) * 1e-9});
+        while (m_frames.size() > kFrames)
+            m_frames.pop_front();
+    }
+    double bps() const {
+        double bits = 0.0, s = 0.0;
+        for (const auto& [b, t] : m_frames) {
+            bits += b;
+            s += t;
+        }
+        return s > 0.0 ? bits / s : 0.0;
+    }
+
+private:
+    static constexpr size_t kFrames = 8;
+    std::deque<std::pair<double, double>> m_frames;  // (bits, seconds on the link)
 };
 
 uint8_t expectedStreams(const LayerPlan& plan) {
@@ -109,15 +149,24 @@ public:
           m_compositor(config.profile, composeOptions()),
           m_summary(designLabel(config.design, config.fixed_e1_deg), config.warmup_frames) {}
 
-    static LiwcConfig liwcConfig(bool reactive) {
+    static LiwcConfig liwcConfig(bool reactive, size_t depth) {
         LiwcConfig c;
         // A real server takes time to render and encode, less the larger the fovea; Eq. 2
-        // alone would not see it. With frames in flight the display's period is the slower
-        // side's, which is what LIWC minimises here (docs/LIWC.md).
+        // alone would not see it. With frames in flight the display's period is the slowest
+        // stage's, which is what LIWC minimises here (docs/LIWC.md).
         c.learn_remote_base = true;
         c.frame_period_objective = true;
+        c.frames_in_flight = static_cast<int>(depth);
         c.reactive = reactive;
         return c;
+    }
+
+    // Frames prepared ahead of the one being finished. Without a server there is nothing to
+    // overlap: one core renders and composes in turn.
+    size_t pipelineDepth() const {
+        return usesServer(m_config.design)
+                   ? static_cast<size_t>(std::clamp(m_config.pipeline_depth, 1, 4))
+                   : 1;
     }
 
     static ComposeOptions composeOptions() {
@@ -147,18 +196,23 @@ public:
         }
         switch (m_config.design) {
             case Design::Qvr: {
-                auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(false));
+                auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(),
+                                                         liwcConfig(false, pipelineDepth()));
                 m_liwc = liwc.get();
                 m_policy = std::move(liwc);
                 break;
             }
             case Design::Sw:
                 // The same model as qvr's, fed as software would be (docs/RUNTIME.md).
-                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(true));
+                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(),
+                                                        liwcConfig(true, pipelineDepth()));
                 break;
             case Design::Ffr:
             case Design::Fixed:
                 m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
+                break;
+            case Design::Aimd:
+                m_policy = makeAimdPolicy(m_probe.header());
                 break;
             default:
                 break;
@@ -186,10 +240,7 @@ public:
             tryConnect(true);
         // Frames are prepared (pose, decision, request) up to pipeline_depth ahead of the one
         // being finished (fovea, wait, UCA, scan-out).
-        // Without a server there is nothing to overlap: one core renders and composes in turn.
-        const size_t depth = usesServer(m_config.design)
-                                 ? static_cast<size_t>(std::clamp(m_config.pipeline_depth, 1, 4))
-                                 : 1;
+        const size_t depth = pipelineDepth();
         m_depth = depth;
         std::deque<Prepared> ahead;
         int64_t next = 0;
@@ -340,6 +391,10 @@ private:
             FrameTelemetry& t = tel(p->telemetry);
             t.stream_rx_ns[cs.stream_id] = rel(cs.last_rx_ns);
             p->last_rx_ns = std::max(p->last_rx_ns, cs.last_rx_ns);
+            if (cs.first_rx_ns > 0)
+                p->first_rx_ns =
+                    p->first_rx_ns > 0 ? std::min(p->first_rx_ns, cs.first_rx_ns) : cs.first_rx_ns;
+            p->packets += cs.packets;
             t.bytes += static_cast<int64_t>(cs.bytes.size());
             p->bytes[cs.stream_id] += static_cast<double>(cs.bytes.size());
         } else if (FrameTelemetry* shown = heldTelemetry(cs.frame_id)) {
@@ -388,6 +443,7 @@ private:
         t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
         if (p->complete()) {
             t.remote_done_ns = rel(m_clock.nowNs());
+            m_link_rate.add(*p, m_last_complete_rx_ns);
             m_last_complete_rx_ns = std::max(m_last_complete_rx_ns, p->last_rx_ns);
             for (PendingFrame& later : m_pending)
                 if (later.frame > p->frame)
@@ -480,7 +536,9 @@ private:
                         light.gaze = gaze;
                     }
                     if (m_liwc)
-                        m_liwc->setLinkEstimate(m_client->throughputBps());
+                        m_liwc->setLinkEstimate(m_link_rate.bps() > 0.0
+                                                    ? m_link_rate.bps()
+                                                    : m_client->throughputBps());
                     const Decision d = m_policy->decide(wf ? *wf : light);
                     m_last_e1_deg = d.e1_deg;
                     c.t_local_pred_ms = d.t_local_pred_ms;
@@ -783,6 +841,10 @@ private:
         m.s1 = plan.s1;
         m.s2 = plan.s2;
         m.throughput_bps = t->throughput_bps;
+        if (p && have_current && p->last_rx_ns > 0) {
+            m.request_ms = double(p->request_ns - m_origin_ns) * 1e-6;
+            m.arrival_ms = double(p->last_rx_ns - m_origin_ns) * 1e-6;
+        }
         m_policy->observe(m);
         if (p && have_current)
             m_probe.observeBits(m.middle_bytes, m.middle_pixels, plan.s1, m.outer_bytes,
@@ -806,6 +868,7 @@ private:
     std::unique_ptr<Renderer> m_renderer;
     std::unique_ptr<FoveaPolicy> m_policy;
     LiwcPolicy* m_liwc = nullptr;  // m_policy when it is qvr's LIWC
+    LinkRateMeter m_link_rate;     // the link's rate as the frames' arrivals show it
     double m_last_e1_deg = kFfrE1Deg;
     std::unique_ptr<net::Client> m_client;
     std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;
