@@ -145,9 +145,17 @@ void AimdPolicy::observe(const FrameMeasurement& m) {
         m_bits_middle = (1.0 - b) * m_bits_middle + b * m.middle_bytes * 8.0 / m.middle_pixels;
     if (m.outer_pixels > 0.0 && m.outer_bytes > 0.0)
         m_bits_outer = (1.0 - b) * m_bits_outer + b * m.outer_bytes * 8.0 / m.outer_pixels;
-    // A frame whose periphery did not all arrive gives no delay sample (EyeNexus updates on
-    // each frame received).
-    if (!(m.arrival_ms > 0.0) || m.arrival_ms < m.request_ms || m_c < 0.0)
+    if (m_c < 0.0)
+        return;
+    // A periphery that missed the wait limit is a loss: decrease, as loss-based congestion
+    // control does (on a link too slow for any frame to arrive in time the delay gives no sample).
+    if (m.periphery_late) {
+        act(DelayTrendDetector::Usage::Overusing);
+        return;
+    }
+    // Otherwise a frame whose periphery did not all arrive gives no delay sample (EyeNexus
+    // updates on each frame received).
+    if (!(m.arrival_ms > 0.0) || m.arrival_ms < m.request_ms)
         return;
     act(m_detector.update(m.request_ms, m.arrival_ms));
 }

@@ -122,7 +122,9 @@ double LiwcPolicy::moveCostFraction() const {
         return 0.0;
     const double extra =
         std::max(0.0, m_moved_bits_ratio / std::max(1e-9, m_held_bits_ratio) - 1.0);
-    return extra / std::max(1.0, m_frames_between_moves);
+    // Spread over the frames a chosen e1 is measured to hold, or has held since the last move if
+    // that is longer (else a cost that stops moves would never see them grow).
+    return extra / std::max({1.0, m_frames_between_moves, double(m_frames_since_move)});
 }
 
 Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double hi) {
@@ -320,12 +322,18 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // measured imbalance against the one Eq. 2 predicted with the pre-frame estimates. During
     // warm-up the estimates are still far off and their error is not the motion's.
     // Observations arrive in frame order, so this one belongs to the oldest open decision.
+    // A frame whose e1 moved carries the move's bytes (a key frame, a new canvas): what it
+    // cost is learned apart (learnMoveCost), and the table and the bits law, which predict a
+    // frame that holds, learn from the others (frame_period_objective).
+    const bool moved_apart = m_config.frame_period_objective &&
+                             learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
+                                                  m.outer_pixels * bitsPerPixelAt(m.s2));
     std::optional<PendingDecision> decided;
     if (!m_pending.empty()) {
         const PendingDecision p = m_pending.front();
         decided = p;
         m_pending.pop_front();
-        if (m_observed >= m_config.table_warmup_frames) {
+        if (m_observed >= m_config.table_warmup_frames && !moved_apart) {
             const double measured =
                 m_config.frame_period_objective ? m.t_remote_ms : m.t_remote_ms - m.t_local_ms;
             const double delta = measured - p.model_imbalance_ms;
@@ -364,12 +372,9 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double rest = std::max(0.0, m.t_remote_ms - transmission_ms);
         m_remote_base_ms = (1.0 - b) * m_remote_base_ms + b * rest;
     }
-    if (m_config.frame_period_objective)
-        learnMoveCost(
-            m, m.middle_pixels * bitsPerPixelAt(m.s1) + m.outer_pixels * bitsPerPixelAt(m.s2));
     // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
-    const bool have_mid = m.middle_pixels > 0 && m.middle_bytes > 0;
-    const bool have_out = m.outer_pixels > 0 && m.outer_bytes > 0;
+    const bool have_mid = !moved_apart && m.middle_pixels > 0 && m.middle_bytes > 0;
+    const bool have_out = !moved_apart && m.outer_pixels > 0 && m.outer_bytes > 0;
     if (have_mid && have_out && m.s2 > 1.05 * m.s1) {
         const double lm = std::log(m.middle_bytes * 8.0 / m.middle_pixels);
         const double lo = std::log(m.outer_bytes * 8.0 / m.outer_pixels);
@@ -390,7 +395,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         m_e1_deg = m.e1_deg;
 }
 
-void LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {
+bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {
     // Whether this frame's e1 differs from the previous observed frame's: its encoders may have
     // opened a new canvas (a key frame, new padding). Its bits against what the bits law (fitted
     // on all frames) predicted, beside the same ratio for frames that held, is what a move costs.
@@ -399,7 +404,7 @@ void LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     const bool first = m_last_observed_e1_deg < 0.0;
     m_last_observed_e1_deg = m.e1_deg;
     if (first)
-        return;
+        return false;
     constexpr double kWeight = 0.2;
     if (moved) {
         m_frames_between_moves =
@@ -410,12 +415,13 @@ void LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     }
     const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
     if (!(sent_bits > 0.0) || !(predicted_bits > 0.0))
-        return;
+        return moved;
     const double ratio = sent_bits / predicted_bits;
     double& ema = moved ? m_moved_bits_ratio : m_held_bits_ratio;
     bool& have = moved ? m_have_moved_ratio : m_have_held_ratio;
     ema = have ? (1.0 - kWeight) * ema + kWeight * ratio : ratio;
     have = true;
+    return moved;
 }
 
 void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {

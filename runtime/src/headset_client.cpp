@@ -841,6 +841,8 @@ private:
         m.s1 = plan.s1;
         m.s2 = plan.s2;
         m.throughput_bps = t->throughput_bps;
+        m.periphery_late =
+            t->remote_requested && !have_current && i >= static_cast<int64_t>(m_depth);
         if (p && have_current && p->last_rx_ns > 0) {
             m.request_ms = double(p->request_ns - m_origin_ns) * 1e-6;
             m.arrival_ms = double(p->last_rx_ns - m_origin_ns) * 1e-6;

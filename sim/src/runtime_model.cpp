@@ -676,6 +676,8 @@ void PassReplay::learn(int64_t i) {
     m.s1 = fs.plan.s1;
     m.s2 = fs.plan.s2;
     m.throughput_bps = m_ack_goodput_bps;
+    m.periphery_late = rf.requested && fs.expected > 0 && fs.decoded < fs.expected &&
+                       i >= static_cast<int64_t>(m_depth);
     if (rf.requested && fs.expected > 0 && fs.decoded == fs.expected) {
         m.request_ms = rf.request_ms;
         m.arrival_ms = fs.last_rx_ms;

@@ -119,5 +119,23 @@ TEST(AimdPolicy, LeavesTheControllerAloneForAFrameWithoutArrival) {
     EXPECT_DOUBLE_EQ(aimd.controller(), c_before);
 }
 
+// A periphery that missed the wait limit is a loss: C falls by 10%, whatever the delays said.
+TEST(AimdPolicy, CutsTheControllerForAFrameWhosePeripheryWasLate) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    AimdPolicy aimd(h);
+    double e1 = aimd.decide(frame(0)).e1_deg;
+    for (int i = 0; i < 10; ++i) {
+        aimd.observe(measured(planner, i, e1, 40.0));
+        e1 = aimd.decide(frame(i + 1)).e1_deg;
+    }
+    const double c_before = aimd.controller();
+    FrameMeasurement late = measured(planner, 10, e1, 40.0);
+    late.arrival_ms = 0.0;
+    late.periphery_late = true;
+    aimd.observe(late);
+    EXPECT_NEAR(aimd.controller(), 0.9 * c_before, 1e-9);
+}
+
 }  // namespace
 }  // namespace qvr

@@ -112,7 +112,8 @@ private:
     // The measured extra bits of a frame whose e1 moved, as a fraction of the bits predicted
     // for it, spread over the frames a chosen e1 is measured to hold (docs/LIWC.md).
     double moveCostFraction() const;
-    void learnMoveCost(const FrameMeasurement& m, double predicted_bits);
+    // Whether the measured frame's e1 moved from the previous one's.
+    bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
     // Both eyes' middle and outer layers' bits at e1 (0 once the fovea covers the frame).
     double peripheryBits(const Gaze& gaze, double e1_deg) const;
     double peripheryTriangles(double e1_deg) const;

@@ -40,6 +40,8 @@ struct FrameMeasurement {
     // clock; 0 if nothing arrived): the one-way delay through server and link, queues included.
     double request_ms = 0.0;
     double arrival_ms = 0.0;
+    // The periphery was requested but had not all arrived by the wait limit (shown late).
+    bool periphery_late = false;
 };
 
 // What the headset would measure of a frame rendered with `plan` at cost `cost`, the remote part
