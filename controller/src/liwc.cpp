@@ -166,10 +166,11 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         v.score = v.period + (std::fabs(e - m_e1_deg) > 1e-6 ? move_cost * v.link : 0.0);
         return v;
     };
-    // Start from staying where we are: another candidate must shorten the period by more than
-    // period_tie, or at an equal period the latency by more than period_tie of the headset's
-    // busy time, to move e1 (hysteresis against the frame-to-frame noise of the measurements;
-    // a tie relative to the whole latency would leave e1 stuck above a floor it should reach).
+    // Start from staying where we are: another candidate must shorten the period, or at an
+    // equal period the latency, by more than period_tie to move e1 (hysteresis against the
+    // frame-to-frame noise of the measurements, and against the server's fit, which sees little
+    // of S's slope while e1 holds: a more eager latency tie walked e1 down on the default run
+    // while the server was the slowest stage).
     const double step = 0.5;
     const int steps = 2 * m_config.max_delta_deg * 2;
     const double top = std::max(lo, hi);
@@ -179,7 +180,7 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         const double tie = m_config.period_tie * std::max(best.score, v.score);
         if (v.score < best.score - tie ||
             (std::fabs(v.score - best.score) <= tie &&
-             v.latency < best.latency - m_config.period_tie * best.local))
+             v.latency < best.latency - m_config.period_tie * best.latency))
             best = v;
     }
     // The window sees only ±max_delta. Where the period is flat across it — a link so slow
