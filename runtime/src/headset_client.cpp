@@ -69,49 +69,10 @@ struct PendingFrame {
     // last stream arrived if that was later (the server renders one frame at a time, so with
     // frames in flight a request waits in its queue). T_remote is measured from here.
     int64_t service_start_ns = 0;
-    int64_t last_rx_ns = 0;   // the newest packet of any of its streams
-    int64_t first_rx_ns = 0;  // the oldest packet of any of its streams (0: none yet)
-    int packets = 0;
+    int64_t last_rx_ns = 0;  // the newest packet of any of its streams
     std::array<double, net::kMaxStreams> bytes{};
     bool complete() const { return expected != 0 && (decoded & expected) == expected; }
     bool broken() const { return (failed & expected) != 0; }
-};
-
-// The link's rate as the headset sees it: each complete frame's bytes over the time its packets
-// held the link (from its first packet, or from the previous frame's last if that came later —
-// the link was still busy with it), summed over the newest kFrames frames. Unlike the server's
-// ack-based estimate (first send to last ack), a frame's wait behind the one before it on the
-// link is not counted as its own transmission. LIWC's X(e1) = bytes / this rate.
-class LinkRateMeter {
-public:
-    void add(const PendingFrame& p, int64_t previous_last_rx_ns) {
-        double bytes = 0.0;
-        for (double b : p.bytes)
-            bytes += b;
-        if (p.first_rx_ns <= 0 || p.last_rx_ns <= 0 || bytes <= 0.0 || p.packets < 2)
-            return;
-        const bool queued = p.first_rx_ns <= previous_last_rx_ns;
-        const int64_t start_ns = queued ? previous_last_rx_ns : p.first_rx_ns;
-        if (p.last_rx_ns <= start_ns)
-            return;
-        // From its own first packet, that packet's transmission is not in the span.
-        const double sent = queued ? bytes : bytes * double(p.packets - 1) / double(p.packets);
-        m_frames.push_back({sent * 8.0, double(p.last_rx_ns - start_ns) * 1e-9});
-        while (m_frames.size() > kFrames)
-            m_frames.pop_front();
-    }
-    double bps() const {
-        double bits = 0.0, s = 0.0;
-        for (const auto& [b, t] : m_frames) {
-            bits += b;
-            s += t;
-        }
-        return s > 0.0 ? bits / s : 0.0;
-    }
-
-private:
-    static constexpr size_t kFrames = 8;
-    std::deque<std::pair<double, double>> m_frames;  // (bits, seconds on the link)
 };
 
 uint8_t expectedStreams(const LayerPlan& plan) {
@@ -391,10 +352,6 @@ private:
             FrameTelemetry& t = tel(p->telemetry);
             t.stream_rx_ns[cs.stream_id] = rel(cs.last_rx_ns);
             p->last_rx_ns = std::max(p->last_rx_ns, cs.last_rx_ns);
-            if (cs.first_rx_ns > 0)
-                p->first_rx_ns =
-                    p->first_rx_ns > 0 ? std::min(p->first_rx_ns, cs.first_rx_ns) : cs.first_rx_ns;
-            p->packets += cs.packets;
             t.bytes += static_cast<int64_t>(cs.bytes.size());
             p->bytes[cs.stream_id] += static_cast<double>(cs.bytes.size());
         } else if (FrameTelemetry* shown = heldTelemetry(cs.frame_id)) {
@@ -443,7 +400,6 @@ private:
         t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
         if (p->complete()) {
             t.remote_done_ns = rel(m_clock.nowNs());
-            m_link_rate.add(*p, m_last_complete_rx_ns);
             m_last_complete_rx_ns = std::max(m_last_complete_rx_ns, p->last_rx_ns);
             for (PendingFrame& later : m_pending)
                 if (later.frame > p->frame)
@@ -536,9 +492,7 @@ private:
                         light.gaze = gaze;
                     }
                     if (m_liwc)
-                        m_liwc->setLinkEstimate(m_link_rate.bps() > 0.0
-                                                    ? m_link_rate.bps()
-                                                    : m_client->throughputBps());
+                        m_liwc->setLinkEstimate(m_client->throughputBps());
                     const Decision d = m_policy->decide(wf ? *wf : light);
                     m_last_e1_deg = d.e1_deg;
                     c.t_local_pred_ms = d.t_local_pred_ms;
@@ -870,7 +824,6 @@ private:
     std::unique_ptr<Renderer> m_renderer;
     std::unique_ptr<FoveaPolicy> m_policy;
     LiwcPolicy* m_liwc = nullptr;  // m_policy when it is qvr's LIWC
-    LinkRateMeter m_link_rate;     // the link's rate as the frames' arrivals show it
     double m_last_e1_deg = kFfrE1Deg;
     std::unique_ptr<net::Client> m_client;
     std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;
