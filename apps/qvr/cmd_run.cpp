@@ -67,7 +67,7 @@ static Registered registerRun(CLI::App& app) {
     addFramesOption(cmd, o->frames, 2, 100000, "Frames per design");
     cmd->add_option("--designs", o->designs,
                     "Comma-separated: local, remote, ffr (= fixed:5), fixed:E for any e1 E in "
-                    "degrees, sw, qvr")
+                    "degrees, sw, qvr, aimd")
         ->check(CLI::Validator(
             [](std::string& list) -> std::string {
                 auto designs = parseDesignList(list, DesignScope::Runtime);

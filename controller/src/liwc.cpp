@@ -117,13 +117,28 @@ double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
     return peripheryBits(gaze, e1_deg) / std::max(1.0, bps) * 1000.0;
 }
 
+double LiwcPolicy::moveCostFraction() const {
+    if (!m_have_moved_ratio || !m_have_held_ratio)
+        return 0.0;
+    const double extra =
+        std::max(0.0, m_moved_bits_ratio / std::max(1e-9, m_held_bits_ratio) - 1.0);
+    // Spread over the frames a chosen e1 is measured to hold, or has held since the last move if
+    // that is longer (else a cost that stops moves would never see them grow).
+    return extra / std::max({1.0, m_frames_between_moves, double(m_frames_since_move)});
+}
+
 Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double hi) {
-    // The frame period with frames in flight is set by the slower side: minimise
-    // max(L, R) over a grid of ±max_delta in half degrees, L the headset's busy time, R the
-    // server's render + encode plus the transmission, each with the table's learned offset on R.
+    // With frames in flight each stage works on its own frame: the period is the slowest stage's
+    // — the headset's L, the server's S, the link's X — and no shorter than the remote chain
+    // S + X over the frames in flight (one frame in flight: the headset renders its fovea while
+    // the server and the link work in turn, max(L, S + X)). Minimise it over a grid of
+    // ±max_delta in half degrees; the table's learned offset corrects the remote chain (on X,
+    // the link's part).
     struct Eval {
-        double e1 = 0.0, local = 0.0, remote = 0.0, period = 0.0, latency = 0.0;
+        double e1 = 0.0, local = 0.0, server = 0.0, link = 0.0, period = 0.0, latency = 0.0;
+        double score = 0.0;  // the period plus, for a move, its byte cost
         double triangles = 0.0, pixels = 0.0;
+        double remote() const { return server + link; }
     };
     // The table's offset for R is read at the bucket of the current e1 for every candidate: that
     // cell is refreshed by every observation, while the cells of buckets e1 passed through
@@ -131,35 +146,40 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // does not fall with it (tests/controller: DriftsToTheSmallestFovea...). What the table
     // then carries is R's motion-correlated error near the operating point.
     const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(m_e1_deg));
+    const double in_flight = std::max(1, m_config.frames_in_flight);
+    const double move_cost = moveCostFraction();
     auto evaluate = [&](double e) {
         Eval v;
         v.e1 = e;
         v.local = localMs(e);
         v.triangles = peripheryTriangles(e);
         v.pixels = peripheryPixels(frame.gaze, e);
-        const double server =
-            e >= m_cover_deg
-                ? 0.0
-                : std::max(0.0, m_server_fit.predict({1.0, v.triangles * 1e-5, v.pixels * 1e-5}));
-        v.remote =
-            e >= m_cover_deg ? 0.0 : std::max(0.0, server + transmissionMs(frame.gaze, e) + offset);
-        v.period = std::max(v.local, v.remote);
-        v.latency = v.local + v.remote;
+        if (e < m_cover_deg) {
+            v.server =
+                std::max(0.0, m_server_fit.predict({1.0, v.triangles * 1e-5, v.pixels * 1e-5}));
+            v.link = std::max(0.0, transmissionMs(frame.gaze, e) + offset);
+        }
+        v.latency = v.local + v.server + v.link;
+        v.period = std::max({v.local, v.server, v.link, v.remote() / in_flight});
+        // A move re-sizes the encoders' canvases: the extra bytes it was measured to cost, on
+        // the link, spread over the frames a chosen e1 holds.
+        v.score = v.period + (std::fabs(e - m_e1_deg) > 1e-6 ? move_cost * v.link : 0.0);
         return v;
     };
     // Start from staying where we are: another candidate must shorten the period, or at an
     // equal period the latency, by more than period_tie to move e1 (hysteresis against the
-    // frame-to-frame noise of the measurements).
+    // frame-to-frame noise of the measurements, and against the server's fit, which sees little
+    // of S's slope while e1 holds: a more eager latency tie walked e1 down on the default run
+    // while the server was the slowest stage).
     const double step = 0.5;
     const int steps = 2 * m_config.max_delta_deg * 2;
-    Eval best = evaluate(std::clamp(m_e1_deg, lo, std::max(lo, hi)));
+    const double top = std::max(lo, hi);
+    Eval best = evaluate(std::clamp(m_e1_deg, lo, top));
     for (int k = 0; k <= steps; ++k) {
-        const double e =
-            std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo, std::max(lo, hi));
-        const Eval v = evaluate(e);
-        const double tie = m_config.period_tie * std::max(best.period, v.period);
-        if (v.period < best.period - tie ||
-            (std::fabs(v.period - best.period) <= tie &&
+        const Eval v = evaluate(std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo, top));
+        const double tie = m_config.period_tie * std::max(best.score, v.score);
+        if (v.score < best.score - tie ||
+            (std::fabs(v.score - best.score) <= tie &&
              v.latency < best.latency - m_config.period_tie * best.latency))
             best = v;
     }
@@ -167,18 +187,17 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // that R exceeds L at every e1 short of the whole view, so each step of the window saves
     // less than the tie — the search would stay put although the all-local cover (or another
     // far e1) is much faster. Look over the whole range on a coarse grid as well, and when a
-    // far e1 beats the window's best by more than the tie, head for it one window step a frame.
+    // far e1 beats the window by more than the tie, head for it one window step a frame.
     {
         Eval far = best;
-        const double top = std::max(lo, hi);
         for (double e = lo;; e = std::min(top, e + kFarStepDeg)) {
             const Eval v = evaluate(e);
-            if (v.period < far.period)
+            if (v.score < far.score)
                 far = v;
             if (e >= top)
                 break;
         }
-        if (far.period < best.period - m_config.period_tie * best.period) {
+        if (far.score < best.score - m_config.period_tie * best.score) {
             const double toward = std::clamp(far.e1, m_e1_deg - m_config.max_delta_deg,
                                              m_e1_deg + m_config.max_delta_deg);
             best = evaluate(std::clamp(toward, lo, top));
@@ -188,14 +207,14 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     Decision d;
     d.e1_deg = best.e1;
     d.t_local_pred_ms = best.local;
-    d.t_remote_pred_ms = best.remote;
+    d.t_remote_pred_ms = best.remote();
     remember(d);
     m_pending.back().periphery_triangles = best.triangles;
     m_pending.back().periphery_pixels = best.pixels;
     // Here the table learns what the model (without the offset) mispredicted of T_remote alone:
     // T_local has its own fit, refreshed every frame, and an offset learned from the imbalance
-    // would move R by L's error, which the period max(L, R) cannot absorb.
-    m_pending.back().model_imbalance_ms = best.remote - offset;
+    // would move R by L's error, which the period cannot absorb.
+    m_pending.back().model_imbalance_ms = best.remote() - offset;
     return d;
 }
 
@@ -304,12 +323,18 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // measured imbalance against the one Eq. 2 predicted with the pre-frame estimates. During
     // warm-up the estimates are still far off and their error is not the motion's.
     // Observations arrive in frame order, so this one belongs to the oldest open decision.
+    // A frame whose e1 moved carries the move's bytes (a key frame, a new canvas): what it
+    // cost is learned apart (learnMoveCost), and the table and the bits law, which predict a
+    // frame that holds, learn from the others (frame_period_objective).
+    const bool moved_apart = m_config.frame_period_objective &&
+                             learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
+                                                  m.outer_pixels * bitsPerPixelAt(m.s2));
     std::optional<PendingDecision> decided;
     if (!m_pending.empty()) {
         const PendingDecision p = m_pending.front();
         decided = p;
         m_pending.pop_front();
-        if (m_observed >= m_config.table_warmup_frames) {
+        if (m_observed >= m_config.table_warmup_frames && !moved_apart) {
             const double measured =
                 m_config.frame_period_objective ? m.t_remote_ms : m.t_remote_ms - m.t_local_ms;
             const double delta = measured - p.model_imbalance_ms;
@@ -349,8 +374,8 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         m_remote_base_ms = (1.0 - b) * m_remote_base_ms + b * rest;
     }
     // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
-    const bool have_mid = m.middle_pixels > 0 && m.middle_bytes > 0;
-    const bool have_out = m.outer_pixels > 0 && m.outer_bytes > 0;
+    const bool have_mid = !moved_apart && m.middle_pixels > 0 && m.middle_bytes > 0;
+    const bool have_out = !moved_apart && m.outer_pixels > 0 && m.outer_bytes > 0;
     if (have_mid && have_out && m.s2 > 1.05 * m.s1) {
         const double lm = std::log(m.middle_bytes * 8.0 / m.middle_pixels);
         const double lo = std::log(m.outer_bytes * 8.0 / m.outer_pixels);
@@ -369,6 +394,35 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // no later decision is already out (a pipelined headset has one in flight).
     if (m_pending.empty())
         m_e1_deg = m.e1_deg;
+}
+
+bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {
+    // Whether this frame's e1 differs from the previous observed frame's: its encoders may have
+    // opened a new canvas (a key frame, new padding). Its bits against what the bits law (fitted
+    // on all frames) predicted, beside the same ratio for frames that held, is what a move costs.
+    const bool moved =
+        m_last_observed_e1_deg >= 0.0 && std::fabs(m.e1_deg - m_last_observed_e1_deg) > 0.05;
+    const bool first = m_last_observed_e1_deg < 0.0;
+    m_last_observed_e1_deg = m.e1_deg;
+    if (first)
+        return false;
+    constexpr double kWeight = 0.2;
+    if (moved) {
+        m_frames_between_moves =
+            (1.0 - kWeight) * m_frames_between_moves + kWeight * (m_frames_since_move + 1);
+        m_frames_since_move = 0;
+    } else {
+        ++m_frames_since_move;
+    }
+    const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
+    if (!(sent_bits > 0.0) || !(predicted_bits > 0.0))
+        return moved;
+    const double ratio = sent_bits / predicted_bits;
+    double& ema = moved ? m_moved_bits_ratio : m_held_bits_ratio;
+    bool& have = moved ? m_have_moved_ratio : m_have_held_ratio;
+    ema = have ? (1.0 - kWeight) * ema + kWeight * ratio : ratio;
+    have = true;
+    return moved;
 }
 
 void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {

@@ -12,7 +12,7 @@ namespace qvr {
 
 namespace {
 
-const std::array<DesignTraits, 8> kTraits = {{
+const std::array<DesignTraits, 9> kTraits = {{
     {Design::Local, "local", Split::LocalOnly, "", false, false, true,
      "baseline: whole frame on the mobile GPU, ATW on the GPU"},
     {Design::Remote, "remote", Split::RemoteOnly, "", false, false, true,
@@ -29,10 +29,20 @@ const std::array<DesignTraits, 8> kTraits = {{
      "Q-VR: LIWC + unified composition/ATW on two UCA units"},
     {Design::Fixed, "fixed", Split::Foveated, "fixed", false, false, true,
      "collaborative foveated with a fixed fovea of any e1 (fixed:E)"},
+    {Design::Aimd, "aimd", Split::Foveated, "aimd", false, false, true,
+     "baseline: e1 from the link's queuing delay by AIMD (EyeNexus), blind to rendering costs"},
 }};
 
+// The designs a name may select: the paper's seven, then the baselines beyond the paper.
+const std::vector<Design>& namedDesigns() {
+    static const std::vector<Design> named = {Design::Local, Design::Remote, Design::Static,
+                                              Design::Ffr,   Design::Dfr,    Design::Sw,
+                                              Design::Qvr,   Design::Aimd};
+    return named;
+}
+
 constexpr std::string_view kFixedPrefix = "fixed:";
-constexpr const char* kRuntimeNames = "local, remote, ffr, sw, qvr or fixed:E";
+constexpr const char* kRuntimeNames = "local, remote, ffr, sw, qvr, aimd or fixed:E";
 
 Expected<DesignSpec> parseFixed(const std::string& name) {
     const std::string_view num = std::string_view(name).substr(kFixedPrefix.size());
@@ -60,7 +70,7 @@ const std::vector<Design>& allDesigns() {
 
 const std::vector<Design>& runtimeDesigns() {
     static const std::vector<Design> designs = {Design::Local, Design::Remote, Design::Ffr,
-                                                Design::Sw, Design::Qvr};
+                                                Design::Sw,    Design::Qvr,    Design::Aimd};
     return designs;
 }
 
@@ -99,7 +109,7 @@ Expected<DesignSpec> parseDesign(const std::string& name, DesignScope scope) {
     }
     if (runtime && name == "fixed")
         return makeError("design 'fixed' needs its e1: fixed:E, e.g. fixed:10");
-    for (Design d : allDesigns()) {
+    for (Design d : namedDesigns()) {
         const DesignTraits& t = traitsOf(d);
         if (t.name != name)
             continue;

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "qvr/compose/uca.h"
+#include "qvr/controller/aimd.h"
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
 #include "qvr/core/silence.h"
@@ -109,15 +110,24 @@ public:
           m_compositor(config.profile, composeOptions()),
           m_summary(designLabel(config.design, config.fixed_e1_deg), config.warmup_frames) {}
 
-    static LiwcConfig liwcConfig(bool reactive) {
+    static LiwcConfig liwcConfig(bool reactive, size_t depth) {
         LiwcConfig c;
         // A real server takes time to render and encode, less the larger the fovea; Eq. 2
-        // alone would not see it. With frames in flight the display's period is the slower
-        // side's, which is what LIWC minimises here (docs/LIWC.md).
+        // alone would not see it. With frames in flight the display's period is the slowest
+        // stage's, which is what LIWC minimises here (docs/LIWC.md).
         c.learn_remote_base = true;
         c.frame_period_objective = true;
+        c.frames_in_flight = static_cast<int>(depth);
         c.reactive = reactive;
         return c;
+    }
+
+    // Frames prepared ahead of the one being finished. Without a server there is nothing to
+    // overlap: one core renders and composes in turn.
+    size_t pipelineDepth() const {
+        return usesServer(m_config.design)
+                   ? static_cast<size_t>(std::clamp(m_config.pipeline_depth, 1, 4))
+                   : 1;
     }
 
     static ComposeOptions composeOptions() {
@@ -147,18 +157,23 @@ public:
         }
         switch (m_config.design) {
             case Design::Qvr: {
-                auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(false));
+                auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(),
+                                                         liwcConfig(false, pipelineDepth()));
                 m_liwc = liwc.get();
                 m_policy = std::move(liwc);
                 break;
             }
             case Design::Sw:
                 // The same model as qvr's, fed as software would be (docs/RUNTIME.md).
-                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(), liwcConfig(true));
+                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(),
+                                                        liwcConfig(true, pipelineDepth()));
                 break;
             case Design::Ffr:
             case Design::Fixed:
                 m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
+                break;
+            case Design::Aimd:
+                m_policy = makeAimdPolicy(m_probe.header());
                 break;
             default:
                 break;
@@ -186,10 +201,7 @@ public:
             tryConnect(true);
         // Frames are prepared (pose, decision, request) up to pipeline_depth ahead of the one
         // being finished (fovea, wait, UCA, scan-out).
-        // Without a server there is nothing to overlap: one core renders and composes in turn.
-        const size_t depth = usesServer(m_config.design)
-                                 ? static_cast<size_t>(std::clamp(m_config.pipeline_depth, 1, 4))
-                                 : 1;
+        const size_t depth = pipelineDepth();
         m_depth = depth;
         std::deque<Prepared> ahead;
         int64_t next = 0;
@@ -784,6 +796,12 @@ private:
         m.s1 = plan.s1;
         m.s2 = plan.s2;
         m.throughput_bps = t->throughput_bps;
+        m.periphery_late =
+            t->remote_requested && !have_current && i >= static_cast<int64_t>(m_depth);
+        if (p && have_current && p->last_rx_ns > 0) {
+            m.request_ms = double(p->request_ns - m_origin_ns) * 1e-6;
+            m.arrival_ms = double(p->last_rx_ns - m_origin_ns) * 1e-6;
+        }
         m_policy->observe(m);
         if (p && have_current)
             m_probe.observeBits(m.middle_bytes, m.middle_pixels, plan.s1, m.outer_bytes,

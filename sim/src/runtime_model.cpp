@@ -14,6 +14,7 @@
 #include <memory>
 #include <numeric>
 
+#include "qvr/controller/aimd.h"
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
 #include "qvr/core/canvas_policy.h"
@@ -315,12 +316,13 @@ private:
 };
 
 // The runtime's policies (runtime/src/headset_client.cpp liwcConfig): qvr is LIWC with the
-// frame-period objective, sw the same model fed reactively.
+// frame-period objective, sw the same model fed reactively, aimd EyeNexus's controller.
 void PassReplay::makePolicy() {
     auto runtimeLiwc = [&](bool reactive) {
         LiwcConfig lc;
         lc.learn_remote_base = m_config.liwc_learn_remote_base;
         lc.frame_period_objective = m_config.liwc_frame_period_objective;
+        lc.frames_in_flight = static_cast<int>(m_depth);
         lc.reactive = reactive;
         return std::make_unique<LiwcPolicy>(m_header, lc);
     };
@@ -334,6 +336,8 @@ void PassReplay::makePolicy() {
         m_policy = makeSoftwareReactivePolicy(m_header);
     } else if (m_traits.policy == "fixed") {
         m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
+    } else if (m_traits.policy == "aimd") {
+        m_policy = makeAimdPolicy(m_header);
     }
 }
 
@@ -672,6 +676,12 @@ void PassReplay::learn(int64_t i) {
     m.s1 = fs.plan.s1;
     m.s2 = fs.plan.s2;
     m.throughput_bps = m_ack_goodput_bps;
+    m.periphery_late = rf.requested && fs.expected > 0 && fs.decoded < fs.expected &&
+                       i >= static_cast<int64_t>(m_depth);
+    if (rf.requested && fs.expected > 0 && fs.decoded == fs.expected) {
+        m.request_ms = rf.request_ms;
+        m.arrival_ms = fs.last_rx_ms;
+    }
     m_policy->observe(m);
 }
 

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 
+#include "qvr/controller/aimd.h"
 #include "qvr/controller/liwc.h"
 #include "qvr/core/check.h"
 #include "qvr/core/run_summary.h"
@@ -67,6 +68,8 @@ Expected<std::unique_ptr<FoveaPolicy>> makeDesignPolicy(Design design, const Wor
         return std::unique_ptr<FoveaPolicy>(std::make_unique<FixedPolicy>(5.0));
     if (t.policy == "sw")
         return makeSoftwareReactivePolicy(header);
+    if (t.policy == "aimd")
+        return makeAimdPolicy(header);
     if (t.policy == "liwc") {
         LiwcConfig cfg;
         // LIWC reads the link rate from the radio before any acknowledgement arrives.
@@ -360,6 +363,10 @@ void Pipeline::finishFrame(FrameRecord& r, const FrameWork& work, double preempt
             measureFrame(r.index, work.plan, work.cost, r.bytes > 0.0 ? r.goodput_bps : 0.0);
         m.t_local_ms = r.t_local_ms;
         m.t_remote_ms = r.t_remote_ms;
+        if (r.bytes > 0.0) {
+            m.request_ms = r.request_ms;
+            m.arrival_ms = r.remote_ready_ms;
+        }
         m_policy->observe(m);
     }
 }

@@ -153,7 +153,7 @@ TEST(LiwcPeriodObjective, DriftsToTheSmallestFoveaWhenTRemoteDoesNotFallWithE1) 
             // either way).
             for (size_t i = 0; i < d.size(); ++i) {
                 if (i >= 80) {
-                    EXPECT_LE(d[i].e1_deg, c.e1_min_deg + 1.0)
+                    EXPECT_LE(d[i].e1_deg, c.e1_min_deg + 1.5)
                         << "depth " << depth << " start " << start << " frame " << i;
                 }
                 EXPECT_GE(d[i].e1_deg, c.e1_min_deg);
@@ -192,40 +192,53 @@ TEST(LiwcPeriodObjective, LeavesAFlatPeriodForTheAllLocalCoverWhenTRemoteExceeds
     }
 }
 
-// T_local rises and T_remote falls with e1: the period max(T_local, T_remote) is smallest where
-// they cross. The crossing is computed here from the made-up machine on a fine grid.
-TEST(LiwcPeriodObjective, SettlesNearTheCrossingWhenLocalRisesAndRemoteFalls) {
+// T_local rises and T_remote falls with e1. With `depth` frames in flight the headset, the server
+// and the link each work on their own frame: the period is the slowest stage's and no shorter
+// than the remote chain over the frames in flight, max(L, S, X, (S + X) / depth) — at depth 1
+// max(T_local, T_remote), smallest where they cross. Its minimum is computed here from the
+// made-up machine on a fine grid.
+TEST(LiwcPeriodObjective, SettlesNearTheBestPipelinedPeriodWhenLocalRisesAndRemoteFalls) {
     const WorkloadHeader h = header();
     const LayerPlanner planner(h.profile);
     Truth truth;
     truth.noise = 0.03;
     const WorkloadFrame f = frame(0, 20'000.0);
-    auto periodAt = [&](double e1) {
-        return std::max(truth.localMs(f, e1), truth.remoteMs(f, planner.plan(f.gaze, e1)));
+    auto periodAt = [&](double e1, int depth) {
+        const LayerPlan plan = planner.plan(f.gaze, e1);
+        const double local = truth.localMs(f, e1), remote = truth.remoteMs(f, plan);
+        const double link = plan.hasRemote() ? truth.transmissionMs(plan) : 0.0;
+        return std::max({local, remote - link, link, remote / depth});
     };
-    double crossing = -1.0, best_period = INFINITY;
-    for (double e = 2.0; e <= 50.0; e += 0.1) {
-        const LayerPlan plan = planner.plan(f.gaze, e);
-        if (crossing < 0.0 && truth.localMs(f, e) >= truth.remoteMs(f, plan))
+    double crossing = -1.0;
+    for (double e = 2.0; e <= 50.0; e += 0.1)
+        if (crossing < 0.0 && truth.localMs(f, e) >= truth.remoteMs(f, planner.plan(f.gaze, e)))
             crossing = e;
-        best_period = std::min(best_period, periodAt(e));
-    }
     // The made-up machine crosses well inside LIWC's range, with both sides moving there.
     ASSERT_GT(crossing, 12.0);
     ASSERT_LT(crossing, 40.0);
     ASSERT_GT(truth.remoteMs(f, planner.plan(f.gaze, 5.0)),
               1.2 * truth.remoteMs(f, planner.plan(f.gaze, crossing)));
     for (int depth : {1, 2}) {
+        double best_e = 0.0, best_period = INFINITY;
+        for (double e = 2.0; e <= 50.0; e += 0.1)
+            if (periodAt(e, depth) < best_period) {
+                best_period = periodAt(e, depth);
+                best_e = e;
+            }
+        if (depth == 1) {
+            ASSERT_NEAR(best_e, crossing, 0.2);
+        }
         for (double start : {5.0, 45.0}) {
             LiwcConfig c = periodConfig();
             c.e1_initial_deg = start;
+            c.frames_in_flight = depth;
             LiwcPolicy liwc(h, c);
             const std::vector<Decision> d = run(liwc, truth, planner, f, 150, depth, 7);
             for (size_t i = 100; i < d.size(); ++i) {
-                EXPECT_NEAR(d[i].e1_deg, crossing, 2.0)
+                // The period it runs at is within 5% of the best one, near where that lies.
+                EXPECT_LE(periodAt(d[i].e1_deg, depth), 1.05 * best_period)
                     << "depth " << depth << " start " << start << " frame " << i;
-                // The period it runs at is within 5% of the best one.
-                EXPECT_LE(periodAt(d[i].e1_deg), 1.05 * best_period)
+                EXPECT_NEAR(d[i].e1_deg, best_e, 2.0)
                     << "depth " << depth << " start " << start << " frame " << i;
             }
         }

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 namespace qvr {
@@ -156,6 +157,27 @@ TEST(Designs, TheSimulatorRefusesUnknownNamesAndFixedE) {
     ASSERT_TRUE(list.ok()) << list.error();
     EXPECT_EQ(list->size(), 3u);
     EXPECT_FALSE(parseDesignList("local,fixed:3", DesignScope::Simulator).ok());
+}
+
+
+// aimd, the network-driven baseline, is a design of the runtime (and its model) and of the
+// simulator, outside the paper's seven that the simulator's evaluation compares.
+TEST(Designs, AimdIsNamedInBothScopesButIsNotOneOfThePapersSeven) {
+    for (DesignScope scope : {DesignScope::Runtime, DesignScope::Simulator}) {
+        auto spec = parseDesign("aimd", scope);
+        ASSERT_TRUE(spec.ok()) << spec.error();
+        EXPECT_EQ(spec->design, Design::Aimd);
+        EXPECT_EQ(spec->label(), "aimd");
+    }
+    EXPECT_EQ(traitsOf(Design::Aimd).design, Design::Aimd);
+    EXPECT_EQ(traitsOf(Design::Aimd).policy, "aimd");
+    EXPECT_TRUE(traitsOf(Design::Aimd).runtime);
+    EXPECT_TRUE(usesServer(Design::Aimd));
+    EXPECT_EQ(std::count(allDesigns().begin(), allDesigns().end(), Design::Aimd), 0);
+    EXPECT_EQ(std::count(runtimeDesigns().begin(), runtimeDesigns().end(), Design::Aimd), 1);
+    auto list = parseDesignList("qvr,aimd,fixed:10", DesignScope::Runtime);
+    ASSERT_TRUE(list.ok()) << list.error();
+    EXPECT_EQ((*list)[1].design, Design::Aimd);
 }
 
 }  // namespace

@@ -718,6 +718,32 @@ TEST(RuntimeModel, LinksFromTheLinkGrammar) {
     }
 }
 
+// aimd runs in the model as the runtime runs it: EyeNexus's controller fed each frame's request
+// and last arrival. On a fast link with a steady server the one-way delay holds, so e1 never
+// rises; on a link far too slow for the periphery every frame misses the wait limit, each a
+// loss, and e1 jumps up.
+TEST(RuntimeModel, AimdFollowsTheLinksQueue) {
+    const RuntimeRunResult fast = run(Design::Aimd, flatCosts(1.0, 1.0, 2.0), 2, 200);
+    ASSERT_EQ(fast.frames.size(), 200u);
+    EXPECT_LE(fast.frames[0].e1_deg, 5.3);
+    for (size_t k = 1; k < fast.frames.size(); ++k) {
+        EXPECT_TRUE(fast.frames[k].requested) << k;
+        EXPECT_LE(fast.frames[k].e1_deg, fast.frames[k - 1].e1_deg + 1e-9) << k;
+    }
+    const WorkloadTrace trace = flatTrace(200);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Aimd;
+    cfg.costs = flatCosts(1.0, 1.0, 2.0);
+    cfg.pipeline_depth = 2;
+    cfg.frames = 200;
+    NoisyLink slow("slow", 2e4, 1.0, kInf, {0, 0}, 1);
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, slow);
+    double top = 0.0;
+    for (const RuntimeFrame& f : r.frames)
+        top = std::max(top, f.e1_deg);
+    EXPECT_GT(top, 10.0);
+}
+
 TEST(RuntimeModel, DesignNames) {
     EXPECT_EQ(parseDesign("qvr", DesignScope::Runtime)->design, Design::Qvr);
     EXPECT_EQ(parseDesign("local", DesignScope::Runtime)->design, Design::Local);

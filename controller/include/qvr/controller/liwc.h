@@ -43,15 +43,19 @@ struct LiwcConfig {
     // encode time, the decode — as a running mean, and adds it to every candidate (docs/LIWC.md).
     // The runtime sets it; the simulator keeps the paper's Eq. 2.
     bool learn_remote_base = false;
-    // The runtime's objective (docs/LIWC.md "The runtime's objective"): with frames in flight the
-    // display's frame period is the slowest of the headset's busy time L(e1), the server's
-    // render + encode S(e1) and the link's transmission X(e1) — the paper's
-    // FPS = min(1/T_GPU, 1/T_network) — so pick the candidate e1 minimising max(L, S, X), ties
-    // (within period_tie) going to the lower L + S + X (motion-to-photon). S(e1) is learned as a
-    // linear function of the periphery's triangles and pixels (the server draws less when the
-    // fovea grows), not a constant. False keeps Eq. 2's balance |T_remote − T_local| → 0, which
-    // the simulator reproduces.
+    // The runtime's objective (docs/LIWC.md "The runtime's objective"): the pipelined frame
+    // period. With frames in flight the headset, the server and the link work on different frames
+    // at once, so the display's period is the slowest stage's — the headset's busy time L(e1),
+    // the server's render + encode S(e1), the link's time X(e1) = bytes / measured throughput —
+    // and no shorter than the remote chain over the frames in flight:
+    // P(e1) = max(L, S, X, (S + X) / frames_in_flight). LIWC picks the candidate minimising
+    // P, ties (within period_tie) going to the lower L + S + X (motion-to-photon); a move away
+    // from the current e1 also pays the bytes a change costs the encoders (a new canvas, a key
+    // frame, padding), as measured, spread over the frames a chosen e1 is measured to hold. S(e1)
+    // is learned as a linear function of the periphery's triangles and pixels. False keeps
+    // Eq. 2's balance |T_remote − T_local| → 0, which the simulator reproduces.
     bool frame_period_objective = false;
+    int frames_in_flight = 2;  // the runtime's pipeline depth
     double period_tie = 0.03;  // candidates within 3% of the best period count as equal
     // The software-reactive variant of the paper (§6.1, "SW"): the same model, but with no
     // pre-render triangle counts (each decision reads the rings of the newest observed frame)
@@ -105,6 +109,11 @@ private:
     double remoteMs(const Gaze& gaze, double e1_deg) const;
     // frame_period_objective: the server's part and the transmission, separately.
     double transmissionMs(const Gaze& gaze, double e1_deg) const;
+    // The measured extra bits of a frame whose e1 moved, as a fraction of the bits predicted
+    // for it, spread over the frames a chosen e1 is measured to hold (docs/LIWC.md).
+    double moveCostFraction() const;
+    // Whether the measured frame's e1 moved from the previous one's.
+    bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
     // Both eyes' middle and outer layers' bits at e1 (0 once the fovea covers the frame).
     double peripheryBits(const Gaze& gaze, double e1_deg) const;
     double peripheryTriangles(double e1_deg) const;
@@ -136,6 +145,14 @@ private:
     WindowedFit m_local_fit;
     WindowedFit m_server_fit;
     double m_link_bps = 0.0;  // setLinkEstimate
+    // frame_period_objective: what moving e1 costs in bytes. EMAs of measured / predicted bits
+    // for frames whose e1 moved and for frames whose e1 held, and of the frames between moves.
+    double m_moved_bits_ratio = 1.0;
+    double m_held_bits_ratio = 1.0;
+    bool m_have_moved_ratio = false, m_have_held_ratio = false;
+    double m_frames_between_moves = 1.0;
+    int m_frames_since_move = 0;
+    double m_last_observed_e1_deg = -1.0;
     // reactive: the rings of the newest observed frame, and those of frames not yet observed.
     struct SeenFrame {
         int64_t index = 0;

@@ -36,6 +36,12 @@ struct FrameMeasurement {
     double s1 = 1.0;
     double s2 = 1.0;
     double throughput_bps = 0.0;  // measured from acknowledgements; 0 if nothing was sent
+    // When the frame's request left and its periphery's last packet arrived (ms on the headset's
+    // clock; 0 if nothing arrived): the one-way delay through server and link, queues included.
+    double request_ms = 0.0;
+    double arrival_ms = 0.0;
+    // The periphery was requested but had not all arrived by the wait limit (shown late).
+    bool periphery_late = false;
 };
 
 // What the headset would measure of a frame rendered with `plan` at cost `cost`, the remote part

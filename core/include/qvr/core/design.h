@@ -13,8 +13,9 @@
 namespace qvr {
 
 // The paper's seven designs, then Fixed: a fixed fovea of any e1 ("fixed:E"; ffr is fixed:5
-// under its own name).
-enum class Design { Local, Remote, Static, Ffr, Dfr, Sw, Qvr, Fixed };
+// under its own name), and Aimd: a network-driven baseline that sizes the fovea from the link's
+// queuing delay alone (EyeNexus's controller, docs/LIWC.md).
+enum class Design { Local, Remote, Static, Ffr, Dfr, Sw, Qvr, Fixed, Aimd };
 
 enum class Split {
     LocalOnly,   // every triangle and pixel on the headset
@@ -27,7 +28,7 @@ struct DesignTraits {
     Design design = Design::Local;
     std::string_view name;
     Split split = Split::LocalOnly;
-    std::string_view policy;        // "" (no fovea), "fixed", "liwc" or "sw"
+    std::string_view policy;        // "" (no fovea), "fixed", "liwc", "sw" or "aimd"
     bool uca = false;               // composition + ATW on the UCA units instead of the GPU
     bool software_control = false;  // e1 picked by the CPU from read-back timers
     bool runtime = false;           // the runtime runs it (static and dfr are simulated only)
@@ -43,7 +44,7 @@ inline constexpr double kFixedE1MaxDeg = 90.0;
 const DesignTraits& traitsOf(Design d);
 // The paper's seven, in Fig. 12's order: what the simulator compares.
 const std::vector<Design>& allDesigns();
-// The named designs the runtime runs: local, remote, ffr, sw, qvr (and fixed:E, by its e1).
+// The named designs the runtime runs: local, remote, ffr, sw, qvr, aimd (and fixed:E, by its e1).
 const std::vector<Design>& runtimeDesigns();
 // Whether the server renders anything for the design.
 bool usesServer(Design design);
@@ -56,12 +57,12 @@ struct DesignSpec {
 };
 std::string designLabel(Design design, double fixed_e1_deg);
 
-// Who reads the name: the simulator takes the paper's seven; the runtime (and the simulator's
-// model of it) takes local, remote, ffr, sw, qvr and fixed:E, and refuses static and dfr with a
-// message that says they are simulated only.
+// Who reads the name: the simulator takes the paper's seven and aimd; the runtime (and the
+// simulator's model of it) takes local, remote, ffr, sw, qvr, aimd and fixed:E, and refuses static
+// and dfr with a message that says they are simulated only.
 enum class DesignScope { Simulator, Runtime };
 
-// "local", "remote", "static", "ffr", "dfr", "sw", "qvr" or "fixed:E" (E in degrees,
+// "local", "remote", "static", "ffr", "dfr", "sw", "qvr", "aimd" or "fixed:E" (E in degrees,
 // kFixedE1MinDeg…kFixedE1MaxDeg), as `scope` allows; errors name the input.
 Expected<DesignSpec> parseDesign(const std::string& name, DesignScope scope);
 // Comma-separated names ("local,remote,ffr,sw,qvr,fixed:10"); empty items are skipped, a design
