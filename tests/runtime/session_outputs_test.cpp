@@ -54,7 +54,8 @@ TEST(SessionOutputs, ClientSummaryHasTheSharedKeysAndItsOwn) {
     EXPECT_EQ(j["control_forged"], 2);
     // The client reports its own key-frame requests; `qvr run` adds the transport's.
     EXPECT_EQ(j["key_frame_requests"], 4);
-    EXPECT_EQ(j.size(), 35u);  // the keys `qvr client` has always written
+    EXPECT_EQ(j["capacity_refusals"], 0);  // refusals by a server at its frame-rate floor
+    EXPECT_EQ(j.size(), 36u);              // the keys `qvr client` writes
 }
 
 TEST(SessionOutputs, ClientWritesTraceAndSummaryAndWarnsOfForgedControl) {
