@@ -159,7 +159,6 @@ TEST(Designs, TheSimulatorRefusesUnknownNamesAndFixedE) {
     EXPECT_FALSE(parseDesignList("local,fixed:3", DesignScope::Simulator).ok());
 }
 
-
 // aimd, the network-driven baseline, is a design of the runtime (and its model) and of the
 // simulator, outside the paper's seven that the simulator's evaluation compares.
 TEST(Designs, AimdIsNamedInBothScopesButIsNotOneOfThePapersSeven) {
