@@ -27,8 +27,9 @@ std::string describeCores(const std::vector<int>& cores) {
         size_t j = i;
         while (j + 1 < cores.size() && cores[j + 1] == cores[j] + 1)
             ++j;
-        out += (out.empty() ? "" : ",") +
-               (j == i ? std::to_string(cores[i]) : fmt::format("{}-{}", cores[i], cores[j]));
+        if (!out.empty())
+            out += ',';
+        out += j == i ? std::to_string(cores[i]) : fmt::format("{}-{}", cores[i], cores[j]);
         i = j + 1;
     }
     return out;

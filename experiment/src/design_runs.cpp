@@ -348,9 +348,12 @@ std::optional<RunError> DesignRunner::startOtherHeadsets() {
 void DesignRunner::keepHeadsets(const std::string& label, const DesignSummary* own,
                                 int64_t start_ns, bool stopped) {
     HeadsetsWindow w{label, {}, start_ns, 0};
-    HeadsetOutcome first{0, m_workloads.front(), {}, own ? "" : "its session failed"};
+    HeadsetOutcome first;
+    first.workload = m_workloads.front();
     if (own)
         first.summary = *own;
+    else
+        first.error = "its session failed";
     w.headsets.push_back(std::move(first));
     if (m_others)
         for (HeadsetOutcome& h : m_others->collect(stopped || !own))
