@@ -56,6 +56,10 @@ struct Truth {
     double remote_constant_ms = 0.0;
     double throughput_bps = 200e6;
     double noise = 0.0;  // relative, uniform ±
+    // A frame whose e1 differs from the previous measured one's carries this fraction more bits
+    // (the encoders' new canvas: a key frame), and its link time grows with them.
+    double move_extra_bits = 0.0;
+    mutable double last_e1_deg = -1.0;
 
     static double bitsPerPixel(double s) { return 0.4 * std::pow(s, 0.9); }
 
@@ -97,6 +101,13 @@ struct Truth {
         m.s2 = plan.s2;
         m.middle_bytes = m.middle_pixels * bitsPerPixel(plan.s1) / 8.0;
         m.outer_bytes = m.outer_pixels * bitsPerPixel(plan.s2) / 8.0;
+        const bool moved = last_e1_deg >= 0.0 && std::fabs(d.e1_deg - last_e1_deg) > 0.05;
+        last_e1_deg = d.e1_deg;
+        if (moved && plan.hasRemote()) {
+            m.middle_bytes *= 1.0 + move_extra_bits;
+            m.outer_bytes *= 1.0 + move_extra_bits;
+            m.t_remote_ms += move_extra_bits * transmissionMs(plan) * u(rng);
+        }
         m.throughput_bps = plan.hasRemote() ? throughput_bps : 0.0;
         return m;
     }
@@ -297,6 +308,41 @@ TEST(LiwcPeriodObjective, ReactiveDecidesWithTheRingsOfTheNewestObservedFrame) {
     const Decision s1 = sw.decide(next_dense), s1_calm = sw_steady.decide(next_calm);
     EXPECT_LE(s1.e1_deg, s1_calm.e1_deg - 1.0);
     EXPECT_GT(s1.t_local_pred_ms, s1_calm.t_local_pred_ms);
+}
+
+// The cost of moving e1 (docs/LIWC.md): on a link-bound machine a frame whose e1 moved carries
+// a key frame's bits. The scene's density flips every 25 frames, which moves the best e1; LIWC
+// measures the extra (κ) from the sizes it is sent and charges a move with it, spread over the
+// frames an e1 holds, so it follows the flips far less often than on the same machine where a
+// move is free.
+TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheLinkAKeyFrame) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    auto movesAfter = [&](double move_extra_bits, int from) {
+        Truth truth;
+        truth.throughput_bps = 20e6;  // the link is the slowest stage
+        truth.move_extra_bits = move_extra_bits;
+        LiwcPolicy liwc(h, periodConfig());
+        std::mt19937 rng(5);
+        int moves = 0;
+        double last_e1 = -1.0;
+        for (int i = 0; i < 300; ++i) {
+            WorkloadFrame fi = frame(i, 20'000.0);
+            truth.throughput_bps = (i / 25) % 2 ? 60e6 : 15e6;
+            const Decision d = liwc.decide(fi);
+            if (i >= from && std::fabs(d.e1_deg - last_e1) > 0.05)
+                ++moves;
+            last_e1 = d.e1_deg;
+            liwc.observe(truth.measure(planner, fi, d, rng));
+        }
+        return moves;
+    };
+    // Moves counted over frames 100-299. Free, e1 follows the link and the fits' noise 94 times;
+    // with the key frames charged it moves under a tenth as often (65 times with κ left out).
+    const int free_moves = movesAfter(0.0, 100), costly_moves = movesAfter(4.0, 100);
+    ASSERT_GE(free_moves, 20);
+    EXPECT_LE(costly_moves * 10, free_moves)
+        << "free " << free_moves << ", costly " << costly_moves;
 }
 
 }  // namespace
