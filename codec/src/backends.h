@@ -18,10 +18,12 @@ std::unique_ptr<VideoDecoder> makeRawDecoder();
 Expected<std::unique_ptr<VideoEncoder>> makeX264Encoder(const CodecConfig& config);
 Expected<std::unique_ptr<VideoDecoder>> makeH264Decoder();
 
-// A frame for a decoder of raw frames (`raw`) or of coded ones: parsed, and refused when it is
-// the other kind. `decoder` names the decoder in the message.
-inline Expected<ParsedFrame> parseFrameFor(std::span<const uint8_t> bytes, bool raw,
-                                           std::string_view decoder) {
+// A frame for a decoder of raw frames (`raw`) or of coded ones: parsed, refused when it is the
+// other kind, then admitted by the stream's reference tracker (which leaves key frames as they
+// are, so a decoder may still refuse a key frame after this). `decoder` names the decoder in the
+// message.
+inline Expected<ParsedFrame> admitFrameFor(std::span<const uint8_t> bytes, bool raw,
+                                           std::string_view decoder, ReferenceTracker& tracker) {
     auto parsed = parseFrame(bytes);
     if (!parsed)
         return makeError(parsed.error());
@@ -29,6 +31,8 @@ inline Expected<ParsedFrame> parseFrameFor(std::span<const uint8_t> bytes, bool 
     if (((h.flags & FrameHeader::kFlagRaw) != 0) != raw)
         return makeError(
             fmt::format("{}: frame {} is {}a raw frame", decoder, h.frame_id, raw ? "not " : ""));
+    if (Status s = tracker.admit(h); !s)
+        return makeError(s.error());
     return parsed;
 }
 

@@ -61,12 +61,10 @@ class RawDecoder final : public VideoDecoder {
 public:
     Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
         const Stopwatch t0;
-        auto parsed = parseFrameFor(bytes, true, "raw decoder");
+        auto parsed = admitFrameFor(bytes, true, "raw decoder", m_tracker);
         if (!parsed)
             return makeError(parsed.error());
         const FrameHeader& h = parsed->header;
-        if (Status s = m_tracker.admit(h); !s)
-            return makeError(s.error());
         const size_t want = size_t{h.width} * h.height * 4;
         if (parsed->payload.size() != want) {
             m_tracker.decoded(h, false);

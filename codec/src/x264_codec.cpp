@@ -283,7 +283,7 @@ public:
 
     Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
         const Stopwatch t0;
-        auto parsed = parseFrameFor(bytes, false, "h264 decoder");
+        auto parsed = admitFrameFor(bytes, false, "h264 decoder", m_tracker);
         if (!parsed)
             return makeError(parsed.error());
         const FrameHeader& h = parsed->header;
@@ -292,8 +292,6 @@ public:
                 fmt::format("h264 decoder: frame {} claims to be a key frame but "
                             "holds no IDR slice",
                             h.frame_id));
-        if (Status s = m_tracker.admit(h); !s)
-            return makeError(s.error());
         auto picture = decodePayload(h, parsed->payload);
         m_tracker.decoded(h, picture.ok());
         if (!picture)
