@@ -22,11 +22,11 @@ Status csvRows(std::string_view text, std::string_view source, std::string_view 
 
 // One trace file format: a header line, then one row per sample, t_ms first and increasing.
 struct TimedCsvFormat {
-    std::string_view header;     // the exact first line
-    size_t columns = 0;          // fields per row, t_ms included
-    size_t max_rows = 0;         // rows a file may hold
-    size_t max_bytes = 0;        // bytes a file may hold
-    std::string_view rows_name;  // what a row is, for "no <rows_name> after the header"
+    std::string_view header;             // the exact first line
+    size_t columns = 0;                  // fields per row, t_ms included
+    size_t max_rows = 0;                 // rows a file may hold
+    size_t max_bytes = size_t{1} << 30;  // bytes a file may hold
+    std::string_view rows_name;          // what a row is, for "no <rows_name> after the header"
 };
 
 // csvRows, then each row in file order to `on_row` once its first column, t_ms, is checked to

@@ -11,11 +11,8 @@
 namespace qvr {
 
 namespace {
-constexpr detail::TimedCsvFormat kGazeCsv{.header = "t_ms,x_deg,y_deg",
-                                          .columns = 3,
-                                          .max_rows = 50'000'000,
-                                          .max_bytes = size_t{1} << 30,
-                                          .rows_name = "samples"};
+constexpr detail::TimedCsvFormat kGazeCsv{
+    .header = "t_ms,x_deg,y_deg", .columns = 3, .max_rows = 50'000'000, .rows_name = "samples"};
 }  // namespace
 
 std::string gazeTraceToCsv(const GazeTrace& trace) {

@@ -15,11 +15,8 @@
 namespace qvr {
 
 namespace {
-constexpr detail::TimedCsvFormat kPoseCsv{.header = "t_ms,qw,qx,qy,qz,x,y,z",
-                                          .columns = 8,
-                                          .max_rows = 10'000'000,
-                                          .max_bytes = size_t{1} << 30,
-                                          .rows_name = "poses"};
+constexpr detail::TimedCsvFormat kPoseCsv{
+    .header = "t_ms,qw,qx,qy,qz,x,y,z", .columns = 8, .max_rows = 10'000'000, .rows_name = "poses"};
 constexpr double kRadPerDeg = 0.017453292519943295;
 }  // namespace
 
