@@ -57,36 +57,26 @@ private:
     int m_height = 0;
 };
 
-class RawDecoder final : public VideoDecoder {
+class RawDecoder final : public FramedDecoder {
 public:
-    Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
-        const Stopwatch t0;
-        auto parsed = parseFrameFor(bytes, true, "raw decoder");
-        if (!parsed)
-            return makeError(parsed.error());
-        const FrameHeader& h = parsed->header;
-        if (Status s = m_tracker.admit(h); !s)
-            return makeError(s.error());
+    RawDecoder() : FramedDecoder(true, "raw decoder") {}
+
+private:
+    Expected<ImageRgba8> decodePayload(const FrameHeader& h,
+                                       std::span<const uint8_t> payload) override {
         const size_t want = size_t{h.width} * h.height * 4;
-        if (parsed->payload.size() != want) {
-            m_tracker.decoded(h, false);
+        if (payload.size() != want) {
+            tracker().decoded(h, false);
             return makeError(
                 fmt::format("raw decoder: frame {} has {} payload bytes, {}x{} RGBA "
                             "needs {}",
-                            h.frame_id, parsed->payload.size(), h.width, h.height, want));
+                            h.frame_id, payload.size(), h.width, h.height, want));
         }
-        m_tracker.decoded(h, true);
+        tracker().decoded(h, true);
         ImageRgba8 image(h.width, h.height);
-        std::memcpy(image.data(), parsed->payload.data(), want);
-        m_last_ms = t0.elapsedMs();
+        std::memcpy(image.data(), payload.data(), want);
         return image;
     }
-    bool needsKeyframe() const override { return m_tracker.needsKeyframe(); }
-    double lastDecodeMs() const override { return m_last_ms; }
-
-private:
-    ReferenceTracker m_tracker;
-    double m_last_ms = 0.0;
 };
 
 }  // namespace

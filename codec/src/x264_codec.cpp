@@ -258,8 +258,10 @@ private:
     bool m_force_key = true;
 };
 
-class H264Decoder final : public VideoDecoder, private FfmpegState {
+class H264Decoder final : public FramedDecoder, private FfmpegState {
 public:
+    H264Decoder() : FramedDecoder(false, "h264 decoder") {}
+
     Status open() {
         const AVCodec* codec = avcodec_find_decoder(AV_CODEC_ID_H264);
         if (!codec)
@@ -281,39 +283,28 @@ public:
         return Status::success();
     }
 
-    Expected<ImageRgba8> decode(std::span<const uint8_t> bytes) override {
-        const Stopwatch t0;
-        auto parsed = parseFrameFor(bytes, false, "h264 decoder");
-        if (!parsed)
-            return makeError(parsed.error());
-        const FrameHeader& h = parsed->header;
-        if (h.keyframe() && !annexBHasIdr(parsed->payload))
+private:
+    Expected<ImageRgba8> decodePayload(const FrameHeader& h,
+                                       std::span<const uint8_t> payload) override {
+        if (h.keyframe() && !annexBHasIdr(payload))
             return makeError(
                 fmt::format("h264 decoder: frame {} claims to be a key frame but "
                             "holds no IDR slice",
                             h.frame_id));
-        if (Status s = m_tracker.admit(h); !s)
-            return makeError(s.error());
-        auto picture = decodePayload(h, parsed->payload);
-        m_tracker.decoded(h, picture.ok());
+        auto picture = feedPayload(h, payload);
+        tracker().decoded(h, picture.ok());
         if (!picture)
             return makeError(picture.error());
-        if (m_tracker.withholdPicture())
+        if (tracker().withholdPicture())
             return makeError(
                 fmt::format("h264 decoder: frame {} decoded while recovering from "
                             "loss; {} more frame(s) until the intra refresh completes",
-                            h.frame_id, m_tracker.recoveringFrames()));
-        auto image = toRgba(h);
-        m_last_ms = t0.elapsedMs();
-        return image;
+                            h.frame_id, tracker().recoveringFrames()));
+        return toRgba(h);
     }
 
-    bool needsKeyframe() const override { return m_tracker.needsKeyframe(); }
-    double lastDecodeMs() const override { return m_last_ms; }
-
-private:
     // Feeds one payload and takes its picture; leaves it in m_frame.
-    Status decodePayload(const FrameHeader& h, std::span<const uint8_t> payload) {
+    Status feedPayload(const FrameHeader& h, std::span<const uint8_t> payload) {
         // libavcodec reads up to AV_INPUT_BUFFER_PADDING_SIZE bytes past a packet's end.
         m_buffer.assign(payload.size() + AV_INPUT_BUFFER_PADDING_SIZE, 0);
         std::memcpy(m_buffer.data(), payload.data(), payload.size());
@@ -387,8 +378,6 @@ private:
     }
 
     std::vector<uint8_t> m_buffer;
-    ReferenceTracker m_tracker;
-    double m_last_ms = 0.0;
 };
 
 }  // namespace

@@ -445,6 +445,16 @@ WireError decodeControlHeader(std::span<const uint8_t> bytes, ControlHeader& out
 
 namespace {
 
+// A one-byte enum from r into out when it is one of first…last; else out is left as it was.
+template <typename Enum>
+bool readEnum(ByteReader& r, Enum first, Enum last, Enum& out) {
+    const uint8_t value = r.u8();
+    if (value < static_cast<uint8_t>(first) || value > static_cast<uint8_t>(last))
+        return false;
+    out = static_cast<Enum>(value);
+    return true;
+}
+
 // Each control message's fields from r, range-checked; decodeFrameRequest is FrameRequest's.
 WireError decodeBody(ByteReader& r, ClientHello& m) {
     r.bytes(m.client_nonce);
@@ -502,12 +512,10 @@ WireError decodeBody(ByteReader& r, MediaAck& m) {
 WireError decodeBody(ByteReader& r, KeyFrameRequest& m) {
     m.stream_mask = r.u8();
     m.last_frame_id = r.u32();
-    const uint8_t reason = r.u8();
-    if (m.stream_mask == 0 || m.stream_mask >= (1u << kMaxStreams) || reason < 1 || reason > 3) {
-        return WireError::kBadField;
-    }
-    m.reason = static_cast<KeyFrameReason>(reason);
-    return WireError::kNone;
+    const bool reason_ok =
+        readEnum(r, KeyFrameReason::kPacketLoss, KeyFrameReason::kStart, m.reason);
+    const bool ok = reason_ok && m.stream_mask != 0 && m.stream_mask < (1u << kMaxStreams);
+    return ok ? WireError::kNone : WireError::kBadField;
 }
 
 WireError decodeBody(ByteReader& r, ThroughputReport& m) {
@@ -517,12 +525,9 @@ WireError decodeBody(ByteReader& r, ThroughputReport& m) {
 }
 
 WireError decodeBody(ByteReader& r, Bye& m) {
-    const uint8_t reason = r.u8();
-    if (reason > kMaxByeReason) {
-        return WireError::kBadField;
-    }
-    m.reason = static_cast<ByeReason>(reason);
-    return WireError::kNone;
+    const bool ok =
+        readEnum(r, ByeReason::kNormal, static_cast<ByeReason>(kMaxByeReason), m.reason);
+    return ok ? WireError::kNone : WireError::kBadField;
 }
 
 WireError decodeBody(ByteReader& r, Nack& m) {

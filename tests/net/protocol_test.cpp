@@ -257,6 +257,17 @@ TEST(NetProtocol, OutOfRangeFieldsAreRejected) {
     auto bye = encodeControl(Bye{});
     bye.back() = 99;
     EXPECT_EQ(decodeControl(bye, out), WireError::kBadField);
+    bye.back() = kMaxByeReason + 1;
+    EXPECT_EQ(decodeControl(bye, out), WireError::kBadField);
+    bye.back() = kMaxByeReason;
+    EXPECT_EQ(decodeControl(bye, out), WireError::kNone);
+    // A key frame request's reason is one of the three the protocol names.
+    auto key = encodeControl(KeyFrameRequest{1, 1, KeyFrameReason::kStart});
+    EXPECT_EQ(decodeControl(key, out), WireError::kNone);
+    for (const uint8_t reason : {0, 4}) {
+        key.back() = reason;
+        EXPECT_EQ(decodeControl(key, out), WireError::kBadField) << int{reason};
+    }
 }
 
 TEST(NetProtocol, MediaPacketsRoundTripAndReassembleInOrder) {

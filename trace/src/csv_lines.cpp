@@ -73,15 +73,16 @@ Status csvRows(std::string_view text, std::string_view source, std::string_view 
 }
 
 Status forEachTimedRow(
-    std::string_view text, std::string_view source, std::string_view header, size_t columns,
-    size_t max_rows, std::string_view rows_name,
+    std::string_view text, std::string_view source, const TimedCsvFormat& format,
     const std::function<Status(const std::vector<double>& row, int line)>& on_row) {
     std::vector<std::vector<double>> rows;
     std::vector<int> lines;
-    if (Status s = csvRows(text, source, header, columns, max_rows, rows, lines); !s)
+    if (Status s =
+            csvRows(text, source, format.header, format.columns, format.max_rows, rows, lines);
+        !s)
         return s;
     if (rows.empty())
-        return makeError(fmt::format("{}: no {} after the header", source, rows_name));
+        return makeError(fmt::format("{}: no {} after the header", source, format.rows_name));
     for (size_t i = 0; i < rows.size(); ++i) {
         if (i > 0 && !(rows[i][0] > rows[i - 1][0]))
             return makeError(

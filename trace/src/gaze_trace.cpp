@@ -11,17 +11,14 @@
 namespace qvr {
 
 namespace {
-constexpr std::string_view kGazeHeader = "t_ms,x_deg,y_deg";
-constexpr size_t kMaxRows = 50'000'000;
-constexpr size_t kMaxBytes = size_t{1} << 30;
+constexpr detail::TimedCsvFormat kGazeCsv{
+    .header = "t_ms,x_deg,y_deg", .columns = 3, .max_rows = 50'000'000, .rows_name = "samples"};
 }  // namespace
 
 std::string gazeTraceToCsv(const GazeTrace& trace) {
-    std::string out(kGazeHeader);
-    out += '\n';
-    for (const auto& s : trace.samples)
-        out += fmt::format("{:.6f},{:.6f},{:.6f}\n", s.t_ms, s.gaze.x_deg, s.gaze.y_deg);
-    return out;
+    return detail::timedCsvText(kGazeCsv, trace.samples, [](const GazeSample& s) {
+        return fmt::format("{:.6f},{:.6f},{:.6f}\n", s.t_ms, s.gaze.x_deg, s.gaze.y_deg);
+    });
 }
 
 Status writeGazeCsv(const GazeTrace& trace, const std::string& path) {
@@ -29,23 +26,18 @@ Status writeGazeCsv(const GazeTrace& trace, const std::string& path) {
 }
 
 Expected<GazeTrace> parseGazeCsv(std::string_view text, std::string_view source) {
-    GazeTrace trace;
-    const auto sample = [&](const std::vector<double>& r, int line) -> Status {
-        if (std::fabs(r[1]) > 90.0 || std::fabs(r[2]) > 90.0)
-            return makeError(
-                fmt::format("{}:{}: gaze ({}, {}) deg beyond ±90", source, line, r[1], r[2]));
-        trace.samples.push_back({r[0], Gaze{r[1], r[2]}});
-        return {};
-    };
-    if (Status s =
-            detail::forEachTimedRow(text, source, kGazeHeader, 3, kMaxRows, "samples", sample);
-        !s)
-        return makeError(s.error());
-    return trace;
+    return detail::parseTimedCsv<GazeTrace>(
+        text, source, kGazeCsv,
+        [&](const std::vector<double>& r, int line) -> Expected<GazeSample> {
+            if (std::fabs(r[1]) > 90.0 || std::fabs(r[2]) > 90.0)
+                return makeError(
+                    fmt::format("{}:{}: gaze ({}, {}) deg beyond ±90", source, line, r[1], r[2]));
+            return GazeSample{r[0], Gaze{r[1], r[2]}};
+        });
 }
 
 Expected<GazeTrace> loadGazeCsv(const std::string& path) {
-    return detail::loadCsvFile(path, kMaxBytes, parseGazeCsv);
+    return detail::loadCsvFile(path, kGazeCsv, parseGazeCsv);
 }
 
 }  // namespace qvr

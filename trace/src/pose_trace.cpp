@@ -15,9 +15,8 @@
 namespace qvr {
 
 namespace {
-constexpr std::string_view kPoseHeader = "t_ms,qw,qx,qy,qz,x,y,z";
-constexpr size_t kMaxRows = 10'000'000;
-constexpr size_t kMaxBytes = size_t{1} << 30;
+constexpr detail::TimedCsvFormat kPoseCsv{
+    .header = "t_ms,qw,qx,qy,qz,x,y,z", .columns = 8, .max_rows = 10'000'000, .rows_name = "poses"};
 constexpr double kRadPerDeg = 0.017453292519943295;
 }  // namespace
 
@@ -113,15 +112,12 @@ PoseTrace smoothPoses(const PoseTrace& trace, double sigma_ms) {
 }
 
 std::string poseTraceToCsv(const PoseTrace& trace) {
-    std::string out(kPoseHeader);
-    out += '\n';
-    for (const auto& s : trace.samples) {
+    return detail::timedCsvText(kPoseCsv, trace.samples, [](const PoseSample& s) {
         const auto& q = s.pose.orientation;
         const auto& p = s.pose.position_m;
-        out += fmt::format("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", s.t_ms, q.w,
+        return fmt::format("{:.6f},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n", s.t_ms, q.w,
                            q.x, q.y, q.z, p.x, p.y, p.z);
-    }
-    return out;
+    });
 }
 
 Status writePoseCsv(const PoseTrace& trace, const std::string& path) {
@@ -129,33 +125,30 @@ Status writePoseCsv(const PoseTrace& trace, const std::string& path) {
 }
 
 Expected<PoseTrace> parsePoseCsv(std::string_view text, std::string_view source) {
-    PoseTrace trace;
-    const auto sample = [&](const std::vector<double>& r, int line) -> Status {
-        const double norm = std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3] + r[4] * r[4]);
-        if (std::fabs(norm - 1.0) > 1e-3)
-            return makeError(fmt::format("{}:{}: quaternion norm {} is not 1", source, line, norm));
-        for (int c = 5; c < 8; ++c) {
-            if (std::fabs(r[static_cast<size_t>(c)]) > 1e6)
-                return makeError(fmt::format("{}:{}: position beyond ±1e6 m", source, line));
-        }
-        PoseSample s;
-        s.t_ms = r[0];
-        s.pose.orientation =
-            glm::normalize(glm::quat(static_cast<float>(r[1]), static_cast<float>(r[2]),
-                                     static_cast<float>(r[3]), static_cast<float>(r[4])));
-        s.pose.position_m =
-            glm::vec3(static_cast<float>(r[5]), static_cast<float>(r[6]), static_cast<float>(r[7]));
-        trace.samples.push_back(s);
-        return {};
-    };
-    if (Status s = detail::forEachTimedRow(text, source, kPoseHeader, 8, kMaxRows, "poses", sample);
-        !s)
-        return makeError(s.error());
-    return trace;
+    return detail::parseTimedCsv<PoseTrace>(
+        text, source, kPoseCsv,
+        [&](const std::vector<double>& r, int line) -> Expected<PoseSample> {
+            const double norm = std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3] + r[4] * r[4]);
+            if (std::fabs(norm - 1.0) > 1e-3)
+                return makeError(
+                    fmt::format("{}:{}: quaternion norm {} is not 1", source, line, norm));
+            for (int c = 5; c < 8; ++c) {
+                if (std::fabs(r[static_cast<size_t>(c)]) > 1e6)
+                    return makeError(fmt::format("{}:{}: position beyond ±1e6 m", source, line));
+            }
+            PoseSample s;
+            s.t_ms = r[0];
+            s.pose.orientation =
+                glm::normalize(glm::quat(static_cast<float>(r[1]), static_cast<float>(r[2]),
+                                         static_cast<float>(r[3]), static_cast<float>(r[4])));
+            s.pose.position_m = glm::vec3(static_cast<float>(r[5]), static_cast<float>(r[6]),
+                                          static_cast<float>(r[7]));
+            return s;
+        });
 }
 
 Expected<PoseTrace> loadPoseCsv(const std::string& path) {
-    return detail::loadCsvFile(path, kMaxBytes, parsePoseCsv);
+    return detail::loadCsvFile(path, kPoseCsv, parsePoseCsv);
 }
 
 }  // namespace qvr

@@ -8,8 +8,9 @@
 
 #include <array>
 #include <deque>
-#include <memory>
 #include <optional>
+#include <string_view>
+#include <vector>
 
 #include "qvr/controller/liwc_table.h"
 #include "qvr/controller/motion_codec.h"

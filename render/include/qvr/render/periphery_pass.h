@@ -6,6 +6,8 @@
 // anti-aliased (an area average of s1 texels) instead of point-sampled at s2.
 #pragma once
 
+#include <cstdint>
+
 #include "qvr/core/expected.h"
 #include "qvr/core/image.h"
 #include "qvr/render/camera.h"

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "qvr/core/expected.h"
 #include "qvr/core/image.h"
