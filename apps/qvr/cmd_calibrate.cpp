@@ -1,13 +1,13 @@
 // `qvr calibrate`'s command line: parses the options and calls the experiment's calibration
 // (qvr/experiment/calibration.h).
 #include <cstdio>
-#include <fstream>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "cli_parse.h"
 #include "commands.h"
+#include "qvr/core/text_file.h"
 #include "qvr/experiment/calibration.h"
 #include "qvr/experiment/host.h"
 
@@ -36,22 +36,13 @@ int runCalibrate(CalibrateCmdOptions& o) {
     }
     cal->command = o.command_line;
     fmt::print("{}", calibrationSummaryText(*cal));
-    {
-        std::ofstream f(o.out);
-        f << cal->toToml();
-        if (!f) {
-            std::fprintf(stderr, "qvr calibrate: cannot write %s\n", o.out.c_str());
-            return 1;
-        }
-    }
     const std::string json = o.json.empty() ? o.out + ".json" : o.json;
-    {
-        std::ofstream f(json);
-        f << cal->toJson().dump(2) << "\n";
-        if (!f) {
-            std::fprintf(stderr, "qvr calibrate: cannot write %s\n", json.c_str());
-            return 1;
-        }
+    Status written = writeTextFile(o.out, cal->toToml());
+    if (written)
+        written = writeJsonFile(json, cal->toJson());
+    if (!written) {
+        std::fprintf(stderr, "qvr calibrate: %s\n", written.error().c_str());
+        return 1;
     }
     fmt::print("  wrote {} (qvr sim --hardware / qvr run --hardware) and {}\n", o.out, json);
     return 0;
@@ -65,9 +56,7 @@ static Registered registerCalibrate(CLI::App& app) {
         "calibrate",
         "Measure this machine's runtime costs (render, encode, decode, UCA, ring counts) and "
         "write a hardware file for the runtime pipeline model");
-    cmd->add_option("--out", o->out, "Hardware file to write (TOML)")
-        ->required()
-        ->check(writableFile());
+    addOutputFileOption(cmd, o->out, "Hardware file to write (TOML)");
     cmd->add_option("--json", o->json, "JSON copy (default: OUT.json)")->check(writableFile());
     cmd->add_option("--scene", o->cal.scene, "Scene the render costs are measured on")
         ->capture_default_str();
@@ -75,9 +64,7 @@ static Registered registerCalibrate(CLI::App& app) {
     addCodecOption(cmd, o->cal.codec);
     // Any core number, also one this machine lacks: the calibration then measures without its
     // speed probe and says why (tests/cli/run_outputs_test.sh).
-    cmd->add_option("--core", o->cal.core, "Core to pin to (-1: none)")
-        ->check(CLI::Range(-1, 4096))
-        ->capture_default_str();
+    addInt(cmd, "--core", o->cal.core, "Core to pin to (-1: none)", -1, 4096);
     addLodOption(cmd, o->cal.lod_px);
     cmd->add_flag("--quick", o->cal.quick, "Fewer samples (what qvr run does before a run)");
     return {cmd, [o] {

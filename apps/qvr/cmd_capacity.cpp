@@ -1,14 +1,14 @@
 // `qvr capacity`: headsets per render server at a target frame rate, from a calibration and a
 // workload through the calibrated runtime model (sim/capacity.h holds the model and its limits).
 #include <cstdio>
-#include <fstream>
 #include <memory>
 
 #include <fmt/format.h>
 
+#include "cli_parse.h"
 #include "commands.h"
-#include "options.h"
 #include "qvr/core/design.h"
+#include "qvr/core/text_file.h"
 #include "qvr/sim/capacity.h"
 
 namespace qvr::cli {
@@ -34,10 +34,11 @@ int runCapacity(CapacityCmdOptions& o) {
         return 2;
     }
     fmt::print("{}", capacityText(*r, o.model));
-    if (!o.json.empty() && !(std::ofstream(o.json) << capacityJson(*r, o.model))) {
-        std::fprintf(stderr, "qvr capacity: cannot write '%s'\n", o.json.c_str());
-        return 1;
-    }
+    if (!o.json.empty())
+        if (Status st = writeTextFile(o.json, capacityJson(*r, o.model)); !st) {
+            std::fprintf(stderr, "qvr capacity: %s\n", st.error().c_str());
+            return 1;
+        }
     return 0;
 }
 
@@ -47,9 +48,7 @@ static Registered registerCapacity(CLI::App& app) {
     auto o = std::make_shared<CapacityCmdOptions>();
     CLI::App* cmd = app.add_subcommand(
         "capacity", "Headsets per render server at a target FPS (the calibrated runtime model)");
-    cmd->add_option("--hardware", o->hardware, "Calibration (qvr calibrate --out FILE)")
-        ->required()
-        ->check(readableFile());
+    addHardwareOption(cmd, o->hardware, "Calibration (qvr calibrate --out FILE)")->required();
     cmd->add_option("--trace", o->trace, "Workload (a qvr run's workload.jsonl, data/workloads/)")
         ->required()
         ->check(readableFile());
@@ -60,10 +59,8 @@ static Registered registerCapacity(CLI::App& app) {
         ->capture_default_str();
     cmd->add_option("--net", o->model.net, "Each headset's link (qvr run --net)")
         ->capture_default_str();
-    cmd->add_option("--headset-share", o->model.headset_share,
-                    "Each headset's share of its core (qvr run --headset-share)")
-        ->check(finiteRange(0.01, 1.0))
-        ->capture_default_str();
+    addFinite(cmd, "--headset-share", o->model.headset_share,
+              "Each headset's share of its core (qvr run --headset-share)", 0.01, 1.0);
     cmd->add_flag("--headsets-share-one-core", o->model.headsets_share_one_core,
                   "The headsets take turns on one core (qvr run --headsets on this machine)");
     cmd->add_option("--max-headsets", o->model.max_headsets)->check(CLI::Range(1, 64));

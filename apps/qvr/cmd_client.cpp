@@ -137,15 +137,11 @@ static Registered registerClient(CLI::App& app) {
     addKeyOptions(cmd, o->settings.key, o->settings.key_file);
     cmd->add_option("--scene", o->scene, "Scene")->capture_default_str();
     addProfileOption(cmd, o->settings.profile, ProfileNames::kRuntime);
-    cmd->add_option("--motion", o->motion, "Head motion: default, a .bvh, a pose CSV, still")
-        ->capture_default_str();
+    addMotionOption(cmd, o->motion);
     addGazeSourceOption(cmd, o->gaze);
     cmd->add_option("--design", o->settings.design, "local, remote, ffr, fixed:E, sw or qvr")
-        ->check(CLI::Validator(
-            [](std::string& name) -> std::string {
-                auto d = parseDesign(name, DesignScope::Runtime);
-                return d ? std::string() : d.error();
-            },
+        ->check(explainedBy(
+            [](const std::string& name) { return parseDesign(name, DesignScope::Runtime); },
             "DESIGN", "DESIGN"))
         ->capture_default_str();
     addCodecOption(cmd, o->settings.codec);
@@ -156,9 +152,7 @@ static Registered registerClient(CLI::App& app) {
     cmd->add_option("--server-stamps", o->server_stamps,
                     "The server's --stamps-csv file: its stages go on trace.json's timeline")
         ->check(CLI::Validator(serverStampsError, "FILE", "SERVER_STAMPS"));
-    cmd->add_option("--out", o->out, "Output folder (telemetry.csv, summary.json, trace.json)")
-        ->check(outputFolder())
-        ->capture_default_str();
+    addOutputFolderOption(cmd, o->out, "Output folder (telemetry.csv, summary.json, trace.json)");
     return {cmd, [o] { return runClient(*o); }};
 }
 

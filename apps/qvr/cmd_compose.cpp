@@ -53,9 +53,7 @@ static Registered registerCompose(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand(
         "compose", "Compose one frame's layers for a display pose with UCA and write a PNG");
     addProfileOption(cmd, opts->profile);
-    cmd->add_option("--e1", opts->e1_deg, "Fovea radius e1 in degrees (the layer plan)")
-        ->check(finiteRange(0.0, 180.0))
-        ->capture_default_str();
+    addFinite(cmd, "--e1", opts->e1_deg, "Fovea radius e1 in degrees (the layer plan)", 0.0, 180.0);
     addGazePointOption(cmd, opts->gaze);
     const CLI::Validator pose(
         [](std::string& text) -> std::string {

@@ -8,9 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "cli_parse.h"
 #include "command_error.h"
 #include "commands.h"
-#include "options.h"
 #include "qvr/controller/control_report.h"
 
 namespace qvr::cli {
@@ -70,14 +70,11 @@ static Registered registerControl(CLI::App& app) {
     cmd->add_option("--throughput-mbps", o->plan.throughput_mbps,
                     "Effective link throughput in Mbit/s (overrides --net)")
         ->check(finiteRange(0.01, 1e6));
-    cmd->add_option("--gpu-mhz", o->plan.gpu_mhz, "Mobile GPU clock; rates scale linearly")
-        ->check(finiteRange(50.0, 5000.0))
-        ->capture_default_str();
-    cmd->add_option("--e1", o->plan.fixed_e1_deg, "e1 of the fixed policy, degrees")
-        ->check(finiteRange(0.0, 90.0))
-        ->capture_default_str();
+    addFinite(cmd, "--gpu-mhz", o->plan.gpu_mhz, "Mobile GPU clock; rates scale linearly", 50.0,
+              5000.0);
+    addFinite(cmd, "--e1", o->plan.fixed_e1_deg, "e1 of the fixed policy, degrees", 0.0, 90.0);
     cmd->add_flag("--compare", o->plan.compare, "Also run every other policy and compare");
-    cmd->add_flag("--json", o->json, "Print machine-readable JSON");
+    addJsonFlag(cmd, o->json);
     return {cmd, [o] { return runControlCommand(*o); }};
 }
 QVR_REGISTER_COMMAND(30, registerControl);

@@ -9,9 +9,9 @@
 
 #include <fmt/format.h>
 
+#include "cli_parse.h"
 #include "command_error.h"
 #include "commands.h"
-#include "options.h"
 #include "qvr/sim/benches.h"
 #include "qvr/sim/eval_setup.h"
 
@@ -71,9 +71,7 @@ static Registered registerEval(CLI::App& app) {
         "Run the paper's experiments (Fig. 12-15, Table 4) on the recorded (or synthetic) suite");
     addFramesOption(cmd, o->eval.frames, 30, 100000,
                     "Frames per run (30..100000); Fig. 14 always gets at least 300");
-    cmd->add_option("--jobs", o->eval.jobs, "Runs simulated in parallel (threads)")
-        ->check(CLI::Range(1, 256))
-        ->capture_default_str();
+    addInt(cmd, "--jobs", o->eval.jobs, "Runs simulated in parallel (threads)", 1, 256);
     cmd->add_option("--bench", o->inputs.benches,
                     "Run only these suite workloads (repeatable); default: all of the suite");
     cmd->add_option("--suite", o->inputs.suite,
@@ -88,9 +86,7 @@ static Registered registerEval(CLI::App& app) {
                     "setting, §2.3), stream (our CRF 23), or auto (lossless when recorded); the "
                     "report shows the other beside it")
         ->capture_default_str();
-    cmd->add_option("--hardware", o->inputs.hardware,
-                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)")
-        ->check(readableFile());
+    addHardwareOption(cmd, o->inputs.hardware, kHardwareOverrideHelp);
     cmd->add_option("--mahimahi", o->inputs.mahimahi,
                     "Mahimahi capacity traces (e.g. ../shared/data/network/*.down) to replay, "
                     "rescaled to 100 Mbps, for ffr, dfr and qvr")
@@ -98,10 +94,9 @@ static Registered registerEval(CLI::App& app) {
     cmd->add_flag("--vsync", o->eval.vsync_paced,
                   "Pace every run to the HMD's vsync: frames start at most once per refresh and "
                   "are shown at the next vsync (MTP runs to it)");
-    cmd->add_option("--out", o->eval.out_dir,
-                    "Output folder: CSV + PNG per experiment, summary.json, report.html")
-        ->required()
-        ->check(outputFolder());
+    addOutputFolderOption(cmd, o->eval.out_dir,
+                          "Output folder: CSV + PNG per experiment, summary.json, report.html")
+        ->required();
     return {cmd, [o]() { return runEval(*o); }};
 }
 

@@ -117,9 +117,8 @@ static Registered registerRender(CLI::App& app) {
               "Extra lightmap brightening on top of the loader's overbright shift", 0.0, 16.0);
     addLodOption(cmd, o->plan.renderer.lod_error_px);
     addMsaaOption(cmd, o->plan.renderer.msaa_samples);
-    cmd->add_option("--out", o->out_dir, "Directory for the PNGs ({eye}_{layer}.png)")
-        ->required()
-        ->check(outputFolder());
+    addOutputFolderOption(cmd, o->out_dir, "Directory for the PNGs ({eye}_{layer}.png)")
+        ->required();
     addJsonFlag(cmd, o->json);
     return {cmd, [o]() { return run(*o); }};
 }

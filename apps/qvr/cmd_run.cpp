@@ -59,41 +59,29 @@ static Registered registerRun(CLI::App& app) {
         "run", "Server + headset on loopback (each on its own core): every design, measured");
     cmd->add_option("--scene", o->scene, "Scene (builtin:room, openarena:MAP, a file)")
         ->capture_default_str();
-    cmd->add_option("--motion", o->motion,
-                    "Head motion: default (CMU BVH), a .bvh, a pose CSV, still")
-        ->capture_default_str();
+    addMotionOption(cmd, o->motion);
     addGazeSourceOption(cmd, o->gaze);
     addLinkOption(cmd, o->net);
     addFramesOption(cmd, o->frames, 2, 100000, "Frames per design");
     cmd->add_option("--designs", o->designs,
                     "Comma-separated: local, remote, ffr (= fixed:5), fixed:E for any e1 E in "
                     "degrees, sw, qvr, aimd")
-        ->check(CLI::Validator(
-            [](std::string& list) -> std::string {
-                auto designs = parseDesignList(list, DesignScope::Runtime);
-                return designs ? std::string() : designs.error();
-            },
+        ->check(explainedBy(
+            [](const std::string& list) { return parseDesignList(list, DesignScope::Runtime); },
             "DESIGNS", "DESIGNS"))
         ->capture_default_str();
     addProfileOption(cmd, o->profile, ProfileNames::kRuntime);
-    cmd->add_option("--out", o->out, "Output folder")->check(outputFolder())->capture_default_str();
+    addOutputFolderOption(cmd, o->out, "Output folder");
     addCodecOption(cmd, o->codec);
     addSeedOption(cmd, o->seed, "Gaze model and simulator seed");
-    cmd->add_option("--remote-timeout-ms", o->remote_timeout_ms,
-                    "Remote layers later than this after the local render are late (frame reuse)")
-        ->check(finiteRange(1.0, 10000.0))
-        ->capture_default_str();
-    cmd->add_flag("--one-pass-periphery", o->one_pass_periphery,
-                  "Server renders middle and outer in one geometry pass per eye (pays when "
-                  "vertex-bound: no LOD, small displays)");
-    cmd->add_flag("--no-holes", o->no_holes,
-                  "Server draws every periphery layer whole, also where the headset's fovea (or "
-                  "the middle layer) covers it");
-    cmd->add_option("--headset-share", o->headset_share,
-                    "Fraction of its core the headset process may use (CFS quota per 10 ms, "
-                    "cgroups; needs root): the analogue of Table 4's slower headset GPUs")
-        ->check(finiteRange(CpuShareGroup::kMinShare + 1e-9, 1.0))
-        ->capture_default_str();
+    addFinite(cmd, "--remote-timeout-ms", o->remote_timeout_ms,
+              "Remote layers later than this after the local render are late (frame reuse)", 1.0,
+              10000.0);
+    addPeripheryPassFlags(cmd, o->one_pass_periphery, o->no_holes);
+    addFinite(cmd, "--headset-share", o->headset_share,
+              "Fraction of its core the headset process may use (CFS quota per 10 ms, cgroups; "
+              "needs root): the analogue of Table 4's slower headset GPUs",
+              CpuShareGroup::kMinShare + 1e-9, 1.0);
     cmd->add_option("--ring-counts", o->ring_counts,
                     "LIWC's triangle rings: clusters (what the fovea draws, cheap) or bvh "
                     "(every scene triangle, exact, the earlier input)")
@@ -107,31 +95,26 @@ static Registered registerRun(CLI::App& app) {
                     "logged, but left out of FPS, MTP, bytes and e1; their worst MTP is reported "
                     "apart")
         ->capture_default_str();
-    cmd->add_option("--pipeline", o->pipeline_depth,
-                    "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before "
-                    "finishing n)")
-        ->check(CLI::Range(1, 2))
-        ->capture_default_str();
-    cmd->add_option("--hardware", o->hardware,
-                    "Calibration for the prediction (qvr calibrate --out FILE); without it the "
-                    "cached calibration of this machine, or a fresh one measured first")
-        ->check(readableFile());
+    addInt(cmd, "--pipeline", o->pipeline_depth,
+           "Frames in flight on the headset: 1 (sequential) or 2 (request n+1 before finishing n)",
+           1, 2);
+    addHardwareOption(cmd, o->hardware,
+                      "Calibration for the prediction (qvr calibrate --out FILE); without it the "
+                      "cached calibration of this machine, or a fresh one measured first");
     cmd->add_flag("--recalibrate", o->recalibrate,
                   "Measure the calibration again even when a cached one exists");
     cmd->add_flag("!--no-video", o->video, "Do not record the qvr display video");
     cmd->add_flag("--quiet", o->quiet, "No progress line on a terminal");
-    cmd->add_option("--headsets", o->headsets,
-                    "Headsets on the one server, each design run with all at once (each its own "
-                    "motion recording and gaze seed; the others in processes of their own)")
-        ->check(CLI::Range(kMinHeadsets, kMaxHeadsets))
-        ->capture_default_str();
+    addInt(cmd, "--headsets", o->headsets,
+           "Headsets on the one server, each design run with all at once (each its own motion "
+           "recording and gaze seed; the others in processes of their own)",
+           kMinHeadsets, kMaxHeadsets);
     cmd->add_flag("--identical-workloads", o->identical_workloads,
                   "Every headset the same motion and gaze (--motion, --gaze, --seed)");
-    cmd->add_option("--quality-every", o->quality_every,
-                    "Measure every Nth displayed frame against a full-resolution render after "
-                    "each design's run (0: off)")
-        ->check(CLI::Range(0, 100000))
-        ->capture_default_str();
+    addInt(cmd, "--quality-every", o->quality_every,
+           "Measure every Nth displayed frame against a full-resolution render after each "
+           "design's run (0: off)",
+           0, 100000);
     cmd->add_flag("!--no-fovea-border", o->fovea_border,
                   "Do not draw the e1 circle (the fovea layer's edge) in the video");
     return {

@@ -146,15 +146,12 @@ static Registered registerServer(CLI::App& app) {
     addCodecOption(cmd, o->settings.codec);
     addCoreOption(cmd, o->settings.core, "Pin the server (all its threads) to this core (-1: no)");
     addLodOption(cmd, o->settings.lod_px);
-    cmd->add_option("--workers", o->settings.workers,
-                    "Render workers (0: one per core the server may use; 1 with --core)")
-        ->check(CLI::Range(0, 64))
-        ->capture_default_str();
-    cmd->add_option("--min-fps", o->settings.min_fps,
-                    "Refuse a headset that would take the admitted ones below this frame rate "
-                    "(0: off; docs/RUNTIME.md)")
-        ->check(finiteRange(0.0, 1000.0))
-        ->capture_default_str();
+    addInt(cmd, "--workers", o->settings.workers,
+           "Render workers (0: one per core the server may use; 1 with --core)", 0, 64);
+    addFinite(cmd, "--min-fps", o->settings.min_fps,
+              "Refuse a headset that would take the admitted ones below this frame rate (0: off; "
+              "docs/RUNTIME.md)",
+              0.0, 1000.0);
     cmd->add_option("--calibration", o->calibration,
                     "Hardware file (qvr calibrate) whose server frame time admission starts from")
         ->check(readableFile());
@@ -167,17 +164,12 @@ static Registered registerServer(CLI::App& app) {
                     "Write one row per served frame (per-layer render, read-back, encode, send) "
                     "here on exit")
         ->check(writableFile());
-    cmd->add_flag("--no-holes", o->settings.no_holes,
-                  "Draw every periphery layer whole, also where the compositor takes a finer "
-                  "layer");
-    cmd->add_flag("--one-pass-periphery", o->settings.one_pass_periphery,
-                  "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
+    addPeripheryPassFlags(cmd, o->settings.one_pass_periphery, o->settings.no_holes);
     cmd->add_flag("--agones", o->agones,
                   "Report Ready, Health and Shutdown to Agones' SDK sidecar at "
                   "localhost:$AGONES_SDK_HTTP_PORT (docs/DEPLOY.md)");
-    cmd->add_option("--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)")
-        ->check(finiteRange(0.0, kMaxDurationS))
-        ->capture_default_str();
+    addFinite(cmd, "--duration-s", o->duration_s, "Stop after this many seconds (0: on signal)",
+              0.0, kMaxDurationS);
     return {cmd, [o] { return runServer(*o); }};
 }
 

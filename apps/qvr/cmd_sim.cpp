@@ -6,9 +6,9 @@
 
 #include <fmt/format.h>
 
+#include "cli_parse.h"
 #include "command_error.h"
 #include "commands.h"
-#include "options.h"
 #include "qvr/sim/benches.h"
 #include "qvr/sim/network.h"
 #include "qvr/sim/sim_run.h"
@@ -99,29 +99,22 @@ static Registered registerSim(CLI::App& app) {
                         " (local baseline, remote-only, static collaborative, fixed 5-deg fovea, "
                         "LIWC without UCA, software Q-VR, Q-VR)")
         ->capture_default_str();
-    cmd->add_option("--gpu-mhz", o->gpu_mhz,
-                    "Mobile GPU clock in MHz; the paper uses 500 (default), 400 and 300")
-        ->check(finiteRange(50.0, 3000.0))
-        ->capture_default_str();
+    addFinite(cmd, "--gpu-mhz", o->gpu_mhz,
+              "Mobile GPU clock in MHz; the paper uses 500 (default), 400 and 300", 50.0, 3000.0);
     cmd->add_option("--net", o->net,
                     "Network: wifi (200 Mbps), lte (100), 5g (500), each with 20 dB SNR noise, or "
                     "trace:FILE[@MBPS] for a Mahimahi trace rescaled to MBPS (default 100)")
         ->capture_default_str();
     addFramesOption(cmd, o->frames, 1, 1'000'000, "Frames to simulate (1..1000000)");
-    cmd->add_option("--hardware", o->hardware,
-                    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)")
-        ->check(readableFile());
+    addHardwareOption(cmd, o->hardware, kHardwareOverrideHelp);
     cmd->add_option("--pipeline", o->pipeline,
                     "Pipeline model: paper (Fig. 4, the default) or runtime (qvr run's, with the "
                     "hardware file's calibrated costs; the default when that file says so)")
         ->check(CLI::IsMember({"paper", "runtime"}));
-    cmd->add_option("--depth", o->depth, "Runtime pipeline: frames in flight (1 or 2)")
-        ->check(CLI::Range(1, 2))
-        ->capture_default_str();
-    cmd->add_option("--wait-limit-ms", o->wait_limit_ms,
-                    "Runtime pipeline: remote layers later than this are late (frame reuse)")
-        ->check(finiteRange(1.0, 10000.0))
-        ->capture_default_str();
+    addInt(cmd, "--depth", o->depth, "Runtime pipeline: frames in flight (1 or 2)", 1, 2);
+    addFinite(cmd, "--wait-limit-ms", o->wait_limit_ms,
+              "Runtime pipeline: remote layers later than this are late (frame reuse)", 1.0,
+              10000.0);
     cmd->add_option("--codec-model", o->codec_model,
                     "Periphery bytes from the trace's lossless (the paper's, §2.3) or stream "
                     "(CRF 23) measurements; auto: lossless when recorded")
@@ -135,9 +128,7 @@ static Registered registerSim(CLI::App& app) {
             "auto|lossless|stream", "CODEC_MODEL"))
         ->capture_default_str();
     addSeedOption(cmd, o->seed, "Seed of the network noise");
-    cmd->add_option("--out", o->out, "Output folder for frames.csv and summary.json")
-        ->required()
-        ->check(outputFolder());
+    addOutputFolderOption(cmd, o->out, "Output folder for frames.csv and summary.json")->required();
     return {cmd, [o]() { return runSim(*o); }};
 }
 

@@ -65,10 +65,9 @@ static Registered registerSweep(CLI::App& app) {
                     "Takes of the adaptive designs and the best fixed e1 after the first")
         ->capture_default_str();
     addFramesOption(cmd, a->frames, 20, 100000, "Frames per design per run");
-    cmd->add_option("--hardware", a->hardware, "Calibration for every run's prediction")
-        ->check(readableFile());
+    addHardwareOption(cmd, a->hardware, "Calibration for every run's prediction");
     addProfileOption(cmd, a->profile, ProfileNames::kRuntime);
-    cmd->add_option("--out", a->out, "Output folder")->check(outputFolder())->capture_default_str();
+    addOutputFolderOption(cmd, a->out, "Output folder");
     cmd->add_flag("--dry-run", a->dry_run, "Print the conditions without running them");
     return {cmd, [a] { return runSweepCommand(*a); }};
 }

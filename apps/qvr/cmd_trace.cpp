@@ -83,9 +83,7 @@ Registered registerTraceMotion(CLI::App& parent) {
     def->excludes(bvh);
     addFinite(cmd, "--rate", o->head.rate_hz, "Display rate to resample to, Hz", 1.0, 1000.0);
     addFramesOption(cmd, o->head.frames, 0, 100'000'000, "Poses to write (0: the whole recording)");
-    cmd->add_option("--out", o->out, "Output CSV (t_ms,qw,qx,qy,qz,x,y,z)")
-        ->required()
-        ->check(writableFile());
+    addOutputFileOption(cmd, o->out, "Output CSV (t_ms,qw,qx,qy,qz,x,y,z)");
     cmd->add_option("--unit", o->unit, "BVH length unit: auto, m, cm, inch or cmu (1/0.45 in)")
         ->capture_default_str();
     cmd->add_option("--joint", o->head.head_joint,
@@ -115,9 +113,7 @@ Registered registerTraceGaze(CLI::App& parent) {
         "gaze", "Seeded gaze trace (CSV): fixations, main-sequence saccades, 120 Hz samples");
     addSeedOption(cmd, o->seed, "Random seed; the same seed gives the same trace");
     addFramesOption(cmd, o->frames, 1, 100'000'000, "Eye-tracker samples to write");
-    cmd->add_option("--out", o->out, "Output CSV (t_ms,x_deg,y_deg)")
-        ->required()
-        ->check(writableFile());
+    addOutputFileOption(cmd, o->out, "Output CSV (t_ms,x_deg,y_deg)");
     GazeModelConfig& m = o->model;
     addFinite(cmd, "--rate", m.sample_rate_hz, "Eye-tracker sample rate, Hz", 1.0, 2000.0);
     addFinite(cmd, "--pursuit", m.pursuit_probability,

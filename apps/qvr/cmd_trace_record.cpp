@@ -61,9 +61,7 @@ Registered registerTraceRecord(CLI::App& parent) {
            "Foreground objects for a scene that marks no interactive objects (a model file): the "
            "nearest visible ones",
            0, 1000);
-    cmd->add_option("--out", o->out, "Output workload trace (JSON lines)")
-        ->required()
-        ->check(writableFile());
+    addOutputFileOption(cmd, o->out, "Output workload trace (JSON lines)");
     cmd->add_flag("--quiet", o->quiet, "No progress line");
     Action action = [o]() -> int {
         o->record.profile = checkedHmdProfile(o->profile);

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.h"
 #include "commands.h"
-#include "options.h"
 #include "qvr/experiment/validation.h"
 #include "qvr/runtime/server_process.h"
 #include "qvr/sim/hardware.h"
@@ -177,24 +177,19 @@ static Registered registerValidate(CLI::App& app) {
                     "Calibrate on this scene only and predict every scene's runs with it (out of "
                     "sample); default: each scene calibrated on itself");
     addFramesOption(cmd, o->frames, 5, 100000, "Frames per design per run");
-    cmd->add_option("--reps", o->reps, "Repetitions of every condition")
-        ->check(CLI::Range(1, 20))
-        ->capture_default_str();
-    cmd->add_option("--retakes", o->retakes,
-                    "Take a run again, up to this many times, when its speed probes moved over "
-                    "10% across it or from the calibration's; the steadiest take counts")
-        ->check(CLI::Range(0, 5))
-        ->capture_default_str();
-    cmd->add_option("--hardware", o->hardware,
-                    "Use this calibration instead of calibrating (one scene)")
-        ->check(readableFile());
+    addInt(cmd, "--reps", o->reps, "Repetitions of every condition", 1, 20);
+    addInt(cmd, "--retakes", o->retakes,
+           "Take a run again, up to this many times, when its speed probes moved over 10% across "
+           "it or from the calibration's; the steadiest take counts",
+           0, 5);
+    addHardwareOption(cmd, o->hardware, "Use this calibration instead of calibrating (one scene)");
     cmd->add_option("--calibrate", o->calibrate,
                     "per-rep: each repetition calibrates each scene anew before its runs; once: "
                     "one calibration per scene before any run")
         ->check(CLI::IsMember({"per-rep", "once"}))
         ->capture_default_str();
     addProfileOption(cmd, o->profile, ProfileNames::kRuntime);
-    cmd->add_option("--out", o->out, "Output folder")->check(outputFolder())->capture_default_str();
+    addOutputFolderOption(cmd, o->out, "Output folder");
     cmd->add_flag("--dry-run", o->dry_run, "Print the commands without running them");
     return {cmd, [o] { return runValidate(*o); }};
 }

@@ -155,16 +155,14 @@ CLI::Option* addProfileOption(CLI::App* cmd, std::string& profile, ProfileNames 
         fmt::format("Display profile: default (1920x2160), low (1280x1600){} or a TOML file",
                     with_runtime ? ", run (480x540), small (320x360)" : "");
     return cmd->add_option("--profile", profile, help)
-        ->check(CLI::Validator(
-            [with_runtime](std::string& name) -> std::string {
+        ->check(explainedBy(
+            [with_runtime](const std::string& name) {
 #ifdef QVR_HAVE_RUNTIME
-                auto p =
-                    with_runtime ? runtime::runtimeProfileByName(name) : hmdProfileByName(name);
+                return with_runtime ? runtime::runtimeProfileByName(name) : hmdProfileByName(name);
 #else
                 (void)with_runtime;
-                auto p = hmdProfileByName(name);
+                return hmdProfileByName(name);
 #endif
-                return p ? std::string() : p.error();
             },
             "PROFILE", "PROFILE"))
         ->capture_default_str();
@@ -222,6 +220,25 @@ CLI::Option* addCoreOption(CLI::App* cmd, int& core, const std::string& help) {
         ->capture_default_str();
 }
 
+CLI::Option* addHardwareOption(CLI::App* cmd, std::string& hardware, const std::string& help) {
+    return cmd->add_option("--hardware", hardware, help)->check(readableFile());
+}
+
+CLI::Option* addOutputFolderOption(CLI::App* cmd, std::string& out, const std::string& help) {
+    return cmd->add_option("--out", out, help)->check(outputFolder())->capture_default_str();
+}
+
+CLI::Option* addOutputFileOption(CLI::App* cmd, std::string& out, const std::string& help) {
+    return cmd->add_option("--out", out, help)->required()->check(writableFile());
+}
+
+CLI::Option* addMotionOption(CLI::App* cmd, std::string& motion) {
+    return cmd
+        ->add_option("--motion", motion,
+                     "Head motion: default (CMU BVH), a .bvh, a pose CSV, still")
+        ->capture_default_str();
+}
+
 CLI::Option* addLodOption(CLI::App* cmd, float& lod_px) {
     return addFinite(cmd, "--lod-px", lod_px,
                      "Level of detail: largest vertex move in each view's own pixels (0: full "
@@ -240,12 +257,11 @@ CLI::Option* addCodecOption(CLI::App* cmd, std::string& codec) {
     return cmd
         ->add_option("--codec", codec,
                      "Codec backend: x264 or raw (a client's must match its server's)")
-        ->check(CLI::Validator(
-            [](std::string& backend) -> std::string {
+        ->check(explainedBy(
+            [](const std::string& backend) {
                 CodecConfig config;
                 config.backend = backend;
-                const Status st = validateCodecConfig(config);
-                return st ? std::string() : st.error();
+                return validateCodecConfig(config);
             },
             "x264|raw", "CODEC"))
         ->capture_default_str();
@@ -256,13 +272,18 @@ CLI::Option* addLinkOption(CLI::App* cmd, std::string& net) {
         ->add_option("--net", net,
                      "Link spec for net's emulator: none, wifi, lte, 5g, rate:MBPS, trace:FILE, "
                      "with impairments after commas (core/link_spec.h)")
-        ->check(CLI::Validator(
-            [](std::string& spec) -> std::string {
-                auto link = qvr::loadLinkSpec(spec);
-                return link ? std::string() : link.error();
-            },
-            "LINK", "LINK"))
+        ->check(explainedBy([](const std::string& spec) { return qvr::loadLinkSpec(spec); }, "LINK",
+                            "LINK"))
         ->capture_default_str();
+}
+
+void addPeripheryPassFlags(CLI::App* cmd, bool& one_pass_periphery, bool& no_holes) {
+    cmd->add_flag("--one-pass-periphery", one_pass_periphery,
+                  "Server renders middle and outer in one geometry pass per eye (pays when "
+                  "vertex-bound: no LOD, small displays)");
+    cmd->add_flag("--no-holes", no_holes,
+                  "Server draws every periphery layer whole, also where the headset's fovea (or "
+                  "the middle layer) covers it");
 }
 #endif
 

@@ -40,6 +40,18 @@ std::string outputFolderError(const std::string& dir);
 // Why `path` cannot be written as an output file (empty when it can); see writableFile.
 std::string writableFileError(const std::string& path, bool make_folder);
 
+// A check from a parser that says why it refuses: `parse(text)` returns an Expected or a Status,
+// whose error is the message.
+template <typename Parse>
+CLI::Validator explainedBy(Parse parse, const std::string& desc, const std::string& name) {
+    return CLI::Validator(
+        [parse](std::string& text) -> std::string {
+            const auto parsed = parse(text);
+            return parsed ? std::string() : parsed.error();
+        },
+        desc, name);
+}
+
 // --- shared options --------------------------------------------------------------------------
 
 // Which display profiles a command knows: the HMD profiles of the paper, or also the small
@@ -62,6 +74,17 @@ CLI::Option* addSeedOption(CLI::App* cmd, uint64_t& seed, const std::string& hel
                            const std::string& name = "--seed");
 // --core: -1 (no pinning) or a core this process may run on.
 CLI::Option* addCoreOption(CLI::App* cmd, int& core, const std::string& help);
+// The help of --hardware where the file overrides the simulator's modelled constants.
+inline constexpr const char* kHardwareOverrideHelp =
+    "TOML file overriding the modelled hardware's constants (docs/MODEL.md)";
+// --hardware: a hardware file (sim/hardware.h) to read; `help` says what the command takes it for.
+CLI::Option* addHardwareOption(CLI::App* cmd, std::string& hardware, const std::string& help);
+// --out as the folder the command writes into, checked before the work starts.
+CLI::Option* addOutputFolderOption(CLI::App* cmd, std::string& out, const std::string& help);
+// --out as the one file the command writes (required), checked before the work starts.
+CLI::Option* addOutputFileOption(CLI::App* cmd, std::string& out, const std::string& help);
+// --motion: a head motion for the runtime (default, a .bvh, a pose CSV, still).
+CLI::Option* addMotionOption(CLI::App* cmd, std::string& motion);
 // --lod-px (render/draw_list.h): each view draws every scene cluster at the coarsest level of
 // detail whose vertices move at most this many of the view's own pixels; 0 draws full detail.
 CLI::Option* addLodOption(CLI::App* cmd, float& lod_px);
@@ -73,6 +96,8 @@ void addKeyOptions(CLI::App* cmd, std::string& key, std::string& key_file);
 CLI::Option* addCodecOption(CLI::App* cmd, std::string& codec);
 // --net: a link spec for net's emulator (net/link_emulator.h's grammar).
 CLI::Option* addLinkOption(CLI::App* cmd, std::string& net);
+// --one-pass-periphery and --no-holes: how the render server draws the periphery layers.
+void addPeripheryPassFlags(CLI::App* cmd, bool& one_pass_periphery, bool& no_holes);
 #endif
 
 }  // namespace qvr::cli

@@ -15,13 +15,14 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "qvr/core/design.h"
+#include "qvr/core/text_file.h"
 #include "qvr/experiment/run_experiment.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/runtime/affinity.h"
@@ -36,39 +37,42 @@ namespace qvr::experiment {
 using namespace qvr::runtime;
 namespace fs = std::filesystem;
 
+namespace {
+
+// The fields of a summary the child sends its parent, each with its key: summaryToJson writes
+// them and summaryFromJson reads them, so the two sides cannot drift apart.
+template <typename Summary, typename Visit>
+void visitSentFields(Summary& s, Visit visit) {
+    visit("design", s.design);
+    visit("frames", s.frames);
+    visit("frames_displayed", s.frames_displayed);
+    visit("frames_reused", s.frames_reused);
+    visit("fps_mean", s.fps_mean);
+    visit("mtp_ms_mean", s.mtp_ms_mean);
+    visit("mtp_ms_p99", s.mtp_ms_p99);
+    visit("bytes_per_frame_mean", s.bytes_per_frame_mean);
+    visit("e1_deg_mean", s.e1_deg_mean);
+    visit("t_local_ms_mean", s.t_local_ms_mean);
+    visit("t_remote_ms_mean", s.t_remote_ms_mean);
+    visit("headset_busy_ms_mean", s.headset_busy_ms_mean);
+    visit("warmup_frames", s.warmup_frames);
+    visit("startup_unfinished", s.startup_unfinished);
+}
+
+}  // namespace
+
 nlohmann::json summaryToJson(const DesignSummary& s) {
-    return {{"design", s.design},
-            {"frames", s.frames},
-            {"frames_displayed", s.frames_displayed},
-            {"frames_reused", s.frames_reused},
-            {"fps_mean", s.fps_mean},
-            {"mtp_ms_mean", s.mtp_ms_mean},
-            {"mtp_ms_p99", s.mtp_ms_p99},
-            {"bytes_per_frame_mean", s.bytes_per_frame_mean},
-            {"e1_deg_mean", s.e1_deg_mean},
-            {"t_local_ms_mean", s.t_local_ms_mean},
-            {"t_remote_ms_mean", s.t_remote_ms_mean},
-            {"headset_busy_ms_mean", s.headset_busy_ms_mean},
-            {"warmup_frames", s.warmup_frames},
-            {"startup_unfinished", s.startup_unfinished}};
+    nlohmann::json j = nlohmann::json::object();
+    visitSentFields(s, [&j](const char* key, const auto& value) { j[key] = value; });
+    return j;
 }
 
 DesignSummary summaryFromJson(const nlohmann::json& j) {
     DesignSummary s;
-    s.design = j.value("design", "");
-    s.frames = j.value("frames", 0);
-    s.frames_displayed = j.value("frames_displayed", 0);
-    s.frames_reused = j.value("frames_reused", 0);
-    s.fps_mean = j.value("fps_mean", 0.0);
-    s.mtp_ms_mean = j.value("mtp_ms_mean", 0.0);
-    s.mtp_ms_p99 = j.value("mtp_ms_p99", 0.0);
-    s.bytes_per_frame_mean = j.value("bytes_per_frame_mean", 0.0);
-    s.e1_deg_mean = j.value("e1_deg_mean", 0.0);
-    s.t_local_ms_mean = j.value("t_local_ms_mean", 0.0);
-    s.t_remote_ms_mean = j.value("t_remote_ms_mean", 0.0);
-    s.headset_busy_ms_mean = j.value("headset_busy_ms_mean", 0.0);
-    s.warmup_frames = j.value("warmup_frames", 0);
-    s.startup_unfinished = j.value("startup_unfinished", false);
+    // A key the child did not send leaves the field at zero (an empty design name).
+    visitSentFields(s, [&j](const char* key, auto& value) {
+        value = j.value(key, std::decay_t<decltype(value)>{});
+    });
     return s;
 }
 
@@ -378,7 +382,8 @@ int runHeadsetChild() {
         if (auto st = writeTelemetryCsv(csv, label, result->frames); !st)
             std::fprintf(stderr, "qvr run-headset: %s\n", st.error().c_str());
     if (const std::string path = s.value("summary_json", ""); !path.empty())
-        std::ofstream(path) << summary.dump(2) << "\n";
+        if (Status st = writeJsonFile(path, summary); !st)
+            std::fprintf(stderr, "qvr run-headset: %s\n", st.error().c_str());
     std::printf("result %s\n", summary.dump().c_str());
     std::fflush(stdout);
     return 0;

@@ -129,26 +129,29 @@ Expected<std::vector<std::string>> adaptiveDesigns(const std::string& list,
     return out;
 }
 
-Expected<std::vector<std::string>> checkedMotions(const std::string& list) {
+// The items of the comma-separated `list` given as `option`: at least one, each a name
+// `is_named` accepts or an existing file.
+Expected<std::vector<std::string>> checkedInputs(const std::string& option, const std::string& list,
+                                                 bool (*is_named)(const std::string&)) {
     std::vector<std::string> out = splitItems(list);
     std::error_code ec;
-    for (const std::string& m : out)
-        if (m != "default" && m != "still" && !fs::is_regular_file(m, ec))
-            return makeError(fmt::format("--motions: {}: no such file", m));
+    for (const std::string& item : out)
+        if (!is_named(item) && !fs::is_regular_file(item, ec))
+            return makeError(fmt::format("{}: {}: no such file", option, item));
     if (out.empty())
-        return makeError(std::string("--motions: none given"));
+        return makeError(fmt::format("{}: none given", option));
     return out;
 }
 
+Expected<std::vector<std::string>> checkedMotions(const std::string& list) {
+    return checkedInputs("--motions", list,
+                         [](const std::string& m) { return m == "default" || m == "still"; });
+}
+
 Expected<std::vector<std::string>> checkedScenes(const std::string& list) {
-    std::vector<std::string> out = splitItems(list);
-    std::error_code ec;
-    for (const std::string& s : out)
-        if (s.find(':') == std::string::npos && !fs::is_regular_file(s, ec))
-            return makeError(fmt::format("--scenes: {}: no such file", s));
-    if (out.empty())
-        return makeError(std::string("--scenes: none given"));
-    return out;
+    // builtin:room, openarena:MAP, ...: a scene with a source prefix is not a file.
+    return checkedInputs("--scenes", list,
+                         [](const std::string& s) { return s.find(':') != std::string::npos; });
 }
 
 }  // namespace

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "qvr/core/text_file.h"
 #include "qvr/experiment/host.h"
 #include "qvr/experiment/sweep.h"
 
@@ -271,9 +271,11 @@ int runSweep(const SweepOptions& o, ConditionRunner& runner, std::FILE* out, std
     const std::string md = sweepMarkdown(o, result);
     fmt::print(out, "\n{}", md);
     const fs::path dir(o.out);
-    std::ofstream(dir / "sweep.md") << md;
-    std::ofstream(dir / "sweep.csv") << sweepCsv(result);
-    std::ofstream(dir / "sweep.json") << sweepJson(o, result).dump(2) << "\n";
+    for (const Status& st : {writeTextFile((dir / "sweep.md").string(), md),
+                             writeTextFile((dir / "sweep.csv").string(), sweepCsv(result)),
+                             writeJsonFile((dir / "sweep.json").string(), sweepJson(o, result))})
+        if (!st)
+            fmt::print(err, "qvr sweep: {}\n", st.error());
     fmt::print(out, "  wrote {}/sweep.md, sweep.csv and sweep.json\n", o.out);
     if (result.stop_signal != 0) {
         fmt::print(err, "qvr sweep: stopped by signal {}\n", result.stop_signal);

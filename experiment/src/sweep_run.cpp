@@ -99,10 +99,7 @@ ChildCommand ProcessConditionRunner::command(const SweepCondition& c,
                                              const std::vector<std::string>& designs,
                                              const std::string& tag) const {
     const SweepOptions& o = m_options;
-    ChildCommand cmd;
-    cmd.output = (fs::path(o.out) / tag).string();
-    cmd.log_path = cmd.output + ".log";
-    cmd.result_path = (fs::path(cmd.output) / "summary.json").string();
+    ChildCommand cmd = runChildIn((fs::path(o.out) / tag).string());
     cmd.line = fmt::format(
         "{} run --scene {} --motion {} --seed {} --net {} --headset-share {:g} --designs {} "
         "--frames {} --profile {}{} --no-video --quality-every 0 --quiet --out {} > {} 2>&1",

@@ -5,10 +5,10 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include <fmt/format.h>
 
+#include "qvr/core/text_file.h"
 #include "qvr/experiment/calibration.h"
 #include "qvr/experiment/host.h"
 
@@ -253,8 +253,11 @@ int runValidation(const ValidationOptions& options, ChildRunner& runner, std::FI
     const std::string md = validationMarkdown(plan, result);
     fmt::print(out, "\n{}", md);
     const fs::path dir(options.out);
-    std::ofstream(dir / "validation.md") << md;
-    std::ofstream(dir / "validation.json") << validationJson(plan, result).dump(2) << "\n";
+    for (const Status& st :
+         {writeTextFile((dir / "validation.md").string(), md),
+          writeJsonFile((dir / "validation.json").string(), validationJson(plan, result))})
+        if (!st)
+            fmt::print(err, "qvr validate: {}\n", st.error());
     fmt::print(out, "  wrote {}/validation.md and validation.json\n", options.out);
     if (result.stop_signal != 0)
         fmt::print(err, "qvr validate: stopped by signal {}\n", result.stop_signal);

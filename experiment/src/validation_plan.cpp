@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -113,18 +114,23 @@ ChildCommand calibrationTake(const ValidationPlan& plan, size_t calibration, int
     return cmd;
 }
 
+ChildCommand runChildIn(std::string output) {
+    ChildCommand cmd;
+    cmd.output = std::move(output);
+    cmd.log_path = cmd.output + ".log";
+    cmd.result_path = (fs::path(cmd.output) / "summary.json").string();
+    return cmd;
+}
+
 ChildCommand runTake(const ValidationPlan& plan, size_t run, int take,
                      const std::string& calibration_file) {
     const ValidationOptions& o = plan.options;
     const PlannedRun& r = plan.runs.at(run);
-    ChildCommand cmd;
-    cmd.output =
+    ChildCommand cmd = runChildIn(
         (fs::path(o.out) / fmt::format("{}_{}_d{}{}_r{}{}", safeName(r.scene), safeName(r.link),
                                        r.depth, conditionSuffix(r), r.rep + 1,
                                        take == 0 ? "" : fmt::format("_t{}", take + 1)))
-            .string();
-    cmd.log_path = cmd.output + ".log";
-    cmd.result_path = (fs::path(cmd.output) / "summary.json").string();
+            .string());
     cmd.line = fmt::format(
         "{} run --scene {} --net {} --pipeline {} --designs {} --frames {} --profile {} "
         "--hardware {}{}{} --no-video --out {} > {} 2>&1",

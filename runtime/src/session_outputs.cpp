@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "qvr/core/run_summary_json.h"
+#include "qvr/core/text_file.h"
 
 namespace qvr::runtime {
 
@@ -92,8 +93,7 @@ Status writeClientOutputs(const std::filesystem::path& out, const ClientSession&
     j["trace"] = chromeTraceJson(*trace);
     j["trace"]["frames"] = result.frames.size();
     j["trace"]["first_frame"] = result.frames.empty() ? 0 : result.frames.front().frame;
-    std::ofstream(out / "summary.json") << j.dump(2) << "\n";
-    return {};
+    return writeJsonFile((out / "summary.json").string(), j);
 }
 
 ServerStampsRead readServerStampsAfterSession(const std::string& path) {
@@ -218,12 +218,10 @@ Status writeServerFramesCsv(const std::string& path,
 Status writeServerOutputs(const ServerOutputs& outputs, const RenderServerStats& s, int core,
                           const std::vector<ServerFrameRecord>& records) {
     if (!outputs.stats_json.empty()) {
-        std::ofstream f(outputs.stats_json);
         nlohmann::json j = serverStatsJson(s, core);
         j.update(serverPoolJson(s));  // "workers", "admission", "sessions"
-        f << j.dump(2) << "\n";
-        if (!f)
-            return makeError("cannot write '" + outputs.stats_json + "'");
+        if (Status st = writeJsonFile(outputs.stats_json, j); !st)
+            return st;
     }
     if (!outputs.frames_csv.empty())
         return writeServerFramesCsv(outputs.frames_csv, records);

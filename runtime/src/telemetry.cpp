@@ -1,9 +1,11 @@
 // Telemetry: CSV rows and the per-design summary `qvr run` writes.
 #include "qvr/runtime/telemetry.h"
 
-#include <fstream>
+#include <string>
 
 #include <fmt/format.h>
+
+#include "qvr/core/text_file.h"
 
 namespace qvr::runtime {
 
@@ -79,15 +81,10 @@ std::string telemetryCsvRow(const std::string& design, const FrameTelemetry& t) 
 
 Status writeTelemetryCsv(const std::string& path, const std::string& design,
                          const std::vector<FrameTelemetry>& frames) {
-    std::ofstream out(path);
-    if (!out)
-        return makeError("cannot write " + path);
-    out << telemetryCsvHeader();
+    std::string text = telemetryCsvHeader();
     for (const FrameTelemetry& t : frames)
-        out << telemetryCsvRow(design, t);
-    if (!out)
-        return makeError("error writing " + path);
-    return {};
+        text += telemetryCsvRow(design, t);
+    return writeTextFile(path, text);
 }
 
 }  // namespace qvr::runtime

@@ -7,7 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "eval_internal.h"
+#include "qvr/core/text_file.h"
 #include "qvr/sim/benches.h"
 
 namespace qvr {
@@ -87,16 +88,6 @@ bool mostBenches(int ok, size_t total) {
 }
 bool mostCells(int ok, int total) {
     return 21 * ok >= 19 * total;
-}
-
-Status writeText(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out)
-        return makeError(fmt::format("cannot write '{}'", path.string()));
-    out << text;
-    if (!out)
-        return makeError(fmt::format("error writing '{}'", path.string()));
-    return Status::success();
 }
 
 nlohmann::json runJson(const RunSummary& s) {
@@ -208,7 +199,7 @@ Status writeSummaryJson(const std::string& path, const std::vector<RunSummary>& 
          "reduction; '-oracle': e1 picked by the oracle policy"},
         {"latency_ratio_final", "median T_remote/T_local over the last 30 frames"},
         {"e1_deg_steady", "mean e1 after the warm-up (Table 4)"}};
-    return writeText(path, j.dump(2) + "\n");
+    return writeJsonFile(path, j);
 }
 
 Status writeFramesCsv(const std::string& path, const std::vector<FrameRecord>& frames) {
@@ -230,7 +221,7 @@ Status writeFramesCsv(const std::string& path, const std::vector<FrameRecord>& f
             r.latency_ratio, r.energy.gpu_dynamic_mj, r.energy.gpu_static_mj, r.energy.radio_mj,
             r.energy.uca_mj, r.energy.liwc_mj, r.energy.total());
     }
-    return writeText(path, s);
+    return writeTextFile(path, s);
 }
 
 namespace {
@@ -741,18 +732,24 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
 
     Outputs out(options.out_dir);
     ReportInputs report{options, runs, output, "", "", "", ""};
-    auto fig12 = writeFig12(runs, out);
-    auto fig13 = fig12 ? writeFig13(runs, out) : Expected<std::string>(makeError(fig12.error()));
-    if (!fig13)
-        return makeError(fig13.error());
-    if (Status st = writeFig14(runs, out); !st)
-        return makeError(st.error());
-    auto t4 = writeTable4(runs, out);
-    auto f15 = t4 ? writeFig15(runs, out) : Expected<std::string>(makeError(t4.error()));
-    if (!f15)
-        return makeError(f15.error());
-    if (Status st = writeMahimahi(runs, out); !st)
-        return makeError(st.error());
+    // The figures' files, in the order they are listed; four of them return the HTML the report
+    // embeds.
+    auto embed = [](Expected<std::string> html, std::string& into) -> Status {
+        if (!html)
+            return makeError(html.error());
+        into = std::move(*html);
+        return {};
+    };
+    const std::function<Status()> figures[] = {
+        [&] { return embed(writeFig12(runs, out), report.fig12); },
+        [&] { return embed(writeFig13(runs, out), report.fig13); },
+        [&] { return writeFig14(runs, out); },
+        [&] { return embed(writeTable4(runs, out), report.t4); },
+        [&] { return embed(writeFig15(runs, out), report.f15); },
+        [&] { return writeMahimahi(runs, out); }};
+    for (const std::function<Status()>& write : figures)
+        if (Status st = write(); !st)
+            return makeError(st.error());
 
     output.headlines = computeHeadlines(runs);
     output.findings = {qvrBeatsDfrAndFfr(runs), dfrBeatsFfr(runs), e1Order(runs, true),
@@ -766,10 +763,6 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         return makeError(st.error());
     out.files().push_back("summary.json");
     output.plot_note = out.plotNote();
-    report.fig12 = std::move(*fig12);
-    report.fig13 = std::move(*fig13);
-    report.t4 = std::move(*t4);
-    report.f15 = std::move(*f15);
     if (Status st = writeReport(report, out); !st)
         return makeError(st.error());
     output.files = out.files();

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qvr/core/run_summary_json.h"
+#include "qvr/core/text_file.h"
 #include "qvr/sim/benches.h"
 #include "qvr/sim/evaluation.h"
 #include "qvr/workload/trace_io.h"
@@ -121,10 +122,10 @@ Status writeRuntimeSimOutputs(const std::filesystem::path& out, const RuntimeRun
               {"t_remote_ms_mean", s.t_remote_ms_mean},
               {"headset_busy_ms_mean", s.headset_busy_ms_mean},
               {"server_busy_ms_mean", s.server_busy_ms_mean}});
-    std::ofstream(out / "summary.json") << j.dump(2) << "\n";
+    const Status summary = writeJsonFile((out / "summary.json").string(), j);
     if (!csv)
         return makeError("error writing " + out.string() + "/frames.csv");
-    return {};
+    return summary;
 }
 
 std::string runtimeSimReport(const RuntimeSummary& s, const std::string& bench,

@@ -97,6 +97,14 @@ TEST(ValidationPlan, RunTakesCarryTheirConditionAndCalibration) {
               "'out/builtin_room_wifi_d2_r1_t2.log' 2>&1");
 }
 
+TEST(ValidationPlan, ARunChildLogsBesideItsFolderAndReportsInIt) {
+    const ChildCommand cmd = runChildIn("out/x");
+    EXPECT_EQ(cmd.output, "out/x");
+    EXPECT_EQ(cmd.log_path, "out/x.log");
+    EXPECT_EQ(cmd.result_path, "out/x/summary.json");
+    EXPECT_TRUE(cmd.line.empty());
+}
+
 TEST(ValidationPlan, ALongLinkKeepsItsLastFortyCharactersInTheFolderName) {
     ValidationOptions o = twoScenes(1, CalibrationPolicy::kOnce);
     o.links = {"trace:/a/very/long/path/to/the/shared/data/network/ATT-LTE-driving-2016.down"};

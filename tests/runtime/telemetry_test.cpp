@@ -1,7 +1,10 @@
 // The run summary, all at once and one frame at a time (telemetry.h RunSummarizer).
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
 
 #include "qvr/runtime/telemetry.h"
 
@@ -132,6 +135,19 @@ TEST(RunSummarizer, OneFrameAtATimeEqualsTheWholeRun) {
     EXPECT_DOUBLE_EQ(a.t_remote_ms_mean, b.t_remote_ms_mean);
     EXPECT_DOUBLE_EQ(a.wall_s, b.wall_s);
     EXPECT_EQ(summarizeRun("x", {}, 10).frames, 0);
+}
+
+TEST(TelemetryCsv, TheFileIsTheHeaderAndOneRowAFrame) {
+    const auto v = frames(3, 4);
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() / "qvr_telemetry_test.csv";
+    ASSERT_TRUE(writeTelemetryCsv(path.string(), "qvr", v));
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_EQ(text.str(), telemetryCsvHeader() + telemetryCsvRow("qvr", v[0]) +
+                              telemetryCsvRow("qvr", v[1]) + telemetryCsvRow("qvr", v[2]));
+    EXPECT_FALSE(writeTelemetryCsv((path / "not_a_folder" / "x.csv").string(), "qvr", v));
 }
 
 }  // namespace

@@ -100,6 +100,9 @@ struct ChildCommand {
     std::string log_path;     // output + ".log"
     std::string result_path;  // read when it exits 0: FILE.json or DIR/summary.json
 };
+// A `qvr run` child writing into the folder `output`: its log beside the folder, its result the
+// folder's summary.json. The caller writes its line.
+ChildCommand runChildIn(std::string output);
 // Take `take` (0-based) of a planned calibration: `qvr calibrate --out
 // OUT/calibration-SCENE[-rREP][-tTAKE].toml`.
 ChildCommand calibrationTake(const ValidationPlan& plan, size_t calibration, int take);
