@@ -172,6 +172,11 @@ static Registered registerServer(CLI::App& app) {
                   "layer");
     cmd->add_flag("--one-pass-periphery", o->settings.one_pass_periphery,
                   "Render middle and outer in one geometry pass per eye (pays when vertex-bound)");
+    cmd->add_option("--share-periphery", o->settings.share_periphery,
+                    "One outer layer for headsets with close poses: off, auto (while its SSIM "
+                    "by eccentricity band holds) or on (docs/RUNTIME.md)")
+        ->check(CLI::IsMember({"off", "auto", "on"}))
+        ->capture_default_str();
     cmd->add_flag("--agones", o->agones,
                   "Report Ready, Health and Shutdown to Agones' SDK sidecar at "
                   "localhost:$AGONES_SDK_HTTP_PORT (docs/DEPLOY.md)");
