@@ -89,6 +89,11 @@ static Registered registerRun(CLI::App& app) {
     cmd->add_flag("--no-holes", o->no_holes,
                   "Server draws every periphery layer whole, also where the headset's fovea (or "
                   "the middle layer) covers it");
+    cmd->add_option("--share-periphery", o->share_periphery,
+                    "Server shares one outer layer among headsets of close pose: off, auto (while "
+                    "its SSIM by band holds) or on (docs/RUNTIME.md)")
+        ->check(CLI::IsMember({"off", "auto", "on"}))
+        ->capture_default_str();
     cmd->add_option("--headset-share", o->headset_share,
                     "Fraction of its core the headset process may use (CFS quota per 10 ms, "
                     "cgroups; needs root): the analogue of Table 4's slower headset GPUs")
@@ -139,11 +144,12 @@ static Registered registerRun(CLI::App& app) {
             o->command_line = fmt::format(
                 "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
                 "--profile {} --codec {} --seed {} --lod-px {} --pipeline {} --headset-share {} "
-                "--ring-counts {}{}{}{}",
+                "--ring-counts {}{}{}{}{}",
                 o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile, o->codec,
                 o->seed, o->lod_px, o->pipeline_depth, o->headset_share, o->ring_counts,
                 o->one_pass_periphery ? " --one-pass-periphery" : "",
                 o->no_holes ? " --no-holes" : "",
+                o->share_periphery != "off" ? " --share-periphery " + o->share_periphery : "",
                 o->headsets > 1
                     ? fmt::format(" --headsets {}{}", o->headsets,
                                   o->identical_workloads ? " --identical-workloads" : "")
