@@ -455,7 +455,8 @@ struct RenderServer::Impl final : net::ServerHandler {
                     return rs;
                 const LayerRect& shared_rect = d.shared.plan.eyes[static_cast<size_t>(eye)].outer;
                 reduceSharedOuter(images.outer, shared_rect,
-                                  plan.eyes[static_cast<size_t>(eye)].outer, images.image);
+                                  plan.eyes[static_cast<size_t>(eye)].outer, images.image,
+                                  config.profile, pose.orientation, pose.orientation);
                 sharing->store(w.id, eye, pose, shared_rect, images.outer);
                 return rs;
             }

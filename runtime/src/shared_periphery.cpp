@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "qvr/compose/quality.h"
+#include "qvr/compose/warp.h"
 #include "qvr/core/check.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/render/periphery_pass.h"
@@ -93,7 +94,7 @@ bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim) {
 }
 
 SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
-                            Eye eye, const LayerHoles& holes) {
+                            Eye eye, const LayerHoles& holes, double margin_deg) {
     QVR_CHECK(!members.empty());
     const size_t e = static_cast<size_t>(eye);
     SharedOuter s{members.front(), holes};
@@ -117,6 +118,10 @@ SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPl
         if (!same_gaze)
             s.holes.enabled = false;  // their holes are different discs
     }
+    // Beyond the image by the rotation a member may be off, so its reprojection stays inside.
+    const int margin_px = static_cast<int>(std::ceil(margin_deg / profile.pixelAngleDeg()));
+    u.rect = {u.rect.x0 - margin_px, u.rect.y0 - margin_px, u.rect.x1 + margin_px,
+              u.rect.y1 + margin_px};
     u.width_px = static_cast<int>(std::ceil(u.rect.width() / u.scale - 1e-9));
     u.height_px = static_cast<int>(std::ceil(u.rect.height() / u.scale - 1e-9));
     s.plan.s2 = u.scale;
@@ -128,8 +133,47 @@ SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPl
     return s;
 }
 
+namespace {
+
+// Bilinear sample of an RGBA8 image at texel coordinates (texel centres at i + 0.5), clamped to
+// the edge.
+void sampleBilinear(const ImageRgba8& img, double u, double v, uint8_t* dst) {
+    const double x = std::clamp(u - 0.5, 0.0, double(img.width() - 1));
+    const double y = std::clamp(v - 0.5, 0.0, double(img.height() - 1));
+    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+    const int x1 = std::min(x0 + 1, img.width() - 1), y1 = std::min(y0 + 1, img.height() - 1);
+    const double fx = x - x0, fy = y - y0;
+    for (int c = 0; c < 3; ++c) {
+        const double top = img.at(x0, y0, c) * (1.0 - fx) + img.at(x1, y0, c) * fx;
+        const double bottom = img.at(x0, y1, c) * (1.0 - fx) + img.at(x1, y1, c) * fx;
+        dst[c] = static_cast<uint8_t>(std::clamp(top * (1.0 - fy) + bottom * fy + 0.5, 0.0, 255.0));
+    }
+    dst[3] = 255;
+}
+
+}  // namespace
+
 void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
-                       const LayerRect& member_outer, ImageRgba8& out) {
+                       const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
+                       const glm::quat& shared_orientation, const glm::quat& member_orientation) {
+    if (angleBetweenDeg(shared_orientation, member_orientation) > 1e-6 && !shared.empty()) {
+        // The member's texel centres through the rotation to the shared render (UCA's map
+        // without the lens, which the layers do not have).
+        HmdProfile flat = profile;
+        flat.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
+        const EyeWarp warp(flat, shared_orientation, member_orientation);
+        out.resize(member_outer.width_px, member_outer.height_px);
+        for (int j = 0; j < member_outer.height_px; ++j) {
+            for (int i = 0; i < member_outer.width_px; ++i) {
+                const WarpSample s =
+                    warp.map(member_outer.rect.x0 + (i + 0.5) * member_outer.scale,
+                             member_outer.rect.y0 + (j + 0.5) * member_outer.scale);
+                sampleBilinear(shared, (s.px - shared_rect.rect.x0) / shared_rect.scale,
+                               (s.py - shared_rect.rect.y0) / shared_rect.scale, &out.at(i, j, 0));
+            }
+        }
+        return;
+    }
     PeripheryGrid g;
     g.x0 = shared_rect.rect.x0;
     g.y0 = shared_rect.rect.y0;
@@ -194,6 +238,15 @@ std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id) const {
     return {id};
 }
 
+bool SharedPeriphery::dueLocked(const Session& s, size_t eye) const {
+    return !s.verdict[eye] || s.frames_since_measure[eye] > m_config.remeasure_frames;
+}
+
+bool SharedPeriphery::anyDueLocked(const std::vector<Id>& group, size_t eye) const {
+    return std::any_of(group.begin(), group.end(),
+                       [&](Id x) { return dueLocked(m_sessions.at(x), eye); });
+}
+
 SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& pose,
                                                   const LayerPlan& plan, const HmdProfile& profile,
                                                   const LayerHoles& holes) {
@@ -204,6 +257,7 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& po
     const LayerRect& outer = plan.eyes[e].outer;
     std::shared_ptr<const ImageRgba8> from;
     LayerRect from_rect;
+    glm::quat from_orientation;
     {
         std::lock_guard lock(m_mutex);
         const std::vector<Id> group = groupOfLocked(id);
@@ -223,27 +277,32 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& po
                 (!best || entry->serial > best->serial))
                 best = &*entry;
         }
-        const bool due = !me.verdict[e] || me.frames_since_measure[e] > m_config.remeasure_frames;
+        const bool due = dueLocked(me, e);
         if (best && m_config.mode == SharePeripheryMode::kAuto && due) {
             d.action = Action::kMeasure;
         } else if (best && (m_config.mode == SharePeripheryMode::kOn || *me.verdict[e])) {
             d.action = Action::kReuse;
             ++m_stats.outer_layers_reused;
+        } else if (m_config.mode == SharePeripheryMode::kAuto && me.verdict[e] == false &&
+                   !anyDueLocked(group, e)) {
+            return d;  // it does not share, and nobody needs its render to measure against
         } else {
             std::vector<LayerPlan> plans = {plan};
             for (Id other : group)
                 if (other != id)
                     plans.push_back(m_sessions[other].plan);
             d.action = Action::kRenderShared;
-            d.shared = sharedOuterPlan(profile, plans, eye, holes);
+            d.shared = sharedOuterPlan(profile, plans, eye, holes, m_config.max_angle_deg);
             ++m_stats.outer_layers_shared;
             return d;
         }
         best->consumed.insert(id);
         from = best->image;
         from_rect = best->rect;
+        from_orientation = best->pose.orientation;
     }
-    reduceSharedOuter(*from, from_rect, outer, d.image);
+    reduceSharedOuter(*from, from_rect, outer, d.image, profile, from_orientation,
+                      pose.orientation);
     return d;
 }
 

@@ -1,7 +1,10 @@
 // Shared periphery: grouping by pose, the group's outer layer and the SSIM gate by band.
 #include "qvr/runtime/shared_periphery.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
+#include <glm/gtc/quaternion.hpp>
 
 #include "qvr/compose/test_pattern.h"
 #include "qvr/foveation/eye_geometry.h"
@@ -77,6 +80,52 @@ TEST(SharedPeriphery, SsimByBandSeesOnlyTheBandsThatDiffer) {
     // Texels nearer than hide_below_deg are left out.
     const auto hidden = outerSsimByBand(profile, plan, Eye::kLeft, shared, own, 10.0, 30.0);
     EXPECT_GE(hidden.front().lo_deg, 30.0);
+}
+
+// A layer whose colour is a smooth function of the world direction, as rendered at `head`.
+ImageRgba8 directionLayer(const HmdProfile& profile, const LayerRect& l, const glm::quat& head) {
+    const EyeGeometry g(profile);
+    ImageRgba8 img(l.width_px, l.height_px);
+    for (int j = 0; j < l.height_px; ++j) {
+        for (int i = 0; i < l.width_px; ++i) {
+            const glm::dvec3 d = glm::dquat(head) * g.directionAt(l.rect.x0 + (i + 0.5) * l.scale,
+                                                                  l.rect.y0 + (j + 0.5) * l.scale);
+            img.at(i, j, 0) = static_cast<uint8_t>(128.0 + 120.0 * d.x);
+            img.at(i, j, 1) = static_cast<uint8_t>(128.0 + 120.0 * d.y);
+            img.at(i, j, 2) = 128;
+            img.at(i, j, 3) = 255;
+        }
+    }
+    return img;
+}
+
+double meanAbsError(const ImageRgba8& a, const ImageRgba8& b) {
+    double sum = 0.0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x)
+            for (int c = 0; c < 3; ++c)
+                sum += std::abs(int(a.at(x, y, c)) - int(b.at(x, y, c)));
+    return sum / (3.0 * a.width() * a.height());
+}
+
+TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const SharedOuter s = sharedOuterPlan(profile, {plan}, Eye::kLeft, {}, 3.0);
+    const LayerRect& shared_rect = s.plan.eyes[0].outer;
+    const LayerRect& member = plan.eyes[0].outer;
+    EXPECT_LT(shared_rect.rect.x0, 0);  // widened beyond the image by the margin
+    const glm::quat a = quatFromEulerDeg({0.0, 0.0, 0.0});
+    const glm::quat b = quatFromEulerDeg({2.0, 1.0, 0.0});
+    const ImageRgba8 shared = directionLayer(profile, shared_rect, a);
+    const ImageRgba8 truth = directionLayer(profile, member, b);
+    ImageRgba8 reprojected, unmoved;
+    reduceSharedOuter(shared, shared_rect, member, reprojected, profile, a, b);
+    reduceSharedOuter(shared, shared_rect, member, unmoved, profile, a, a);
+    ASSERT_EQ(reprojected.width(), member.width_px);
+    const double err = meanAbsError(reprojected, truth);
+    EXPECT_LT(err, 0.6);
+    EXPECT_GT(meanAbsError(unmoved, truth), 3.0 * err);
 }
 
 TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {

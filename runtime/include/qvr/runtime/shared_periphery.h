@@ -72,19 +72,23 @@ std::vector<BandSsim> outerSsimByBand(const HmdProfile& profile, const LayerPlan
                                       double band_deg, double hide_below_deg);
 bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim);
 
-// The layer the group renders for one eye: the union of its members' outer rectangles at the
-// finest of their sampling scales, with the plan (gaze, e2) whose hole every member can take
-// (holes off when the members' gazes differ).
+// The layer the group renders for one eye: the union of its members' outer rectangles, widened
+// by margin_deg beyond each edge (what a member's rotation may bring into view), at the finest
+// of their sampling scales, with the plan (gaze, e2) whose hole every member can take (holes off
+// when the members' gazes differ).
 struct SharedOuter {
     LayerPlan plan;  // a member's plan with eyes[eye].outer the shared rect
     LayerHoles holes;
 };
 SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
-                            Eye eye, const LayerHoles& holes);
+                            Eye eye, const LayerHoles& holes, double margin_deg = 0.0);
 
-// A shared layer reduced (box filter) to one member's outer layer.
+// A shared layer as one member gets it: its outer layer's texels, rotated from the shared
+// render's orientation to the member's (bilinear), or box-filtered when the two are the same.
+// The member's UCA then takes it as rendered at its own pose; position is not corrected.
 void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
-                       const LayerRect& member_outer, ImageRgba8& out);
+                       const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
+                       const glm::quat& shared_orientation, const glm::quat& member_orientation);
 
 struct SharePeripheryStats {
     std::string mode = "off";
@@ -152,6 +156,8 @@ private:
         std::array<int, 2> frames_since_measure{};
     };
     std::vector<Id> groupOfLocked(Id id) const;
+    bool dueLocked(const Session& s, size_t eye) const;  // a measurement is due
+    bool anyDueLocked(const std::vector<Id>& group, size_t eye) const;
 
     SharePeripheryConfig m_config;
     mutable std::mutex m_mutex;
