@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 #include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
 
 #include "qvr/compose/test_pattern.h"
 #include "qvr/foveation/eye_geometry.h"
+#include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
 
 namespace qvr::runtime {
@@ -198,6 +200,14 @@ TEST(SharedPeriphery, OffNeverShares) {
     sp.noteRequest(2, Pose{}, plan);
     EXPECT_EQ(sp.decide(2, Eye::kLeft, Pose{}, plan, profile, {}).action,
               SharedPeriphery::Action::kOwn);
+    RenderServerStats stats;
+    stats.share_periphery = sp.stats();
+    const nlohmann::json j = serverPoolJson(stats)["share_periphery"];
+    EXPECT_EQ(j["mode"], "off");
+    for (const char* key :
+         {"min_ssim", "band_deg", "outer_layers_own", "outer_layers_shared", "outer_layers_reused",
+          "measurements", "measurements_failed", "service_ms_per_headset_frame", "ssim_by_band"})
+        EXPECT_TRUE(j.contains(key)) << key;
     EXPECT_FALSE(parseSharePeripheryMode("sometimes").ok());
     EXPECT_EQ(*parseSharePeripheryMode("auto"), SharePeripheryMode::kAuto);
 }
