@@ -29,7 +29,7 @@ namespace qvr::runtime {
 enum class SharePeripheryMode {
     kOff,   // every headset its own outer layer
     kAuto,  // shared among close headsets while the measured SSIM holds
-    kOn,    // shared among close headsets, SSIM measured but not obeyed (for cost measurements)
+    kOn,    // shared among close headsets without measuring (for cost measurements)
 };
 Expected<SharePeripheryMode> parseSharePeripheryMode(const std::string& name);
 const char* sharePeripheryModeName(SharePeripheryMode mode);
