@@ -470,8 +470,12 @@ struct RenderServer::Impl final : net::ServerHandler {
             return rs;
         sharing->countOwn();
         if (d.action == SharedPeriphery::Action::kMeasure) {
-            const double hide_deg = layerHoleDeg(config.profile, plan, eye, LayerKind::kOuter,
-                                                 LayerHoles{.enabled = true});
+            // What the compositor shows of the outer layer: beyond the middle layer's disc, or
+            // beyond the fovea's when there is no middle layer.
+            const double hide_deg = plan.eyes[static_cast<size_t>(eye)].middle.empty()
+                                        ? plan.e1_deg
+                                        : layerHoleDeg(config.profile, plan, eye, LayerKind::kOuter,
+                                                       LayerHoles{.enabled = true});
             sharing->measured(w.id, eye,
                               outerSsimByBand(config.profile, plan, eye, d.image, images.image,
                                               sharing->config().band_deg, hide_deg));
