@@ -260,10 +260,13 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& po
     glm::quat from_orientation;
     {
         std::lock_guard lock(m_mutex);
+        auto self = m_sessions.find(id);
+        if (self == m_sessions.end())
+            return d;  // gone while its frame was served
         const std::vector<Id> group = groupOfLocked(id);
         if (group.size() < 2)
             return d;
-        Session& me = m_sessions[id];
+        Session& me = self->second;
         ++me.frames_since_measure[e];
         // The newest usable shared render of another member: close to this pose, covering this
         // headset's outer layer at least as finely, not given to it yet.
