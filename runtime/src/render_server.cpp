@@ -178,6 +178,8 @@ struct RenderServer::Impl final : net::ServerHandler {
         auto s = std::make_shared<SessionState>();
         s->stats.client = id;
         s->admitted_ns = clock->nowNs();
+        if (sharing)
+            sharing->join(id);
         std::lock_guard lock(mutex);
         clients[id] = s;
         sessions.push_back(std::move(s));

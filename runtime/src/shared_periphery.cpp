@@ -209,11 +209,19 @@ SharedPeriphery::SharedPeriphery(SharePeripheryConfig config) : m_config(config)
     m_stats.band_deg = config.band_deg;
 }
 
+void SharedPeriphery::join(Id id) {
+    std::lock_guard lock(m_mutex);
+    m_sessions.try_emplace(id);
+}
+
 void SharedPeriphery::noteRequest(Id id, const Pose& pose, const LayerPlan& plan) {
     std::lock_guard lock(m_mutex);
-    Session& s = m_sessions[id];
-    s.pose = pose;
-    s.plan = plan;
+    auto it = m_sessions.find(id);
+    if (it == m_sessions.end())
+        return;  // gone while its frame was served
+    it->second.pose = pose;
+    it->second.plan = plan;
+    it->second.posed = true;
 }
 
 void SharedPeriphery::forget(Id id) {
@@ -225,6 +233,8 @@ std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id) const {
     std::vector<Id> ids;
     std::vector<Pose> poses;
     for (const auto& [k, s] : m_sessions) {
+        if (!s.posed)
+            continue;  // no request yet
         ids.push_back(k);
         poses.push_back(s.pose);
     }

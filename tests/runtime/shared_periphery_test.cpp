@@ -159,6 +159,8 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
     c.mode = SharePeripheryMode::kAuto;
     SharedPeriphery sp(c);
     using A = SharedPeriphery::Action;
+    sp.join(1);
+    sp.join(2);
     sp.noteRequest(1, yawed(0.0), plan);
     EXPECT_EQ(sp.decide(1, Eye::kLeft, yawed(0.0), plan, profile, holes).action, A::kOwn);
     sp.noteRequest(2, yawed(1.0), plan);
@@ -183,6 +185,12 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
     // Far apart: each its own.
     sp.noteRequest(2, yawed(30.0), plan);
     EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(30.0), plan, profile, holes).action, A::kOwn);
+    // A session that left is not brought back by a late request.
+    sp.forget(1);
+    sp.noteRequest(1, yawed(1.0), plan);
+    sp.noteRequest(2, yawed(1.0), plan);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kOwn);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kOwn);
     const SharePeripheryStats s = sp.stats();
     EXPECT_EQ(s.measurements, 2u);
     EXPECT_EQ(s.measurements_failed, 1u);
@@ -196,6 +204,8 @@ TEST(SharedPeriphery, OffNeverShares) {
     const HmdProfile profile = smallProfile();
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
     SharedPeriphery sp(SharePeripheryConfig{});
+    sp.join(1);
+    sp.join(2);
     sp.noteRequest(1, Pose{}, plan);
     sp.noteRequest(2, Pose{}, plan);
     EXPECT_EQ(sp.decide(2, Eye::kLeft, Pose{}, plan, profile, {}).action,

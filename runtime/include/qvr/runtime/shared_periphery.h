@@ -117,7 +117,8 @@ public:
     explicit SharedPeriphery(SharePeripheryConfig config);
 
     const SharePeripheryConfig& config() const { return m_config; }
-    void noteRequest(Id id, const Pose& pose, const LayerPlan& plan);
+    void join(Id id);                                                  // a session connected
+    void noteRequest(Id id, const Pose& pose, const LayerPlan& plan);  // a joined session's frame
     void forget(Id id);
 
     enum class Action {
@@ -149,6 +150,7 @@ private:
     struct Session {
         Pose pose;
         LayerPlan plan;
+        bool posed = false;  // a request noted
         // Per eye: its newest shared render, whether the last measurement passed, and the
         // frames since.
         std::array<std::optional<Entry>, 2> entries;
