@@ -78,6 +78,7 @@ static Registered registerRun(CLI::App& app) {
               "Remote layers later than this after the local render are late (frame reuse)", 1.0,
               10000.0);
     addPeripheryPassFlags(cmd, o->one_pass_periphery, o->no_holes);
+    addSharePeripheryOption(cmd, o->share_periphery);
     addFinite(cmd, "--headset-share", o->headset_share,
               "Fraction of its core the headset process may use (CFS quota per 10 ms, cgroups; "
               "needs root): the analogue of Table 4's slower headset GPUs",
@@ -122,11 +123,12 @@ static Registered registerRun(CLI::App& app) {
             o->command_line = fmt::format(
                 "qvr run --scene {} --motion {} --gaze {} --net {} --frames {} --designs {} "
                 "--profile {} --codec {} --seed {} --lod-px {} --pipeline {} --headset-share {} "
-                "--ring-counts {}{}{}{}",
+                "--ring-counts {}{}{}{}{}",
                 o->scene, o->motion, o->gaze, o->net, o->frames, o->designs, o->profile, o->codec,
                 o->seed, o->lod_px, o->pipeline_depth, o->headset_share, o->ring_counts,
                 o->one_pass_periphery ? " --one-pass-periphery" : "",
                 o->no_holes ? " --no-holes" : "",
+                o->share_periphery != "off" ? " --share-periphery " + o->share_periphery : "",
                 o->headsets > 1
                     ? fmt::format(" --headsets {}{}", o->headsets,
                                   o->identical_workloads ? " --identical-workloads" : "")

@@ -165,6 +165,7 @@ static Registered registerServer(CLI::App& app) {
                     "here on exit")
         ->check(writableFile());
     addPeripheryPassFlags(cmd, o->settings.one_pass_periphery, o->settings.no_holes);
+    addSharePeripheryOption(cmd, o->settings.share_periphery);
     cmd->add_flag("--agones", o->agones,
                   "Report Ready, Health and Shutdown to Agones' SDK sidecar at "
                   "localhost:$AGONES_SDK_HTTP_PORT (docs/DEPLOY.md)");

@@ -285,6 +285,15 @@ void addPeripheryPassFlags(CLI::App* cmd, bool& one_pass_periphery, bool& no_hol
                   "Server draws every periphery layer whole, also where the headset's fovea (or "
                   "the middle layer) covers it");
 }
+
+CLI::Option* addSharePeripheryOption(CLI::App* cmd, std::string& mode) {
+    return cmd
+        ->add_option("--share-periphery", mode,
+                     "Server shares one outer layer among headsets of close pose: off, auto "
+                     "(while its SSIM by eccentricity band holds) or on (docs/RUNTIME.md)")
+        ->check(CLI::IsMember({"off", "auto", "on"}))
+        ->capture_default_str();
+}
 #endif
 
 }  // namespace qvr::cli

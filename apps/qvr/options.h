@@ -98,6 +98,8 @@ CLI::Option* addCodecOption(CLI::App* cmd, std::string& codec);
 CLI::Option* addLinkOption(CLI::App* cmd, std::string& net);
 // --one-pass-periphery and --no-holes: how the render server draws the periphery layers.
 void addPeripheryPassFlags(CLI::App* cmd, bool& one_pass_periphery, bool& no_holes);
+// --share-periphery off|auto|on: one outer layer for headsets of close pose (docs/RUNTIME.md).
+CLI::Option* addSharePeripheryOption(CLI::App* cmd, std::string& mode);
 #endif
 
 }  // namespace qvr::cli

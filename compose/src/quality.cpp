@@ -36,6 +36,7 @@ struct Accum {
     RegionQuality finish() const {
         RegionQuality q;
         q.pixels = pixels;
+        q.ssim_windows = ssim_windows;
         const double mse = samples > 0 ? sq_err / static_cast<double>(samples) : 0.0;
         q.psnr_db = mse > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse)
                               : std::numeric_limits<double>::infinity();
@@ -48,53 +49,13 @@ struct Accum {
 
 namespace {
 
-// PSNR and SSIM per region, a region being what `label` makes of a pixel's eccentricity (deg):
-// 1..regions, or 0 to leave it out. The last accumulator holds every counted pixel.
-template <typename Label>
-std::vector<Accum> measureRegions(const HmdProfile& profile, const Gaze& gaze_deg,
-                                  const Pose& render_pose, const Pose& display_pose,
-                                  const ImageRgba8& image, const ImageRgbD& truth, int regions,
-                                  Label label) {
-    const int width = image.width();
-    const int height = image.height();
-    QVR_CHECK(truth.width() == width && truth.height() == height);
-    const EyeWarp warp(profile, render_pose.orientation, display_pose.orientation);
-    const glm::dvec3 gaze = glm::normalize(glm::dvec3(std::tan(gaze_deg.x_deg / kDegPerRad),
-                                                      std::tan(gaze_deg.y_deg / kDegPerRad), -1.0));
-    std::vector<uint8_t> region(static_cast<size_t>(width) * static_cast<size_t>(height));
-    std::vector<float> ly_img(region.size()), ly_ref(region.size());
-    std::vector<Accum> acc(static_cast<size_t>(regions) + 1);
-    const size_t all = static_cast<size_t>(regions);
-    for (int y = 0; y < height; ++y) {
-        for (int x = 0; x < width; ++x) {
-            const size_t i =
-                static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
-            const WarpSample s = warp.map(x + 0.5, y + 0.5);
-            uint8_t reg = kOff;
-            if (s.inside) {
-                const double c = std::clamp(glm::dot(glm::normalize(s.dir), gaze), -1.0, 1.0);
-                reg = static_cast<uint8_t>(label(std::acos(c) * kDegPerRad));
-            }
-            region[i] = reg;
-            const double r = image.at(x, y, 0), g = image.at(x, y, 1), b = image.at(x, y, 2);
-            ly_img[i] = static_cast<float>(luma(r, g, b));
-            ly_ref[i] =
-                static_cast<float>(luma(truth.at(x, y, 0), truth.at(x, y, 1), truth.at(x, y, 2)));
-            if (reg == kOff)
-                continue;
-            double e2 = 0.0;
-            for (int c = 0; c < 3; ++c) {
-                const double d = image.at(x, y, c) - truth.at(x, y, c);
-                e2 += d * d;
-            }
-            for (Accum* a : {&acc[reg - 1u], &acc[all]}) {
-                a->sq_err += e2;
-                a->samples += 3;
-                a->pixels += 1;
-            }
-        }
-    }
-    // SSIM: sums over the 7×7 window for x, y, x², y², xy and the count of on-field pixels,
+// SSIM of luma over 7×7 windows wholly on labelled pixels (region ≠ 0), added to the window's
+// centre pixel's region and to the last accumulator (every region).
+void accumulateSsim(const std::vector<float>& ly_img, const std::vector<float>& ly_ref,
+                    const std::vector<uint8_t>& region, int width, int height,
+                    std::vector<Accum>& acc) {
+    const size_t all = acc.size() - 1;
+    // Sums over the 7×7 window for x, y, x², y², xy and the count of on-field pixels,
     // kept per column over the current 7 rows, then summed across 7 columns.
     constexpr double kC1 = (0.01 * 255.0) * (0.01 * 255.0);
     constexpr double kC2 = (0.03 * 255.0) * (0.03 * 255.0);
@@ -145,6 +106,55 @@ std::vector<Accum> measureRegions(const HmdProfile& profile, const Gaze& gaze_de
         }
         addRow(y - kHalf, -1.0);
     }
+}
+
+// PSNR and SSIM per region, a region being what `label` makes of a pixel's eccentricity (deg):
+// 1..regions, or 0 to leave it out. The last accumulator holds every counted pixel.
+template <typename Label>
+std::vector<Accum> measureRegions(const HmdProfile& profile, const Gaze& gaze_deg,
+                                  const Pose& render_pose, const Pose& display_pose,
+                                  const ImageRgba8& image, const ImageRgbD& truth, int regions,
+                                  Label label) {
+    const int width = image.width();
+    const int height = image.height();
+    QVR_CHECK(truth.width() == width && truth.height() == height);
+    const EyeWarp warp(profile, render_pose.orientation, display_pose.orientation);
+    const glm::dvec3 gaze = glm::normalize(glm::dvec3(std::tan(gaze_deg.x_deg / kDegPerRad),
+                                                      std::tan(gaze_deg.y_deg / kDegPerRad), -1.0));
+    std::vector<uint8_t> region(static_cast<size_t>(width) * static_cast<size_t>(height));
+    std::vector<float> ly_img(region.size()), ly_ref(region.size());
+    std::vector<Accum> acc(static_cast<size_t>(regions) + 1);
+    const size_t all = static_cast<size_t>(regions);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            const size_t i =
+                static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+            const WarpSample s = warp.map(x + 0.5, y + 0.5);
+            uint8_t reg = kOff;
+            if (s.inside) {
+                const double c = std::clamp(glm::dot(glm::normalize(s.dir), gaze), -1.0, 1.0);
+                reg = static_cast<uint8_t>(label(std::acos(c) * kDegPerRad));
+            }
+            region[i] = reg;
+            const double r = image.at(x, y, 0), g = image.at(x, y, 1), b = image.at(x, y, 2);
+            ly_img[i] = static_cast<float>(luma(r, g, b));
+            ly_ref[i] =
+                static_cast<float>(luma(truth.at(x, y, 0), truth.at(x, y, 1), truth.at(x, y, 2)));
+            if (reg == kOff)
+                continue;
+            double e2 = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const double d = image.at(x, y, c) - truth.at(x, y, c);
+                e2 += d * d;
+            }
+            for (Accum* a : {&acc[reg - 1u], &acc[all]}) {
+                a->sq_err += e2;
+                a->samples += 3;
+                a->pixels += 1;
+            }
+        }
+    }
+    accumulateSsim(ly_img, ly_ref, region, width, height, acc);
     return acc;
 }
 
@@ -200,6 +210,44 @@ BandQuality measureQualityBands(const HmdProfile& profile, const LayerPlan& plan
         q.by_eccentricity.push_back({(i + 0.5) * bin_deg, e[static_cast<size_t>(i)].finish()});
     }
     return q;
+}
+
+std::vector<RegionQuality> measureLabelledQuality(const ImageRgba8& image,
+                                                  const ImageRgba8& reference,
+                                                  const std::vector<uint8_t>& labels, int regions) {
+    const int width = image.width();
+    const int height = image.height();
+    QVR_CHECK(reference.width() == width && reference.height() == height);
+    QVR_CHECK(labels.size() == static_cast<size_t>(width) * static_cast<size_t>(height));
+    QVR_CHECK(regions >= 1 && regions < 256);
+    std::vector<float> ly_img(labels.size()), ly_ref(labels.size());
+    std::vector<Accum> acc(static_cast<size_t>(regions) + 1);
+    const size_t all = static_cast<size_t>(regions);
+    for (size_t i = 0; i < labels.size(); ++i) {
+        const uint8_t* a = image.data() + 4 * i;
+        const uint8_t* b = reference.data() + 4 * i;
+        ly_img[i] = static_cast<float>(luma(a[0], a[1], a[2]));
+        ly_ref[i] = static_cast<float>(luma(b[0], b[1], b[2]));
+        const uint8_t reg = labels[i];
+        if (reg == kOff)
+            continue;
+        QVR_CHECK(reg <= regions);
+        double e2 = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(a[c]) - double(b[c]);
+            e2 += d * d;
+        }
+        for (Accum* x : {&acc[reg - 1u], &acc[all]}) {
+            x->sq_err += e2;
+            x->samples += 3;
+            x->pixels += 1;
+        }
+    }
+    accumulateSsim(ly_img, ly_ref, labels, width, height, acc);
+    std::vector<RegionQuality> out;
+    for (const Accum& a : acc)
+        out.push_back(a.finish());
+    return out;
 }
 
 }  // namespace qvr

@@ -164,6 +164,8 @@ std::variant<ServerProcess, RunError> startServer(const RunOptions& plan,
         args.push_back("--one-pass-periphery");
     if (plan.no_holes)
         args.push_back("--no-holes");
+    if (plan.share_periphery != "off")
+        args.insert(args.end(), {"--share-periphery", plan.share_periphery});
     auto server = key_written ? ServerProcess::start(*exe, args)
                               : Expected<ServerProcess>(makeError("cannot write the key file"));
     unlink(key_path);

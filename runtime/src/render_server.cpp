@@ -85,13 +85,20 @@ nlohmann::json serverPoolJson(const RenderServerStats& s) {
              {"service_ms_mean", mean(x.service_ms_total)},
              {"queue_ms_mean", mean(x.queue_ms_total)}});
     }
+    double service_ms = 0.0, frames = 0.0;
+    for (const SessionStats& x : s.sessions) {
+        service_ms += x.service_ms_total;
+        frames += double(x.frames_rendered);
+    }
     return {{"workers", s.workers},
             {"admission",
              {{"min_fps", s.min_fps},
               {"frame_cost_ms", s.frame_cost_ms},
               {"frame_cost_source", s.frame_cost_source},
               {"refused_capacity", s.net.refused_capacity}}},
-            {"sessions", std::move(sessions)}};
+            {"sessions", std::move(sessions)},
+            {"share_periphery",
+             sharePeripheryJson(s.share_periphery, frames > 0.0 ? service_ms / frames : 0.0)}};
 }
 
 namespace {
@@ -143,6 +150,7 @@ struct RenderServer::Impl final : net::ServerHandler {
     Clock* clock = &SteadyClock::instance();  // config.clock, or the steady clock
     std::shared_ptr<const Scene> scene;
     std::unique_ptr<net::Server> server;
+    std::unique_ptr<SharedPeriphery> sharing;  // null when off
     int worker_count = 1;
     std::vector<std::thread> workers;
 
@@ -170,11 +178,15 @@ struct RenderServer::Impl final : net::ServerHandler {
         auto s = std::make_shared<SessionState>();
         s->stats.client = id;
         s->admitted_ns = clock->nowNs();
+        if (sharing)
+            sharing->join(id);
         std::lock_guard lock(mutex);
         clients[id] = s;
         sessions.push_back(std::move(s));
     }
     void onClientGone(net::ClientId id) override {
+        if (sharing)
+            sharing->forget(id);
         Encoders released;  // destroyed after the lock (x264 takes its time)
         std::lock_guard lock(mutex);
         auto it = clients.find(id);
@@ -351,6 +363,8 @@ struct RenderServer::Impl final : net::ServerHandler {
             ++state.stats.frames_dropped;
             return;
         }
+        if (sharing)
+            sharing->noteRequest(id, req.pose, plan);
         w.key_mask = state.key_frame_mask.exchange(0);
         for (int eye = 0; eye < 2; ++eye) {
             const EyeLayers& layers = plan.eyes[static_cast<size_t>(eye)];
@@ -402,8 +416,10 @@ struct RenderServer::Impl final : net::ServerHandler {
                 continue;
             ++w.layers_planned;
             w.render_start_ns = clock->nowNs();
-            auto rs = renderLayer(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye), kind,
-                                  images.image, CameraOptions{}, config.holes);
+            auto rs = sharing && kind == LayerKind::kOuter
+                          ? renderOuter(r, images, plan, static_cast<Eye>(eye), w)
+                          : renderLayer(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye),
+                                        kind, images.image, CameraOptions{}, config.holes);
             w.render_end_ns = clock->nowNs();
             w.delta.render_ms_total += double(w.render_end_ns - w.render_start_ns) * 1e-6;
             if (!rs) {
@@ -419,6 +435,54 @@ struct RenderServer::Impl final : net::ServerHandler {
             ++w.delta.layers_rendered;
             send(w, stamps, sid, images.image);
         }
+    }
+
+    // An outer layer into images.image with sharing on: another member's shared render reduced
+    // to this headset's layer; or its own beside such a candidate when a measurement is due;
+    // or the group's layer, rendered, kept for the others and reduced; or its own alone.
+    Expected<RenderStats> renderOuter(Renderer& r, Images& images, const LayerPlan& plan, Eye eye,
+                                      const Work& w) {
+        const Pose& pose = w.req->pose;
+        SharedPeriphery::Decision d =
+            sharing->decide(w.id, eye, pose, plan, config.profile, config.holes);
+        switch (d.action) {
+            case SharedPeriphery::Action::kReuse:
+                images.image = std::move(d.image);
+                return RenderStats{};
+            case SharedPeriphery::Action::kRenderShared: {
+                auto rs =
+                    renderLayer(r, config.profile, d.shared.plan, pose, eye, LayerKind::kOuter,
+                                images.outer, CameraOptions{}, d.shared.holes);
+                if (!rs)
+                    return rs;
+                const LayerRect& shared_rect = d.shared.plan.eyes[static_cast<size_t>(eye)].outer;
+                reduceSharedOuter(images.outer, shared_rect,
+                                  plan.eyes[static_cast<size_t>(eye)].outer, images.image,
+                                  config.profile, pose.orientation, pose.orientation);
+                sharing->store(w.id, eye, pose, shared_rect, images.outer);
+                return rs;
+            }
+            case SharedPeriphery::Action::kMeasure:
+            case SharedPeriphery::Action::kOwn:
+                break;
+        }
+        auto rs = renderLayer(r, config.profile, plan, pose, eye, LayerKind::kOuter, images.image,
+                              CameraOptions{}, config.holes);
+        if (!rs)
+            return rs;
+        sharing->countOwn();
+        if (d.action == SharedPeriphery::Action::kMeasure) {
+            // What the compositor shows of the outer layer: beyond the middle layer's disc, or
+            // beyond the fovea's when there is no middle layer.
+            const double hide_deg = plan.eyes[static_cast<size_t>(eye)].middle.empty()
+                                        ? plan.e1_deg
+                                        : layerHoleDeg(config.profile, plan, eye, LayerKind::kOuter,
+                                                       LayerHoles{.enabled = true});
+            sharing->measured(w.id, eye,
+                              outerSsimByBand(config.profile, plan, eye, d.image, images.image,
+                                              sharing->config().band_deg, hide_deg));
+        }
+        return rs;
     }
 
     // Encodes one layer with its stream's encoder and hands it to the transport, which never
@@ -550,6 +614,8 @@ Expected<std::unique_ptr<RenderServer>> RenderServer::start(RenderServerConfig c
     impl->config.net.settings = net::makeSessionSettings(impl->config.codec.backend, hp.name,
                                                          hp.width_px, hp.height_px, hp.refresh_hz);
     impl->scene = std::move(scene);
+    if (impl->config.share_periphery.mode != SharePeripheryMode::kOff)
+        impl->sharing = std::make_unique<SharedPeriphery>(impl->config.share_periphery);
     Impl* p = impl.get();
     if (Status st = p->startWorkers(); !st)
         return makeError("render server: " + st.error());
@@ -598,6 +664,8 @@ RenderServerStats RenderServer::stats() const {
             s.sessions.push_back(st);
         }
     }
+    s.share_periphery = m_impl->sharing ? m_impl->sharing->stats()
+                                        : SharedPeriphery(m_impl->config.share_periphery).stats();
     if (m_impl->server)
         s.net = m_impl->server->stats();
     return s;

@@ -47,6 +47,10 @@ Expected<RenderServerConfig> renderServerConfig(const ServerSettings& s) {
         cfg.admission.frame_cost_ms = s.frame_cost_ms;
     cfg.one_pass_periphery = s.one_pass_periphery;
     cfg.holes.enabled = !s.no_holes;
+    auto share = parseSharePeripheryMode(s.share_periphery);
+    if (!share)
+        return makeError("--share-periphery: " + share.error());
+    cfg.share_periphery.mode = *share;
     if (!s.keep_frame_records)
         cfg.max_frame_records = 0;
     GlRendererOptions gl;

@@ -323,6 +323,32 @@ TEST(RenderServerPool, AHeadsetOverTheFloorIsRefusedWithTheReason) {
 
 // Without a calibration the server measures its own service time per headset-frame and
 // admission goes by it once it has served measure_frames frames.
+// Two headsets at one pose with sharing on auto: after a measurement, the outer layers one
+// renders the other reuses, and every frame's outer layers are accounted for.
+TEST(RenderServerPool, CoLocatedSessionsShareTheOuterLayer) {
+    RenderServerConfig c = poolConfig(1, 1ms);
+    c.share_periphery.mode = SharePeripheryMode::kAuto;
+    auto server = startServer(c);
+    ASSERT_TRUE(server);
+    std::vector<std::unique_ptr<FakeHeadset>> headsets;
+    for (int i = 0; i < 2; ++i) {
+        headsets.push_back(std::make_unique<FakeHeadset>());
+        headsets.back()->duration = 500ms;
+    }
+    runAll(headsets, server->port());
+    server->stop();
+    const RenderServerStats s = server->stats();
+    const SharePeripheryStats& sp = s.share_periphery;
+    EXPECT_EQ(sp.mode, "auto");
+    EXPECT_GE(sp.measurements, 1u);
+    EXPECT_EQ(sp.measurements_failed, 0u);  // the same pose: the same layer
+    EXPECT_GT(sp.outer_layers_reused, 0u);
+    EXPECT_EQ(sp.outer_layers_own + sp.outer_layers_shared + sp.outer_layers_reused,
+              2 * s.frames_rendered);
+    for (const SessionStats& x : s.sessions)
+        EXPECT_GT(x.frames_sent, 0u);
+}
+
 TEST(RenderServerPool, MeasuresItsCostPerHeadsetFrame) {
     RenderServerConfig c = poolConfig(1, 5ms);  // ≥ 3 layers: ≥ 15 ms a frame
     c.admission.min_fps = 60.0;

@@ -18,6 +18,7 @@ struct RegionQuality {
     double psnr_db = 0.0;  // over RGB, peak 255; +inf when identical
     double ssim = 0.0;     // mean SSIM of luma over 7×7 windows wholly inside the region's field
     int64_t pixels = 0;
+    int64_t ssim_windows = 0;  // the windows the SSIM is the mean of (0: no SSIM)
 };
 
 struct QualityReport {
@@ -55,5 +56,12 @@ BandQuality measureQualityBands(const HmdProfile& profile, const LayerPlan& plan
                                 const Pose& render_pose, const Pose& display_pose,
                                 const ImageRgba8& image, const ImageRgbD& truth,
                                 double blend_band_texels = 2.0, double bin_deg = 5.0);
+
+// PSNR and SSIM of `image` against `reference` (same size, no warp) per labelled region:
+// labels[y · width + x] in 1..regions names the pixel's region, 0 leaves it out (and out of every
+// SSIM window). Returns regions + 1 results, the last over every labelled pixel.
+std::vector<RegionQuality> measureLabelledQuality(const ImageRgba8& image,
+                                                  const ImageRgba8& reference,
+                                                  const std::vector<uint8_t>& labels, int regions);
 
 }  // namespace qvr

@@ -31,6 +31,7 @@ struct RunOptions {
     int quality_every = 15;  // every Nth displayed frame is measured against a full render
     bool one_pass_periphery = false;
     bool no_holes = false;
+    std::string share_periphery = "off";  // the server's --share-periphery
     double headset_share = 1.0;
     std::string ring_counts = "clusters";
     int pipeline_depth = 2;

@@ -22,6 +22,7 @@
 #include "qvr/net/server.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/render/renderer.h"
+#include "qvr/runtime/shared_periphery.h"
 #include "qvr/scene/scene.h"
 
 namespace qvr::runtime {
@@ -101,6 +102,9 @@ struct RenderServerConfig {
     // Leave out of each periphery layer the clusters the compositor takes from a finer layer
     // only (render/renderer.h LayerHoles): a larger fovea then costs the server less.
     LayerHoles holes{.enabled = true};
+    // One outer layer for headsets whose poses are close (docs/RUNTIME.md §Shared periphery);
+    // off by default. Eyes rendered in one pass (one_pass_periphery) are not shared.
+    SharePeripheryConfig share_periphery;
 };
 
 // One served frame, for the per-frame server log (`qvr server --frames-csv`): where the server's
@@ -164,6 +168,7 @@ struct RenderServerStats {
     // Every session, the ended ones too (the oldest ended ones beyond kMaxEndedSessions
     // forgotten), in the order they were admitted.
     std::vector<SessionStats> sessions;
+    SharePeripheryStats share_periphery;
     net::ServerStats net;
 };
 inline constexpr size_t kMaxEndedSessions = 256;
@@ -173,7 +178,8 @@ inline constexpr size_t kMaxEndedSessions = 256;
 // "refused_capacity"}, "sessions": [{"client", "connected", "connected_s", "frames_requested",
 // "frames_dropped", "frames_rendered", "frames_encoded", "frames_sent", "fps_sent",
 // "streams_sent", "stream_send_failures", "render_ms_mean", "encode_ms_mean",
-// "service_ms_mean", "queue_ms_mean"}, ...]} (docs/RUNTIME.md §Serving many headsets).
+// "service_ms_mean", "queue_ms_mean"}, ...], "share_periphery": sharePeripheryJson()}
+// (docs/RUNTIME.md §Serving many headsets, §Shared periphery).
 nlohmann::json serverPoolJson(const RenderServerStats& s);
 
 class RenderServer {

@@ -26,7 +26,8 @@ struct ServerSettings {
     bool one_pass_periphery = false;
     bool no_holes = false;
     float lod_px = 1.0f;
-    bool keep_frame_records = false;  // for a frames CSV
+    bool keep_frame_records = false;      // for a frames CSV
+    std::string share_periphery = "off";  // off, auto or on (SharePeripheryMode)
 };
 // An error when the key, the profile or the link cannot be had.
 Expected<RenderServerConfig> renderServerConfig(const ServerSettings& s);

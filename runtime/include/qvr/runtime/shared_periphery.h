@@ -1,0 +1,171 @@
+// Shared periphery (docs/RUNTIME.md §Shared periphery): headsets of one scene whose head poses are
+// close get one outer layer per eye rendered for all of them — at the finest of their outer
+// sampling rates, over the union of their outer rectangles — each reduced to its own layer rect.
+// Sharing is kept for a headset only while the SSIM of the shared layer against its own outer
+// layer stays above a threshold in every eccentricity band.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "qvr/core/expected.h"
+#include "qvr/core/image.h"
+#include "qvr/core/pose.h"
+#include "qvr/foveation/hmd_profile.h"
+#include "qvr/foveation/layer_plan.h"
+#include "qvr/render/renderer.h"
+
+namespace qvr::runtime {
+
+enum class SharePeripheryMode {
+    kOff,   // every headset its own outer layer
+    kAuto,  // shared among close headsets while the measured SSIM holds
+    kOn,    // shared among close headsets without measuring (for cost measurements)
+};
+Expected<SharePeripheryMode> parseSharePeripheryMode(const std::string& name);
+const char* sharePeripheryModeName(SharePeripheryMode mode);
+
+struct SharePeripheryConfig {
+    SharePeripheryMode mode = SharePeripheryMode::kOff;
+    // Poses this close are candidates: the member's UCA takes a shared layer as rendered at its
+    // own pose, so the difference shows as misregistration (the SSIM measures what it costs).
+    double max_angle_deg = 3.0;
+    double max_position_m = 0.10;
+    // Every eccentricity band's SSIM (luma, 7×7 windows) of the shared layer against the
+    // headset's own must be at least this (docs/RUNTIME.md says why 0.9).
+    double min_ssim = 0.90;
+    double band_deg = 10.0;
+    // A headset's verdict is measured again after this many of its frames.
+    int remeasure_frames = 90;
+};
+
+bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c);
+
+// Groups by pose: each pose joins the first group whose first member (its leader) is close,
+// else starts a group. Indices into `poses`, groups in order of their leaders.
+std::vector<std::vector<size_t>> groupByPose(const std::vector<Pose>& poses,
+                                             const SharePeripheryConfig& c);
+
+// One eccentricity band [lo_deg, hi_deg) of an outer layer.
+struct BandSsim {
+    double lo_deg = 0.0;
+    double hi_deg = 0.0;
+    double ssim = 0.0;
+    int64_t texels = 0;
+};
+
+// SSIM of `shared` (the shared layer as the headset gets it: reduced to its own outer layer)
+// against `own` (its own outer layer) by eccentricity band of band_deg from the plan's gaze.
+// Texels nearer the gaze than hide_below_deg (what the compositor takes from the middle layer
+// only) are left out; bands without a whole 7×7 window are left out.
+std::vector<BandSsim> outerSsimByBand(const HmdProfile& profile, const LayerPlan& plan, Eye eye,
+                                      const ImageRgba8& shared, const ImageRgba8& own,
+                                      double band_deg, double hide_below_deg);
+bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim);
+
+// The layer the group renders for one eye: the union of its members' outer rectangles, widened
+// by margin_deg beyond each edge (what a member's rotation may bring into view), at the finest
+// of their sampling scales, with the plan (gaze, e2) whose hole every member can take (holes off
+// when the members' gazes differ).
+struct SharedOuter {
+    LayerPlan plan;  // a member's plan with eyes[eye].outer the shared rect
+    LayerHoles holes;
+};
+SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
+                            Eye eye, const LayerHoles& holes, double margin_deg = 0.0);
+
+// A shared layer as one member gets it: its outer layer's texels, rotated from the shared
+// render's orientation to the member's (bilinear), or box-filtered when the two are the same.
+// The member's UCA then takes it as rendered at its own pose; position is not corrected.
+void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
+                       const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
+                       const glm::quat& shared_orientation, const glm::quat& member_orientation);
+
+struct SharePeripheryStats {
+    std::string mode = "off";
+    double min_ssim = 0.0;
+    double band_deg = 0.0;
+    uint64_t outer_layers_own = 0;     // rendered for one headset
+    uint64_t outer_layers_shared = 0;  // rendered for a group (and reduced for the renderer)
+    uint64_t outer_layers_reused = 0;  // taken from another headset's shared render
+    uint64_t measurements = 0;
+    uint64_t measurements_failed = 0;  // some band below min_ssim
+    // By band over every measurement: the mean and the lowest SSIM.
+    struct Band {
+        double lo_deg = 0.0, hi_deg = 0.0;
+        double ssim_mean = 0.0, ssim_min = 1.0;
+        uint64_t measurements = 0;
+    };
+    std::vector<Band> ssim_by_band;
+};
+nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame);
+
+// The server's sharing state, thread-safe: the sessions' latest poses and plans, the newest
+// shared layer each session rendered per eye, each session's SSIM verdict.
+class SharedPeriphery {
+public:
+    using Id = uint64_t;
+    explicit SharedPeriphery(SharePeripheryConfig config);
+
+    const SharePeripheryConfig& config() const { return m_config; }
+    void join(Id id);                                                  // a session connected
+    void noteRequest(Id id, const Pose& pose, const LayerPlan& plan);  // a joined session's frame
+    void forget(Id id);
+
+    enum class Action {
+        kOwn,           // render its own outer layer
+        kRenderShared,  // render `shared` for the group, then store() it
+        kReuse,         // `image` holds the layer, reduced from another's shared render
+        kMeasure,       // `image` holds a candidate; render its own, measured(), send its own
+    };
+    struct Decision {
+        Action action = Action::kOwn;
+        SharedOuter shared;
+        ImageRgba8 image;
+    };
+    Decision decide(Id id, Eye eye, const Pose& pose, const LayerPlan& plan,
+                    const HmdProfile& profile, const LayerHoles& holes);
+    void store(Id renderer, Eye eye, const Pose& pose, const LayerRect& rect, ImageRgba8 image);
+    void measured(Id id, Eye eye, const std::vector<BandSsim>& bands);
+    void countOwn();
+    SharePeripheryStats stats() const;
+
+private:
+    struct Entry {
+        Pose pose;
+        LayerRect rect;
+        std::shared_ptr<const ImageRgba8> image;
+        std::set<Id> consumed;  // the members it was given to
+        uint64_t serial = 0;    // newer renders have larger serials
+    };
+    struct Session {
+        Pose pose;
+        LayerPlan plan;
+        bool posed = false;  // a request noted
+        // Per eye: its newest shared render, whether the last measurement passed, and the
+        // frames since.
+        std::array<std::optional<Entry>, 2> entries;
+        std::array<std::optional<bool>, 2> verdict;
+        std::array<int, 2> frames_since_measure{};
+    };
+    std::vector<Id> groupOfLocked(Id id) const;
+    bool dueLocked(const Session& s, size_t eye) const;  // a measurement is due
+    bool anyDueLocked(const std::vector<Id>& group, size_t eye) const;
+
+    SharePeripheryConfig m_config;
+    mutable std::mutex m_mutex;
+    std::map<Id, Session> m_sessions;
+    SharePeripheryStats m_stats;
+    uint64_t m_serial = 0;
+};
+
+}  // namespace qvr::runtime

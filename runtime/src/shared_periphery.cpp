@@ -1,0 +1,367 @@
+// Shared periphery: grouping by pose, the group's outer layer, and the SSIM gate by eccentricity
+// band (shared_periphery.h).
+#include "qvr/runtime/shared_periphery.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+
+#include "qvr/compose/quality.h"
+#include "qvr/compose/warp.h"
+#include "qvr/core/check.h"
+#include "qvr/foveation/eye_geometry.h"
+#include "qvr/render/periphery_pass.h"
+
+namespace qvr::runtime {
+
+Expected<SharePeripheryMode> parseSharePeripheryMode(const std::string& name) {
+    if (name == "off")
+        return SharePeripheryMode::kOff;
+    if (name == "auto")
+        return SharePeripheryMode::kAuto;
+    if (name == "on")
+        return SharePeripheryMode::kOn;
+    return makeError("share-periphery mode '" + name + "': expected off, auto or on");
+}
+
+const char* sharePeripheryModeName(SharePeripheryMode mode) {
+    switch (mode) {
+        case SharePeripheryMode::kAuto:
+            return "auto";
+        case SharePeripheryMode::kOn:
+            return "on";
+        case SharePeripheryMode::kOff:
+            break;
+    }
+    return "off";
+}
+
+bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c) {
+    return angleBetweenDeg(a.orientation, b.orientation) <= c.max_angle_deg &&
+           double(glm::length(a.position_m - b.position_m)) <= c.max_position_m;
+}
+
+std::vector<std::vector<size_t>> groupByPose(const std::vector<Pose>& poses,
+                                             const SharePeripheryConfig& c) {
+    std::vector<std::vector<size_t>> groups;
+    for (size_t i = 0; i < poses.size(); ++i) {
+        auto g = std::find_if(groups.begin(), groups.end(), [&](const std::vector<size_t>& x) {
+            return posesClose(poses[x.front()], poses[i], c);
+        });
+        if (g == groups.end())
+            groups.push_back({i});
+        else
+            g->push_back(i);
+    }
+    return groups;
+}
+
+std::vector<BandSsim> outerSsimByBand(const HmdProfile& profile, const LayerPlan& plan, Eye eye,
+                                      const ImageRgba8& shared, const ImageRgba8& own,
+                                      double band_deg, double hide_below_deg) {
+    QVR_CHECK(band_deg >= 1.0);
+    QVR_CHECK(shared.width() == own.width() && shared.height() == own.height());
+    const LayerRect& outer = plan.eyes[static_cast<size_t>(eye)].outer;
+    const EyeGeometry geometry(profile);
+    const int bands = static_cast<int>(std::ceil(180.0 / band_deg));
+    std::vector<uint8_t> labels(static_cast<size_t>(own.width()) * size_t(own.height()), 0);
+    for (int j = 0; j < own.height(); ++j) {
+        for (int i = 0; i < own.width(); ++i) {
+            const double e_deg =
+                geometry.eccentricityDeg(plan.gaze, outer.rect.x0 + (i + 0.5) * outer.scale,
+                                         outer.rect.y0 + (j + 0.5) * outer.scale);
+            if (e_deg < hide_below_deg)
+                continue;
+            labels[size_t(j) * size_t(own.width()) + size_t(i)] =
+                static_cast<uint8_t>(std::min(bands, 1 + static_cast<int>(e_deg / band_deg)));
+        }
+    }
+    const std::vector<RegionQuality> q = measureLabelledQuality(shared, own, labels, bands);
+    std::vector<BandSsim> out;
+    for (int b = 0; b < bands; ++b) {
+        const RegionQuality& r = q[static_cast<size_t>(b)];
+        if (r.ssim_windows > 0)
+            out.push_back({b * band_deg, (b + 1) * band_deg, r.ssim, r.pixels});
+    }
+    return out;
+}
+
+bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim) {
+    return std::all_of(bands.begin(), bands.end(),
+                       [&](const BandSsim& b) { return b.ssim >= min_ssim; });
+}
+
+SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
+                            Eye eye, const LayerHoles& holes, double margin_deg) {
+    QVR_CHECK(!members.empty());
+    const size_t e = static_cast<size_t>(eye);
+    SharedOuter s{members.front(), holes};
+    LayerRect& u = s.plan.eyes[e].outer;
+    double min_hole_deg = 1e9;
+    for (const LayerPlan& m : members) {
+        const LayerRect& o = m.eyes[e].outer;
+        if (o.empty())
+            continue;
+        if (u.empty()) {
+            u = o;
+        } else {
+            u.rect = {std::min(u.rect.x0, o.rect.x0), std::min(u.rect.y0, o.rect.y0),
+                      std::max(u.rect.x1, o.rect.x1), std::max(u.rect.y1, o.rect.y1)};
+            u.scale = std::min(u.scale, o.scale);
+        }
+        min_hole_deg =
+            std::min(min_hole_deg, layerHoleDeg(profile, m, eye, LayerKind::kOuter, holes));
+        const bool same_gaze = std::fabs(m.gaze.x_deg - s.plan.gaze.x_deg) < 1e-6 &&
+                               std::fabs(m.gaze.y_deg - s.plan.gaze.y_deg) < 1e-6;
+        if (!same_gaze)
+            s.holes.enabled = false;  // their holes are different discs
+    }
+    // Beyond the image by the rotation a member may be off, so its reprojection stays inside.
+    const int margin_px = static_cast<int>(std::ceil(margin_deg / profile.pixelAngleDeg()));
+    u.rect = {u.rect.x0 - margin_px, u.rect.y0 - margin_px, u.rect.x1 + margin_px,
+              u.rect.y1 + margin_px};
+    u.width_px = static_cast<int>(std::ceil(u.rect.width() / u.scale - 1e-9));
+    u.height_px = static_cast<int>(std::ceil(u.rect.height() / u.scale - 1e-9));
+    s.plan.s2 = u.scale;
+    if (!(min_hole_deg > 0.0 && min_hole_deg < 1e9))
+        s.holes.enabled = false;
+    if (s.holes.enabled)  // the hole every member can take: the smallest of theirs
+        s.plan.e2_deg = min_hole_deg + (holes.band_texels + holes.margin_texels) * u.scale *
+                                           profile.pixelAngleDeg();
+    return s;
+}
+
+namespace {
+
+// Bilinear sample of an RGBA8 image at texel coordinates (texel centres at i + 0.5), clamped to
+// the edge.
+void sampleBilinear(const ImageRgba8& img, double u, double v, uint8_t* dst) {
+    const double x = std::clamp(u - 0.5, 0.0, double(img.width() - 1));
+    const double y = std::clamp(v - 0.5, 0.0, double(img.height() - 1));
+    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+    const int x1 = std::min(x0 + 1, img.width() - 1), y1 = std::min(y0 + 1, img.height() - 1);
+    const double fx = x - x0, fy = y - y0;
+    for (int c = 0; c < 3; ++c) {
+        const double top = img.at(x0, y0, c) * (1.0 - fx) + img.at(x1, y0, c) * fx;
+        const double bottom = img.at(x0, y1, c) * (1.0 - fx) + img.at(x1, y1, c) * fx;
+        dst[c] = static_cast<uint8_t>(std::clamp(top * (1.0 - fy) + bottom * fy + 0.5, 0.0, 255.0));
+    }
+    dst[3] = 255;
+}
+
+}  // namespace
+
+void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
+                       const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
+                       const glm::quat& shared_orientation, const glm::quat& member_orientation) {
+    if (angleBetweenDeg(shared_orientation, member_orientation) > 1e-6 && !shared.empty()) {
+        // The member's texel centres through the rotation to the shared render (UCA's map
+        // without the lens, which the layers do not have).
+        HmdProfile flat = profile;
+        flat.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
+        const EyeWarp warp(flat, shared_orientation, member_orientation);
+        out.resize(member_outer.width_px, member_outer.height_px);
+        for (int j = 0; j < member_outer.height_px; ++j) {
+            for (int i = 0; i < member_outer.width_px; ++i) {
+                const WarpSample s =
+                    warp.map(member_outer.rect.x0 + (i + 0.5) * member_outer.scale,
+                             member_outer.rect.y0 + (j + 0.5) * member_outer.scale);
+                sampleBilinear(shared, (s.px - shared_rect.rect.x0) / shared_rect.scale,
+                               (s.py - shared_rect.rect.y0) / shared_rect.scale, &out.at(i, j, 0));
+            }
+        }
+        return;
+    }
+    PeripheryGrid g;
+    g.x0 = shared_rect.rect.x0;
+    g.y0 = shared_rect.rect.y0;
+    g.scale = shared_rect.scale;
+    g.width_px = shared.width();
+    g.height_px = shared.height();
+    reduceToOuter(shared, g, member_outer, out);
+}
+
+nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame) {
+    nlohmann::json bands = nlohmann::json::array();
+    for (const SharePeripheryStats::Band& b : s.ssim_by_band)
+        bands.push_back({{"lo_deg", b.lo_deg},
+                         {"hi_deg", b.hi_deg},
+                         {"ssim_mean", b.ssim_mean},
+                         {"ssim_min", b.ssim_min},
+                         {"measurements", b.measurements}});
+    return {{"mode", s.mode},
+            {"min_ssim", s.min_ssim},
+            {"band_deg", s.band_deg},
+            {"outer_layers_own", s.outer_layers_own},
+            {"outer_layers_shared", s.outer_layers_shared},
+            {"outer_layers_reused", s.outer_layers_reused},
+            {"measurements", s.measurements},
+            {"measurements_failed", s.measurements_failed},
+            {"service_ms_per_headset_frame", service_ms_per_frame},
+            {"ssim_by_band", std::move(bands)}};
+}
+
+SharedPeriphery::SharedPeriphery(SharePeripheryConfig config) : m_config(config) {
+    m_stats.mode = sharePeripheryModeName(config.mode);
+    m_stats.min_ssim = config.min_ssim;
+    m_stats.band_deg = config.band_deg;
+}
+
+void SharedPeriphery::join(Id id) {
+    std::lock_guard lock(m_mutex);
+    m_sessions.try_emplace(id);
+}
+
+void SharedPeriphery::noteRequest(Id id, const Pose& pose, const LayerPlan& plan) {
+    std::lock_guard lock(m_mutex);
+    auto it = m_sessions.find(id);
+    if (it == m_sessions.end())
+        return;  // gone while its frame was served
+    it->second.pose = pose;
+    it->second.plan = plan;
+    it->second.posed = true;
+}
+
+void SharedPeriphery::forget(Id id) {
+    std::lock_guard lock(m_mutex);
+    m_sessions.erase(id);
+}
+
+std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id) const {
+    std::vector<Id> ids;
+    std::vector<Pose> poses;
+    for (const auto& [k, s] : m_sessions) {
+        if (!s.posed)
+            continue;  // no request yet
+        ids.push_back(k);
+        poses.push_back(s.pose);
+    }
+    for (const std::vector<size_t>& g : groupByPose(poses, m_config)) {
+        std::vector<Id> out;
+        for (size_t i : g)
+            out.push_back(ids[i]);
+        if (std::find(out.begin(), out.end(), id) != out.end())
+            return out;
+    }
+    return {id};
+}
+
+bool SharedPeriphery::dueLocked(const Session& s, size_t eye) const {
+    return !s.verdict[eye] || s.frames_since_measure[eye] > m_config.remeasure_frames;
+}
+
+bool SharedPeriphery::anyDueLocked(const std::vector<Id>& group, size_t eye) const {
+    return std::any_of(group.begin(), group.end(),
+                       [&](Id x) { return dueLocked(m_sessions.at(x), eye); });
+}
+
+SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& pose,
+                                                  const LayerPlan& plan, const HmdProfile& profile,
+                                                  const LayerHoles& holes) {
+    Decision d;
+    if (m_config.mode == SharePeripheryMode::kOff)
+        return d;
+    const size_t e = static_cast<size_t>(eye);
+    const LayerRect& outer = plan.eyes[e].outer;
+    std::shared_ptr<const ImageRgba8> from;
+    LayerRect from_rect;
+    glm::quat from_orientation;
+    {
+        std::lock_guard lock(m_mutex);
+        auto self = m_sessions.find(id);
+        if (self == m_sessions.end())
+            return d;  // gone while its frame was served
+        const std::vector<Id> group = groupOfLocked(id);
+        if (group.size() < 2)
+            return d;
+        Session& me = self->second;
+        ++me.frames_since_measure[e];
+        // The newest usable shared render of another member: close to this pose, covering this
+        // headset's outer layer at least as finely, not given to it yet.
+        Entry* best = nullptr;
+        for (Id other : group) {
+            if (other == id)
+                continue;
+            auto& entry = m_sessions[other].entries[e];
+            if (entry && !entry->consumed.contains(id) && posesClose(entry->pose, pose, m_config) &&
+                entry->rect.rect.contains(outer.rect) && entry->rect.scale <= outer.scale + 1e-9 &&
+                (!best || entry->serial > best->serial))
+                best = &*entry;
+        }
+        const bool due = dueLocked(me, e);
+        if (best && m_config.mode == SharePeripheryMode::kAuto && due) {
+            d.action = Action::kMeasure;
+        } else if (best && (m_config.mode == SharePeripheryMode::kOn || *me.verdict[e])) {
+            d.action = Action::kReuse;
+            ++m_stats.outer_layers_reused;
+        } else if (m_config.mode == SharePeripheryMode::kAuto && me.verdict[e] == false &&
+                   !anyDueLocked(group, e)) {
+            return d;  // it does not share, and nobody needs its render to measure against
+        } else {
+            std::vector<LayerPlan> plans = {plan};
+            for (Id other : group)
+                if (other != id)
+                    plans.push_back(m_sessions[other].plan);
+            d.action = Action::kRenderShared;
+            d.shared = sharedOuterPlan(profile, plans, eye, holes, m_config.max_angle_deg);
+            ++m_stats.outer_layers_shared;
+            return d;
+        }
+        best->consumed.insert(id);
+        from = best->image;
+        from_rect = best->rect;
+        from_orientation = best->pose.orientation;
+    }
+    reduceSharedOuter(*from, from_rect, outer, d.image, profile, from_orientation,
+                      pose.orientation);
+    return d;
+}
+
+void SharedPeriphery::store(Id renderer, Eye eye, const Pose& pose, const LayerRect& rect,
+                            ImageRgba8 image) {
+    std::lock_guard lock(m_mutex);
+    auto it = m_sessions.find(renderer);
+    if (it == m_sessions.end())
+        return;
+    it->second.entries[static_cast<size_t>(eye)] =
+        Entry{pose, rect, std::make_shared<const ImageRgba8>(std::move(image)), {}, ++m_serial};
+}
+
+void SharedPeriphery::measured(Id id, Eye eye, const std::vector<BandSsim>& bands) {
+    std::lock_guard lock(m_mutex);
+    const bool pass = bandsPass(bands, m_config.min_ssim);
+    ++m_stats.measurements;
+    m_stats.measurements_failed += pass ? 0 : 1;
+    auto it = m_sessions.find(id);
+    if (it != m_sessions.end()) {
+        it->second.verdict[static_cast<size_t>(eye)] = pass;
+        it->second.frames_since_measure[static_cast<size_t>(eye)] = 0;
+    }
+    for (const BandSsim& b : bands) {
+        auto& v = m_stats.ssim_by_band;
+        auto x =
+            std::find_if(v.begin(), v.end(), [&](const auto& y) { return y.lo_deg == b.lo_deg; });
+        if (x == v.end()) {
+            x = v.insert(std::upper_bound(v.begin(), v.end(), b.lo_deg,
+                                          [](double lo, const auto& y) { return lo < y.lo_deg; }),
+                         SharePeripheryStats::Band{b.lo_deg, b.hi_deg, 0.0, 1.0, 0});
+        }
+        ++x->measurements;
+        x->ssim_mean += (b.ssim - x->ssim_mean) / double(x->measurements);
+        x->ssim_min = std::min(x->ssim_min, b.ssim);
+    }
+}
+
+void SharedPeriphery::countOwn() {
+    std::lock_guard lock(m_mutex);
+    ++m_stats.outer_layers_own;
+}
+
+SharePeripheryStats SharedPeriphery::stats() const {
+    std::lock_guard lock(m_mutex);
+    return m_stats;
+}
+
+}  // namespace qvr::runtime

@@ -1,0 +1,226 @@
+// Shared periphery: grouping by pose, the group's outer layer and the SSIM gate by band.
+#include "qvr/runtime/shared_periphery.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#include "qvr/compose/test_pattern.h"
+#include "qvr/foveation/eye_geometry.h"
+#include "qvr/runtime/render_server.h"
+#include "qvr/runtime/session.h"
+
+namespace qvr::runtime {
+namespace {
+
+HmdProfile smallProfile() {
+    return runtimeProfileByName("small").value();
+}
+
+Pose yawed(double yaw_deg, float x_m = 0.0f) {
+    Pose p;
+    p.orientation = quatFromEulerDeg({yaw_deg, 0.0, 0.0});
+    p.position_m.x = x_m;
+    return p;
+}
+
+TEST(SharedPeriphery, GroupsPosesCloseToTheirLeader) {
+    SharePeripheryConfig c;
+    c.max_angle_deg = 3.0;
+    c.max_position_m = 0.1;
+    EXPECT_TRUE(posesClose(yawed(0.0), yawed(2.5), c));
+    EXPECT_FALSE(posesClose(yawed(0.0), yawed(3.5), c));
+    EXPECT_FALSE(posesClose(yawed(0.0), yawed(0.0, 0.2f), c));
+    const auto groups = groupByPose({yawed(0.0), yawed(20.0), yawed(1.0), yawed(21.0, 0.05f)}, c);
+    ASSERT_EQ(groups.size(), 2u);
+    EXPECT_EQ(groups[0], (std::vector<size_t>{0, 2}));
+    EXPECT_EQ(groups[1], (std::vector<size_t>{1, 3}));
+    // A pose close to a member but not to its leader starts a group of its own.
+    EXPECT_EQ(groupByPose({yawed(0.0), yawed(2.5), yawed(5.0)}, c).size(), 2u);
+}
+
+TEST(SharedPeriphery, SsimByBandSeesOnlyTheBandsThatDiffer) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const LayerRect& outer = plan.eyes[0].outer;
+    ASSERT_FALSE(outer.empty());
+    const ImageRgba8 own = renderTestPattern(outer.width_px, outer.height_px);
+    const auto same = outerSsimByBand(profile, plan, Eye::kLeft, own, own, 10.0, 0.0);
+    ASSERT_GE(same.size(), 3u);
+    for (const BandSsim& b : same)
+        EXPECT_NEAR(b.ssim, 1.0, 1e-9) << b.lo_deg;
+    EXPECT_TRUE(bandsPass(same, 0.9));
+    // Shift the texels beyond 40° by one texel: those bands drop, the inner ones stay whole
+    // (a band's windows near the 40° edge see both, so the test looks below 30°).
+    const EyeGeometry g(profile);
+    ImageRgba8 shared = own;
+    for (int y = 0; y < own.height(); ++y) {
+        for (int x = 1; x < own.width(); ++x) {
+            const double e_deg =
+                g.eccentricityDeg(plan.gaze, outer.rect.x0 + (x + 0.5) * outer.scale,
+                                  outer.rect.y0 + (y + 0.5) * outer.scale);
+            if (e_deg <= 40.0)
+                continue;
+            for (int c = 0; c < 4; ++c)
+                shared.at(x, y, c) = own.at(x - 1, y, c);
+        }
+    }
+    const auto shifted = outerSsimByBand(profile, plan, Eye::kLeft, shared, own, 10.0, 0.0);
+    ASSERT_EQ(shifted.size(), same.size());
+    bool outer_dropped = false;
+    for (const BandSsim& b : shifted) {
+        if (b.hi_deg <= 30.0) {
+            EXPECT_NEAR(b.ssim, 1.0, 1e-9) << b.lo_deg;
+        }
+        if (b.lo_deg >= 50.0 && b.ssim < 0.9)
+            outer_dropped = true;
+    }
+    EXPECT_TRUE(outer_dropped);
+    EXPECT_FALSE(bandsPass(shifted, 0.9));
+    // Texels nearer than hide_below_deg are left out.
+    const auto hidden = outerSsimByBand(profile, plan, Eye::kLeft, shared, own, 10.0, 30.0);
+    EXPECT_GE(hidden.front().lo_deg, 30.0);
+}
+
+// A layer whose colour is a smooth function of the world direction, as rendered at `head`.
+ImageRgba8 directionLayer(const HmdProfile& profile, const LayerRect& l, const glm::quat& head) {
+    const EyeGeometry g(profile);
+    ImageRgba8 img(l.width_px, l.height_px);
+    for (int j = 0; j < l.height_px; ++j) {
+        for (int i = 0; i < l.width_px; ++i) {
+            const glm::dvec3 d = glm::dquat(head) * g.directionAt(l.rect.x0 + (i + 0.5) * l.scale,
+                                                                  l.rect.y0 + (j + 0.5) * l.scale);
+            img.at(i, j, 0) = static_cast<uint8_t>(128.0 + 120.0 * d.x);
+            img.at(i, j, 1) = static_cast<uint8_t>(128.0 + 120.0 * d.y);
+            img.at(i, j, 2) = 128;
+            img.at(i, j, 3) = 255;
+        }
+    }
+    return img;
+}
+
+double meanAbsError(const ImageRgba8& a, const ImageRgba8& b) {
+    double sum = 0.0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x)
+            for (int c = 0; c < 3; ++c)
+                sum += std::abs(int(a.at(x, y, c)) - int(b.at(x, y, c)));
+    return sum / (3.0 * a.width() * a.height());
+}
+
+TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const SharedOuter s = sharedOuterPlan(profile, {plan}, Eye::kLeft, {}, 3.0);
+    const LayerRect& shared_rect = s.plan.eyes[0].outer;
+    const LayerRect& member = plan.eyes[0].outer;
+    EXPECT_LT(shared_rect.rect.x0, 0);  // widened beyond the image by the margin
+    const glm::quat a = quatFromEulerDeg({0.0, 0.0, 0.0});
+    const glm::quat b = quatFromEulerDeg({2.0, 1.0, 0.0});
+    const ImageRgba8 shared = directionLayer(profile, shared_rect, a);
+    const ImageRgba8 truth = directionLayer(profile, member, b);
+    ImageRgba8 reprojected, unmoved;
+    reduceSharedOuter(shared, shared_rect, member, reprojected, profile, a, b);
+    reduceSharedOuter(shared, shared_rect, member, unmoved, profile, a, a);
+    ASSERT_EQ(reprojected.width(), member.width_px);
+    const double err = meanAbsError(reprojected, truth);
+    EXPECT_LT(err, 0.6);
+    EXPECT_GT(meanAbsError(unmoved, truth), 3.0 * err);
+}
+
+TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlanner planner(profile);
+    const LayerPlan a = planner.plan({0.0, 0.0}, 10.0);
+    const LayerPlan b = planner.plan({0.0, 0.0}, 25.0);
+    ASSERT_NE(a.eyes[0].outer.scale, b.eyes[0].outer.scale);
+    const LayerHoles holes{.enabled = true};
+    const SharedOuter s = sharedOuterPlan(profile, {a, b}, Eye::kLeft, holes);
+    const LayerRect& u = s.plan.eyes[0].outer;
+    EXPECT_DOUBLE_EQ(u.scale, std::min(a.eyes[0].outer.scale, b.eyes[0].outer.scale));
+    EXPECT_TRUE(u.rect.contains(a.eyes[0].outer.rect));
+    EXPECT_TRUE(u.rect.contains(b.eyes[0].outer.rect));
+    // Its hole is no larger than either member's.
+    const double hole = layerHoleDeg(profile, s.plan, Eye::kLeft, LayerKind::kOuter, s.holes);
+    EXPECT_LE(hole, layerHoleDeg(profile, a, Eye::kLeft, LayerKind::kOuter, holes) + 1e-9);
+    EXPECT_LE(hole, layerHoleDeg(profile, b, Eye::kLeft, LayerKind::kOuter, holes) + 1e-9);
+    // Different gazes: different hole discs, so none.
+    const LayerPlan c = planner.plan({10.0, 0.0}, 10.0);
+    EXPECT_FALSE(sharedOuterPlan(profile, {a, c}, Eye::kLeft, holes).holes.enabled);
+}
+
+TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const LayerHoles holes{.enabled = true};
+    SharePeripheryConfig c;
+    c.mode = SharePeripheryMode::kAuto;
+    SharedPeriphery sp(c);
+    using A = SharedPeriphery::Action;
+    sp.join(1);
+    sp.join(2);
+    sp.noteRequest(1, yawed(0.0), plan);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, yawed(0.0), plan, profile, holes).action, A::kOwn);
+    sp.noteRequest(2, yawed(1.0), plan);
+    auto d = sp.decide(1, Eye::kLeft, yawed(0.0), plan, profile, holes);
+    ASSERT_EQ(d.action, A::kRenderShared);
+    const LayerRect rect = d.shared.plan.eyes[0].outer;
+    const ImageRgba8 layer = renderTestPattern(rect.width_px, rect.height_px);
+    sp.store(1, Eye::kLeft, yawed(0.0), rect, layer);
+    // Headset 2 measures before it shares; a passing measurement lets it reuse the next one.
+    d = sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes);
+    ASSERT_EQ(d.action, A::kMeasure);
+    EXPECT_EQ(d.image.width(), plan.eyes[0].outer.width_px);
+    sp.measured(2, Eye::kLeft, {{50.0, 60.0, 0.95, 100}});
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action,
+              A::kRenderShared);  // that render was given to it already
+    sp.store(1, Eye::kLeft, yawed(0.0), rect, layer);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kReuse);
+    // A failing band stops the reuse until the next measurement.
+    sp.measured(2, Eye::kLeft, {{50.0, 60.0, 0.95, 100}, {60.0, 70.0, 0.5, 100}});
+    sp.store(1, Eye::kLeft, yawed(0.0), rect, layer);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kRenderShared);
+    // Far apart: each its own.
+    sp.noteRequest(2, yawed(30.0), plan);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(30.0), plan, profile, holes).action, A::kOwn);
+    // A session that left is not brought back by a late request.
+    sp.forget(1);
+    sp.noteRequest(1, yawed(1.0), plan);
+    sp.noteRequest(2, yawed(1.0), plan);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kOwn);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kOwn);
+    const SharePeripheryStats s = sp.stats();
+    EXPECT_EQ(s.measurements, 2u);
+    EXPECT_EQ(s.measurements_failed, 1u);
+    EXPECT_EQ(s.outer_layers_reused, 1u);
+    ASSERT_EQ(s.ssim_by_band.size(), 2u);
+    EXPECT_DOUBLE_EQ(s.ssim_by_band[0].ssim_mean, 0.95);
+    EXPECT_DOUBLE_EQ(s.ssim_by_band[1].ssim_min, 0.5);
+}
+
+TEST(SharedPeriphery, OffNeverShares) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    SharedPeriphery sp(SharePeripheryConfig{});
+    sp.join(1);
+    sp.join(2);
+    sp.noteRequest(1, Pose{}, plan);
+    sp.noteRequest(2, Pose{}, plan);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, Pose{}, plan, profile, {}).action,
+              SharedPeriphery::Action::kOwn);
+    RenderServerStats stats;
+    stats.share_periphery = sp.stats();
+    const nlohmann::json j = serverPoolJson(stats)["share_periphery"];
+    EXPECT_EQ(j["mode"], "off");
+    for (const char* key :
+         {"min_ssim", "band_deg", "outer_layers_own", "outer_layers_shared", "outer_layers_reused",
+          "measurements", "measurements_failed", "service_ms_per_headset_frame", "ssim_by_band"})
+        EXPECT_TRUE(j.contains(key)) << key;
+    EXPECT_FALSE(parseSharePeripheryMode("sometimes").ok());
+    EXPECT_EQ(*parseSharePeripheryMode("auto"), SharePeripheryMode::kAuto);
+}
+
+}  // namespace
+}  // namespace qvr::runtime
