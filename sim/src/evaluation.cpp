@@ -223,7 +223,7 @@ Status writeFramesCsv(const std::string& path, const std::vector<FrameRecord>& f
             "{},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},"
             "{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.0f},{:.0f},{:.0f},{:.4f},"
             "{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}\n",
-            r.index, r.e1_deg, r.e2_deg, r.start_ms, r.render_start_ms, r.render_end_ms,
+            r.index, r.e1_deg, r.e2_deg, r.pose_ms, r.render_start_ms, r.render_end_ms,
             r.remote_ready_ms, r.display_ready_ms, r.render_work_ms, r.t_local_ms, r.t_remote_ms,
             r.net_ms, r.server_render_ms, r.encode_ms, r.decode_ms, r.comp_ms, r.atw_ms, r.uca_ms,
             r.gpu_ms, r.preemptions, r.bytes, r.goodput_bps, r.shaded_pixels, r.mtp_ms, r.fps,
