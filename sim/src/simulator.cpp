@@ -440,9 +440,10 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
 
 namespace {
 
-// The statistics every pipeline shares, from core's summariser: the first warmup_frames left out.
+// The statistics every pipeline shares, from core's summariser: the first warmup_frames left out,
+// the MTP p99 exact however long the run (its frames are in memory anyway).
 RunStats sharedStats(const std::vector<FrameRecord>& frames, int warmup_frames) {
-    FrameSummarizer summarizer(warmup_frames);
+    FrameSummarizer summarizer(warmup_frames, frames.size());
     for (const FrameRecord& r : frames)
         summarizer.add(r);
     return summarizer.finish();
