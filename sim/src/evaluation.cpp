@@ -703,6 +703,29 @@ Finding fewerBytesThanStatic(const EvalRuns& runs) {
                         *std::max_element(r.begin(), r.end()))};
 }
 
+// The figures' CSV and plots in order, up to the first that cannot be written; the CSV text the
+// report quotes is kept in `report`.
+Status writeFigures(const EvalRuns& runs, Outputs& out, ReportInputs& report) {
+    const auto keep = [](Expected<std::string> csv, std::string& into) -> Status {
+        if (!csv)
+            return makeError(csv.error());
+        into = std::move(*csv);
+        return Status::success();
+    };
+    Status st = keep(writeFig12(runs, out), report.fig12);
+    if (st)
+        st = keep(writeFig13(runs, out), report.fig13);
+    if (st)
+        st = writeFig14(runs, out);
+    if (st)
+        st = keep(writeTable4(runs, out), report.t4);
+    if (st)
+        st = keep(writeFig15(runs, out), report.f15);
+    if (st)
+        st = writeMahimahi(runs, out);
+    return st;
+}
+
 }  // namespace
 
 Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
@@ -741,17 +764,7 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
 
     Outputs out(options.out_dir);
     ReportInputs report{options, runs, output, "", "", "", ""};
-    auto fig12 = writeFig12(runs, out);
-    auto fig13 = fig12 ? writeFig13(runs, out) : Expected<std::string>(makeError(fig12.error()));
-    if (!fig13)
-        return makeError(fig13.error());
-    if (Status st = writeFig14(runs, out); !st)
-        return makeError(st.error());
-    auto t4 = writeTable4(runs, out);
-    auto f15 = t4 ? writeFig15(runs, out) : Expected<std::string>(makeError(t4.error()));
-    if (!f15)
-        return makeError(f15.error());
-    if (Status st = writeMahimahi(runs, out); !st)
+    if (Status st = writeFigures(runs, out, report); !st)
         return makeError(st.error());
 
     output.headlines = computeHeadlines(runs);
@@ -766,10 +779,6 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
         return makeError(st.error());
     out.files().push_back("summary.json");
     output.plot_note = out.plotNote();
-    report.fig12 = std::move(*fig12);
-    report.fig13 = std::move(*fig13);
-    report.t4 = std::move(*t4);
-    report.f15 = std::move(*f15);
     if (Status st = writeReport(report, out); !st)
         return makeError(st.error());
     output.files = out.files();
