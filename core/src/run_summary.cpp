@@ -32,8 +32,9 @@ size_t histBin(double ms) {
 
 }  // namespace
 
-FrameSummarizer::FrameSummarizer(int warmup_frames)
-    : m_warmup(warmup_frames > 0 ? static_cast<size_t>(warmup_frames) : 0) {
+FrameSummarizer::FrameSummarizer(int warmup_frames, size_t exact_mtp_frames)
+    : m_warmup(warmup_frames > 0 ? static_cast<size_t>(warmup_frames) : 0),
+      m_exact_mtp_frames(exact_mtp_frames) {
     m_startup.reserve(m_warmup);
 }
 
@@ -75,7 +76,7 @@ void FrameSummarizer::count(const FrameSample& f) {
     m_mtp_sum += f.mtp_ms;
     m_mtp_min = m_s.frames == 1 ? f.mtp_ms : std::min(m_mtp_min, f.mtp_ms);
     m_mtp_max = m_s.frames == 1 ? f.mtp_ms : std::max(m_mtp_max, f.mtp_ms);
-    if (m_mtp_hist.empty() && m_mtp_exact.size() < kExactMtpFrames) {
+    if (m_mtp_hist.empty() && m_mtp_exact.size() < m_exact_mtp_frames) {
         m_mtp_exact.push_back(f.mtp_ms);
     } else {
         if (m_mtp_hist.empty()) {
@@ -119,7 +120,7 @@ double FrameSummarizer::mtpP99() const {
 RunStats FrameSummarizer::finish() const {
     if (!m_startup_done && !m_startup.empty()) {
         // No frame past the start-up: summarize every frame.
-        FrameSummarizer all(0);
+        FrameSummarizer all(0, m_exact_mtp_frames);
         for (const FrameSample& f : m_startup)
             all.add(f);
         RunStats s = all.finish();

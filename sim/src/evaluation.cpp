@@ -214,7 +214,7 @@ Status writeFramesCsv(const std::string& path, const std::vector<FrameRecord>& f
             "{},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},"
             "{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.0f},{:.0f},{:.0f},{:.4f},"
             "{:.3f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}\n",
-            r.index, r.e1_deg, r.e2_deg, r.start_ms, r.render_start_ms, r.render_end_ms,
+            r.index, r.e1_deg, r.e2_deg, r.pose_ms, r.render_start_ms, r.render_end_ms,
             r.remote_ready_ms, r.display_ready_ms, r.render_work_ms, r.t_local_ms, r.t_remote_ms,
             r.net_ms, r.server_render_ms, r.encode_ms, r.decode_ms, r.comp_ms, r.atw_ms, r.uca_ms,
             r.gpu_ms, r.preemptions, r.bytes, r.goodput_bps, r.shaded_pixels, r.mtp_ms, r.fps,
@@ -694,6 +694,29 @@ Finding fewerBytesThanStatic(const EvalRuns& runs) {
                         *std::max_element(r.begin(), r.end()))};
 }
 
+// The figures' CSV and plots in order, up to the first that cannot be written; the CSV text the
+// report quotes is kept in `report`.
+Status writeFigures(const EvalRuns& runs, Outputs& out, ReportInputs& report) {
+    const auto keep = [](Expected<std::string> csv, std::string& into) -> Status {
+        if (!csv)
+            return makeError(csv.error());
+        into = std::move(*csv);
+        return Status::success();
+    };
+    Status st = keep(writeFig12(runs, out), report.fig12);
+    if (st)
+        st = keep(writeFig13(runs, out), report.fig13);
+    if (st)
+        st = writeFig14(runs, out);
+    if (st)
+        st = keep(writeTable4(runs, out), report.t4);
+    if (st)
+        st = keep(writeFig15(runs, out), report.f15);
+    if (st)
+        st = writeMahimahi(runs, out);
+    return st;
+}
+
 }  // namespace
 
 Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
@@ -732,24 +755,8 @@ Expected<EvalOutput> runEvaluation(const EvalOptions& options) {
 
     Outputs out(options.out_dir);
     ReportInputs report{options, runs, output, "", "", "", ""};
-    // The figures' files, in the order they are listed; four of them return the HTML the report
-    // embeds.
-    auto embed = [](Expected<std::string> html, std::string& into) -> Status {
-        if (!html)
-            return makeError(html.error());
-        into = std::move(*html);
-        return {};
-    };
-    const std::function<Status()> figures[] = {
-        [&] { return embed(writeFig12(runs, out), report.fig12); },
-        [&] { return embed(writeFig13(runs, out), report.fig13); },
-        [&] { return writeFig14(runs, out); },
-        [&] { return embed(writeTable4(runs, out), report.t4); },
-        [&] { return embed(writeFig15(runs, out), report.f15); },
-        [&] { return writeMahimahi(runs, out); }};
-    for (const std::function<Status()>& write : figures)
-        if (Status st = write(); !st)
-            return makeError(st.error());
+    if (Status st = writeFigures(runs, out, report); !st)
+        return makeError(st.error());
 
     output.headlines = computeHeadlines(runs);
     output.findings = {qvrBeatsDfrAndFfr(runs), dfrBeatsFfr(runs), e1Order(runs, true),

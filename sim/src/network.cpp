@@ -18,13 +18,14 @@ double RadioPower::energyPerBitNj(double goodput_bps) const {
     return alpha_mw_per_mbps + beta_mw * 1e6 / goodput_bps;
 }
 
+double Link::packetsOf(double payload_bytes) const {
+    return std::max(1.0, std::ceil(payload_bytes / (m_efficiency * kMahimahiPacketBytes)));
+}
+
 NoisyLink::NoisyLink(std::string name, double nominal_bps, double efficiency, double snr_db,
                      RadioPower radio, uint64_t seed)
-    : m_name(std::move(name)),
-      m_nominal_bps(nominal_bps),
-      m_efficiency(efficiency),
+    : Link(std::move(name), nominal_bps, efficiency, radio),
       m_sigma(std::isfinite(snr_db) ? std::pow(10.0, -snr_db / 20.0) : 0.0),
-      m_radio(radio),
       m_rng(seed) {
     QVR_CHECK(nominal_bps > 0.0 && efficiency > 0.0 && efficiency <= 1.0);
 }
@@ -42,20 +43,13 @@ LinkTransfer NoisyLink::transfer(double /*start_ms*/, double payload_bytes) {
     return {payload_bytes * 8.0 / goodput_bps * 1e3, goodput_bps};
 }
 
-double NoisyLink::packetsOf(double payload_bytes) const {
-    return std::max(1.0, std::ceil(payload_bytes / (m_efficiency * kMahimahiPacketBytes)));
-}
-
 double NoisyLink::noiseSigmaOver(double payload_bytes) const {
     return m_sigma / std::sqrt(packetsOf(payload_bytes));
 }
 
 TraceLink::TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
                      double efficiency, RadioPower radio)
-    : m_name(std::move(name)),
-      m_target_mean_bps(target_mean_bps),
-      m_efficiency(efficiency),
-      m_radio(radio) {
+    : Link(std::move(name), target_mean_bps, efficiency, radio) {
     QVR_CHECK(target_mean_bps > 0.0 && trace.period_ms > 0);
     // Dividing every stamp by target/trace mean scales the capacity to the target.
     m_time_scale = trace.meanBps() / target_mean_bps;
@@ -70,8 +64,7 @@ LinkTransfer TraceLink::transfer(double start_ms, double payload_bytes) {
         return {0.0, meanGoodputBps()};
     const auto& opp = m_opportunities_ms;
     const double period = m_period_ms;
-    const int64_t packets = static_cast<int64_t>(
-        std::ceil(payload_bytes / (m_efficiency * static_cast<double>(kMahimahiPacketBytes))));
+    const int64_t packets = static_cast<int64_t>(packetsOf(payload_bytes));
     const double start = std::max(0.0, start_ms);
     double cycle = std::floor(start / period);
     const double offset = start - cycle * period;

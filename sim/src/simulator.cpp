@@ -338,13 +338,12 @@ void Pipeline::finishFrame(FrameRecord& r, const FrameWork& work, double preempt
     const double period_ms = std::max(r.gpu_ms, r.net_ms);
     r.fps = period_ms > 0.0 ? 1000.0 / period_ms : 0.0;
     const double vsync_ms = 1000.0 / m_header.profile.refresh_hz;
-    r.shown_ms = m_config.vsync_paced ? std::ceil(r.display_ready_ms / vsync_ms) * vsync_ms
-                                      : r.display_ready_ms;
+    r.display_ms = m_config.vsync_paced ? std::ceil(r.display_ready_ms / vsync_ms) * vsync_ms
+                                        : r.display_ready_ms;
     // Motion-to-photon runs from the oldest pose whose pixels reach the display: for the static
     // design that is the pose the prefetched background was rendered for.
-    const double pose_ms =
-        work.remote.valid ? std::min(r.start_ms, work.remote.pose_ms) : r.start_ms;
-    r.mtp_ms = m_hw.fixed.sensor_ms + (r.shown_ms - pose_ms) + m_hw.fixed.display_ms;
+    const double pose_ms = work.remote.valid ? std::min(r.pose_ms, work.remote.pose_ms) : r.pose_ms;
+    r.mtp_ms = m_hw.fixed.sensor_ms + (r.display_ms - pose_ms) + m_hw.fixed.display_ms;
     m_previous_inputs_delay_ms = std::max(0.0, inputs_ready_ms - r.request_ms);
     r.latency_ratio =
         (r.t_local_ms > 0.0 && r.t_remote_ms > 0.0) ? r.t_remote_ms / r.t_local_ms : 0.0;
@@ -376,7 +375,7 @@ FrameRecord Pipeline::step(int n, int n_frames) {
     FrameRecord r;
     r.index = frame.index;
     const double start = paceStart();
-    r.start_ms = start;
+    r.pose_ms = start;
     m_previous_start_ms = start;
     const double ls_end = start + leadMs();
     m_cpu_free = ls_end;
@@ -404,6 +403,7 @@ FrameRecord Pipeline::step(int n, int n_frames) {
 
     const RemoteFetch& remote = work.remote;
     r.remote_ready_ms = remote.valid ? remote.ready_ms : slot.end_ms;
+    r.remote_requested = remote.valid;
     if (remote.valid) {
         r.t_remote_ms = remote.t_remote_ms;
         r.net_ms = remote.net_ms;
@@ -438,6 +438,19 @@ RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& li
     return result;
 }
 
+namespace {
+
+// The statistics every pipeline shares, from core's summariser: the first warmup_frames left out,
+// the MTP p99 exact however long the run (its frames are in memory anyway).
+RunStats sharedStats(const std::vector<FrameRecord>& frames, int warmup_frames) {
+    FrameSummarizer summarizer(warmup_frames, frames.size());
+    for (const FrameRecord& r : frames)
+        summarizer.add(r);
+    return summarizer.finish();
+}
+
+}  // namespace
+
 RunSummary summarize(const std::vector<FrameRecord>& frames, const SimConfig& config,
                      const std::string& net_name, double refresh_hz) {
     RunSummary s;
@@ -448,46 +461,39 @@ RunSummary summarize(const std::vector<FrameRecord>& frames, const SimConfig& co
     s.frames = static_cast<int>(frames.size());
     if (frames.empty())
         return s;
+    const RunStats all = sharedStats(frames, 0);
+    s.mtp_ms_mean = all.mtp_ms_mean;
+    s.mtp_ms_p99 = all.mtp_ms_p99;
+    s.bytes_per_frame_mean = all.bytes_per_frame_mean;
+    s.e1_deg_mean = all.e1_deg_mean;
+    s.e1_deg_steady = sharedStats(frames, steadyStateStart(s.frames)).e1_deg_mean;
+    s.t_local_ms_mean = all.t_local_ms_mean;
+    s.t_remote_ms_mean = all.t_remote_ms_mean;
+    s.uca_ms_mean = all.uca_ms_mean;
     const double n = static_cast<double>(frames.size());
-    std::vector<double> mtp;
-    double period_sum = 0.0, e1_steady_sum = 0.0;
-    int steady_n = 0;
-    const int steady_from = steadyStateStart(s.frames);
+    double period_sum = 0.0;
     for (const FrameRecord& r : frames) {
-        mtp.push_back(r.mtp_ms);
-        s.mtp_ms_mean += r.mtp_ms / n;
         period_sum += std::max(r.gpu_ms, r.net_ms);
-        s.bytes_per_frame_mean += r.bytes / n;
         s.pixels_per_frame_mean += r.shaded_pixels / n;
         s.energy_mean.gpu_dynamic_mj += r.energy.gpu_dynamic_mj / n;
         s.energy_mean.gpu_static_mj += r.energy.gpu_static_mj / n;
         s.energy_mean.radio_mj += r.energy.radio_mj / n;
         s.energy_mean.uca_mj += r.energy.uca_mj / n;
         s.energy_mean.liwc_mj += r.energy.liwc_mj / n;
-        s.e1_deg_mean += r.e1_deg / n;
-        s.t_local_ms_mean += r.t_local_ms / n;
-        s.t_remote_ms_mean += r.t_remote_ms / n;
         s.render_wait_ms_mean += (r.t_local_ms - r.render_work_ms) / n;
         s.gpu_ms_mean += r.gpu_ms / n;
         s.net_ms_mean += r.net_ms / n;
         s.preemptions_per_frame += r.preemptions / n;
         s.comp_ms_mean += r.comp_ms / n;
         s.atw_ms_mean += r.atw_ms / n;
-        s.uca_ms_mean += r.uca_ms / n;
         s.display_dram_mb_per_frame += r.display_dram_bytes * 1e-6 / n;
         s.display_dram_ms_mean += r.display_dram_ms / n;
         s.radio_w_max = std::max(s.radio_w_max, r.radio_w);
-        if (r.index - frames.front().index >= steady_from) {
-            e1_steady_sum += r.e1_deg;
-            ++steady_n;
-        }
     }
-    s.mtp_ms_p99 = percentile(mtp, 99.0);
     s.fps_mean = period_sum > 0.0 ? 1000.0 * n / period_sum : 0.0;
-    const double span_ms = frames.back().shown_ms - frames.front().shown_ms;
-    s.fps_pipeline = span_ms > 0.0 ? 1000.0 * (n - 1.0) / span_ms : s.fps_mean;
+    // Core's rate of display needs two frames shown at different times.
+    s.fps_pipeline = all.fps_mean > 0.0 ? all.fps_mean : s.fps_mean;
     s.energy_mj_per_frame = s.energy_mean.total();
-    s.e1_deg_steady = steady_n > 0 ? e1_steady_sum / steady_n : s.e1_deg_mean;
     std::vector<double> tail;
     for (size_t i = frames.size() > 30 ? frames.size() - 30 : 0; i < frames.size(); ++i)
         tail.push_back(frames[i].latency_ratio);

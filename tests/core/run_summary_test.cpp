@@ -89,5 +89,25 @@ TEST(FrameSummarizer, TheStartUpLastsUntilRemoteLayersAreShown) {
     EXPECT_EQ(never.frames, 20);
 }
 
+TEST(FrameSummarizer, KeepsAsManyMtpsExactAsItIsTold) {
+    // Beyond exact_mtp_frames the p99 is the histogram's; a caller that asks for every frame gets
+    // the nearest rank itself.
+    std::vector<FrameSample> v = steadyFrames(200);
+    std::vector<double> mtp;
+    for (size_t i = 0; i < v.size(); ++i) {
+        v[i].mtp_ms = 10.0 + std::fmod(7.3 * static_cast<double>(i), 13.0);
+        mtp.push_back(v[i].mtp_ms);
+    }
+    auto p99 = [&](size_t exact_mtp_frames) {
+        FrameSummarizer s(0, exact_mtp_frames);
+        for (const FrameSample& f : v)
+            s.add(f);
+        return s.finish().mtp_ms_p99;
+    };
+    EXPECT_EQ(p99(v.size()), percentile(mtp, 99.0));
+    EXPECT_NE(p99(50), percentile(mtp, 99.0));
+    EXPECT_NEAR(p99(50), percentile(mtp, 99.0), percentile(mtp, 99.0) * 1e-3);
+}
+
 }  // namespace
 }  // namespace qvr

@@ -223,7 +223,7 @@ TEST(Simulator, MtpIsSensorPlusPipelinePlusDisplay) {
     NoisyLink link("lte", 100e6, calibratedLinkEfficiency(), 20.0, {51.97, 1288.04}, 3);
     const RunResult run = simulate(trace, config(Design::Qvr, 40), link);
     for (const FrameRecord& r : run.frames)
-        EXPECT_NEAR(r.mtp_ms, 2.0 + (r.display_ready_ms - r.start_ms) + 5.0, 1e-9);
+        EXPECT_NEAR(r.mtp_ms, 2.0 + (r.display_ready_ms - r.pose_ms) + 5.0, 1e-9);
 }
 
 TEST(Simulator, StaticDesignCountsThePrefetchedPoseInItsLatency) {
@@ -233,7 +233,7 @@ TEST(Simulator, StaticDesignCountsThePrefetchedPoseInItsLatency) {
     for (size_t i = 1; i < run.frames.size(); ++i) {
         const FrameRecord& r = run.frames[i];
         // The background shown was rendered for the previous frame's pose.
-        EXPECT_NEAR(r.mtp_ms, 2.0 + (r.display_ready_ms - run.frames[i - 1].start_ms) + 5.0, 1e-9);
+        EXPECT_NEAR(r.mtp_ms, 2.0 + (r.display_ready_ms - run.frames[i - 1].pose_ms) + 5.0, 1e-9);
         EXPECT_NEAR(
             r.bytes,
             trace.frames[i].static_split.bg_bytes + trace.frames[i].static_split.depth_bytes, 1e-6);

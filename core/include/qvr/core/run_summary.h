@@ -1,7 +1,7 @@
 // One run's frames and their statistics, as every pipeline reports them: the runtime's telemetry
 // (runtime/telemetry.h), the simulator's model of the runtime (sim/runtime_model.h) and the
-// paper simulator's percentiles (sim/simulator.h) all go through here, so a p99 means the same
-// statistic on both sides.
+// paper simulator (sim/simulator.h) all go through here, so a p99 means the same statistic on
+// both sides.
 #pragma once
 
 #include <cstddef>
@@ -76,7 +76,8 @@ struct RunStats {
 };
 
 // RunStats one frame at a time in display order, in memory that does not grow with the run (a
-// `qvr client` may run for hours): the MTP p99 is exact over the first kExactMtpFrames frames
+// `qvr client` may run for hours): the MTP p99 is exact over the first exact_mtp_frames frames
+// (kExactMtpFrames unless told; a caller that holds every frame anyway may ask for all of them)
 // and beyond that read from a log-spaced histogram (relative error ≤ 0.05%). The start-up is the
 // first warmup_frames frames and, after them, every frame that requested layers while none had
 // been shown (RunStats::warmup_frames).
@@ -84,7 +85,7 @@ class FrameSummarizer {
 public:
     static constexpr size_t kExactMtpFrames = size_t{1} << 16;
 
-    explicit FrameSummarizer(int warmup_frames);
+    explicit FrameSummarizer(int warmup_frames, size_t exact_mtp_frames = kExactMtpFrames);
     void add(const FrameSample& f);
     RunStats finish() const;
 
@@ -94,6 +95,7 @@ private:
 
     RunStats m_s;
     size_t m_warmup = 0;
+    size_t m_exact_mtp_frames = kExactMtpFrames;
     // The first warmup frames wait here until a later one proves they were the start-up (a run
     // of no more frames than that is summarized whole).
     std::vector<FrameSample> m_startup;

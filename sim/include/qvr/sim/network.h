@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "qvr/core/expected.h"
@@ -30,16 +31,32 @@ struct LinkTransfer {
     double goodput_bps = 0.0;  // payload bits / duration, what acknowledgements measure
 };
 
-// A downlink the simulator sends frames over. A transfer is timed from its start, so
+// A downlink the simulator sends frames over: a name, a nominal capacity, the payload share of it
+// a transfer gets on average (efficiency) and a radio. A transfer is timed from its start, so
 // trace-driven links see the capacity of that moment.
 class Link {
 public:
     virtual ~Link() = default;
-    virtual std::string_view name() const = 0;
-    virtual double meanGoodputBps() const = 0;
-    virtual double nominalBps() const = 0;
+    std::string_view name() const { return m_name; }
+    double nominalBps() const { return m_nominal_bps; }
+    double meanGoodputBps() const { return m_nominal_bps * m_efficiency; }
+    const RadioPower& radio() const { return m_radio; }
+    // The packets a payload occupies: payload / (η·1500 bytes), rounded up, at least one.
+    double packetsOf(double payload_bytes) const;
     virtual LinkTransfer transfer(double start_ms, double payload_bytes) = 0;
-    virtual const RadioPower& radio() const = 0;
+
+protected:
+    Link(std::string name, double nominal_bps, double efficiency, RadioPower radio)
+        : m_name(std::move(name)),
+          m_nominal_bps(nominal_bps),
+          m_efficiency(efficiency),
+          m_radio(radio) {}
+
+private:
+    std::string m_name;
+    double m_nominal_bps;
+    double m_efficiency;
+    RadioPower m_radio;
 };
 
 // Constant capacity C with white noise per sample, σ = 10^(−SNR/20) (noise amplitude relative to
@@ -50,22 +67,13 @@ class NoisyLink final : public Link {
 public:
     NoisyLink(std::string name, double nominal_bps, double efficiency, double snr_db,
               RadioPower radio, uint64_t seed);
-    std::string_view name() const override { return m_name; }
-    double meanGoodputBps() const override { return m_nominal_bps * m_efficiency; }
-    double nominalBps() const override { return m_nominal_bps; }
     LinkTransfer transfer(double start_ms, double payload_bytes) override;
-    const RadioPower& radio() const override { return m_radio; }
     double noiseSigma() const { return m_sigma; }  // per sample
-    double packetsOf(double payload_bytes) const;  // ≥ 1
     // The relative spread of a transfer's goodput: σ/√packets.
     double noiseSigmaOver(double payload_bytes) const;
 
 private:
-    std::string m_name;
-    double m_nominal_bps;
-    double m_efficiency;
     double m_sigma;
-    RadioPower m_radio;
     std::mt19937_64 m_rng;
     std::normal_distribution<double> m_normal{0.0, 1.0};
 };
@@ -77,21 +85,13 @@ class TraceLink final : public Link {
 public:
     TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
               double efficiency, RadioPower radio);
-    std::string_view name() const override { return m_name; }
-    double meanGoodputBps() const override { return m_target_mean_bps * m_efficiency; }
-    double nominalBps() const override { return m_target_mean_bps; }
     LinkTransfer transfer(double start_ms, double payload_bytes) override;
-    const RadioPower& radio() const override { return m_radio; }
     double timeScale() const { return m_time_scale; }
 
 private:
-    std::string m_name;
     std::vector<double> m_opportunities_ms;  // the rescaled stamps, non-decreasing
     double m_period_ms = 0.0;                // the rescaled loop length
-    double m_target_mean_bps;
-    double m_efficiency;
     double m_time_scale;
-    RadioPower m_radio;
 };
 
 // The paper simulator's links, named in the link grammar (qvr/core/link_spec.h): "wifi", "lte" or

@@ -11,6 +11,7 @@
 
 #include "qvr/controller/policy.h"
 #include "qvr/core/design.h"
+#include "qvr/core/run_summary.h"
 #include "qvr/sim/energy.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/network.h"
@@ -36,43 +37,47 @@ struct SimConfig {
     bool oracle_policy = false;
 };
 
-struct FrameRecord {
+// One simulated frame. What every pipeline's summary reads of a frame is core's FrameSample
+// (qvr/core/run_summary.h), in ms from the first frame's control logic: pose_ms is when the
+// control logic begins (the pose has arrived), display_ms when the frame is on the display
+// (display_ready_ms, or its vsync when paced), mtp_ms = 2 ms sensor + pipeline + 5 ms display,
+// t_local_ms submission → render end (waits and preemptions included), t_remote_ms request →
+// remote layers decoded where remote_requested, bytes the downlink payload, uca_ms the UCA's wall
+// time (both units), e1_deg 0 for designs without a fovea. The rest is the simulator's own.
+struct FrameRecord : FrameSample {
     int64_t index = 0;
-    double e1_deg = 0.0;  // 0 for designs without a fovea
     double e2_deg = 0.0;
     // Event times, ms from the first frame's control logic.
-    double start_ms = 0.0;  // control logic begins (the pose has arrived)
     double request_ms = 0.0;
     double render_start_ms = 0.0;
     double render_end_ms = 0.0;
     double remote_ready_ms = 0.0;
     double display_ready_ms = 0.0;  // composition + ATW done
-    double shown_ms = 0.0;          // on the display: display_ready_ms, or its vsync when paced
     // Durations.
     double render_work_ms = 0.0;  // local render at the GPU's rate, no interruptions
-    double t_local_ms = 0.0;      // submission → render end: waits and preemptions included
-    double t_remote_ms = 0.0;     // request → remote layers decoded
     double net_ms = 0.0;          // transmission alone
     double server_render_ms = 0.0;
     double encode_ms = 0.0;
     double decode_ms = 0.0;
     double comp_ms = 0.0;             // on the GPU
     double atw_ms = 0.0;              // on the GPU
-    double uca_ms = 0.0;              // UCA wall time (both units)
     double gpu_ms = 0.0;              // T_GPU: GPU busy time this frame
     double display_dram_bytes = 0.0;  // composition + ATW (GPU passes or UCA): read + written
     double display_dram_ms = 0.0;     // those bytes at Table 2's DRAM bandwidth
     double radio_w = 0.0;             // radio power while this frame's payload arrives
     int preemptions = 0;
-    double bytes = 0.0;
     double goodput_bps = 0.0;
     double shaded_pixels = 0.0;  // both eyes, every layer at its own resolution
-    double mtp_ms = 0.0;         // 2 ms sensor + pipeline + 5 ms display
     double fps = 0.0;            // min(1/T_GPU, 1/T_network)
     double latency_ratio = 0.0;  // T_remote / T_local, 0 when either is absent
     FrameEnergy energy;
 };
 
+// One run's statistics over all its frames. Those every pipeline shares are core's run
+// summariser's (qvr/core/run_summary.h FrameSummarizer, no start-up left out; percentiles nearest
+// rank): mtp_ms_mean, mtp_ms_p99, fps_pipeline (its fps_mean), bytes_per_frame_mean, e1_deg_mean
+// (and e1_deg_steady, with the warm-up left out), t_local_ms_mean, t_remote_ms_mean (over the
+// frames that fetched remote layers) and uca_ms_mean. The rest only the simulator knows.
 struct RunSummary {
     std::string bench;
     std::string design;
@@ -80,7 +85,7 @@ struct RunSummary {
     std::string net;
     int frames = 0;
     double mtp_ms_mean = 0.0;
-    double mtp_ms_p99 = 0.0;    // nearest rank (qvr/core/run_summary.h percentile)
+    double mtp_ms_p99 = 0.0;
     double fps_mean = 0.0;      // 1000 / mean(max(T_GPU, T_network))
     double fps_pipeline = 0.0;  // frames displayed per second in the event timeline
     double bytes_per_frame_mean = 0.0;
@@ -88,7 +93,7 @@ struct RunSummary {
     double energy_mj_per_frame = 0.0;
     FrameEnergy energy_mean;
     double e1_deg_mean = 0.0;
-    double e1_deg_steady = 0.0;        // mean over frames after the warm-up
+    double e1_deg_steady = 0.0;        // mean over frames after steadyStateStart
     double latency_ratio_final = 0.0;  // median (nearest rank) over the last 30 frames
     double t_local_ms_mean = 0.0;
     double t_remote_ms_mean = 0.0;
