@@ -554,16 +554,6 @@ TEST(Lod, ALowerResolutionViewOfBuiltinRoomDrawsFewerTriangles) {
     EXPECT_LE(t_high, t_none);
 }
 
-// Mean absolute RGB difference of two images of one size, in 8-bit levels.
-double meanAbsDiff(const ImageRgba8& a, const ImageRgba8& b) {
-    double sum = 0.0;
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x)
-            for (int c = 0; c < 3; ++c)
-                sum += std::abs(int(a.at(x, y, c)) - int(b.at(x, y, c)));
-    return sum / (3.0 * a.width() * a.height());
-}
-
 TEST(GlLod, OnePixelOfErrorDrawsFewerPrimitivesAndNearlyTheSameImage) {
     QVR_GL_RENDERER_OR_SKIP(gl);
     GlRendererOptions options;
@@ -598,9 +588,9 @@ TEST(GlLod, OnePixelOfErrorDrawsFewerPrimitivesAndNearlyTheSameImage) {
         const ImageRgba8 left = test::crop(exact, 0, 0, w, h);
         const ImageRgba8 right = test::crop(exact, 1, 0, w, h);
         const double psnr = test::psnrDb(exact, coarse);
-        const double mad = meanAbsDiff(exact, coarse);
+        const double mad = test::meanAbsDiff(exact, coarse);
         const double shift_psnr = test::psnrDb(left, right);
-        const double shift_mad = meanAbsDiff(left, right);
+        const double shift_mad = test::meanAbsDiff(left, right);
         std::printf(
             "builtin:room pitch %.0f, LOD 1 px: %llu of %llu primitives; PSNR %.1f dB, "
             "mean |diff| %.2f levels (one-pixel shift: %.1f dB, %.2f levels)\n",

@@ -32,6 +32,16 @@ inline HmdProfile smallProfile() {
     return p;
 }
 
+// Mean absolute RGB difference of two images of one size, in 8-bit levels.
+inline double meanAbsDiff(const ImageRgba8& a, const ImageRgba8& b) {
+    double sum = 0.0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x)
+            for (int c = 0; c < 3; ++c)
+                sum += std::abs(int(a.at(x, y, c)) - int(b.at(x, y, c)));
+    return sum / (3.0 * a.width() * a.height());
+}
+
 // One GL renderer for the whole test program (context creation costs ~50 ms on llvmpipe).
 // Skips only when EGL itself cannot give an OpenGL 4.5 context; QVR_REQUIRE_GL=1 makes that a
 // failure, for machines where a driver is known to be present.

@@ -7,6 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
+#include "../render/render_test_util.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/foveation/eye_geometry.h"
 #include "qvr/runtime/render_server.h"
@@ -101,15 +102,6 @@ ImageRgba8 directionLayer(const HmdProfile& profile, const LayerRect& l, const g
     return img;
 }
 
-double meanAbsError(const ImageRgba8& a, const ImageRgba8& b) {
-    double sum = 0.0;
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x)
-            for (int c = 0; c < 3; ++c)
-                sum += std::abs(int(a.at(x, y, c)) - int(b.at(x, y, c)));
-    return sum / (3.0 * a.width() * a.height());
-}
-
 TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
     const HmdProfile profile = smallProfile();
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
@@ -125,9 +117,9 @@ TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
     reduceSharedOuter(shared, shared_rect, member, reprojected, profile, a, b);
     reduceSharedOuter(shared, shared_rect, member, unmoved, profile, a, a);
     ASSERT_EQ(reprojected.width(), member.width_px);
-    const double err = meanAbsError(reprojected, truth);
+    const double err = test::meanAbsDiff(reprojected, truth);
     EXPECT_LT(err, 0.6);
-    EXPECT_GT(meanAbsError(unmoved, truth), 3.0 * err);
+    EXPECT_GT(test::meanAbsDiff(unmoved, truth), 3.0 * err);
 }
 
 TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {
