@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -106,6 +107,7 @@ struct FakeHeadset {
     std::chrono::milliseconds period{10};
     std::chrono::milliseconds duration{1000};
     int stall_after = 0;
+    std::function<bool()> done;  // stops early once this holds (checked every frame)
     std::atomic<bool> connected{false};
     std::atomic<int> sent{0};
 
@@ -122,7 +124,7 @@ struct FakeHeadset {
             return;
         }
         auto next = std::chrono::steady_clock::now();
-        for (uint32_t f = 1; std::chrono::steady_clock::now() < end; ++f) {
+        for (uint32_t f = 1; std::chrono::steady_clock::now() < end && !(done && done()); ++f) {
             sent += client.sendFrameRequest(frameRequest(f)).ok() ? 1 : 0;
             next += period;
             while (std::chrono::steady_clock::now() < next) {
@@ -331,9 +333,14 @@ TEST(RenderServerPool, CoLocatedSessionsShareTheOuterLayer) {
     auto server = startServer(c);
     ASSERT_TRUE(server);
     std::vector<std::unique_ptr<FakeHeadset>> headsets;
+    // Until a few outer layers have been reused: a sanitizer build on a busy machine serves only
+    // a handful of frames in the half second that is plenty for a release build.
     for (int i = 0; i < 2; ++i) {
         headsets.push_back(std::make_unique<FakeHeadset>());
-        headsets.back()->duration = 500ms;
+        headsets.back()->duration = 30s;
+        headsets.back()->done = [&server] {
+            return server->stats().share_periphery.outer_layers_reused >= 4;
+        };
     }
     runAll(headsets, server->port());
     server->stop();
