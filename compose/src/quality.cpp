@@ -3,6 +3,7 @@
 #include "qvr/compose/quality.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -108,6 +109,22 @@ void accumulateSsim(const std::vector<float>& ly_img, const std::vector<float>& 
     }
 }
 
+// One pixel's squared RGB error against its reference, counted in its region (1-based) and in
+// the last accumulator, which holds every counted pixel.
+void addPixelError(std::vector<Accum>& acc, uint8_t region, const std::array<double, 3>& rgb,
+                   const std::array<double, 3>& reference) {
+    double e2 = 0.0;
+    for (size_t c = 0; c < 3; ++c) {
+        const double d = rgb[c] - reference[c];
+        e2 += d * d;
+    }
+    for (Accum* a : {&acc[region - 1u], &acc.back()}) {
+        a->sq_err += e2;
+        a->samples += 3;
+        a->pixels += 1;
+    }
+}
+
 // PSNR and SSIM per region, a region being what `label` makes of a pixel's eccentricity (deg):
 // 1..regions, or 0 to leave it out. The last accumulator holds every counted pixel.
 template <typename Label>
@@ -124,7 +141,6 @@ std::vector<Accum> measureRegions(const HmdProfile& profile, const Gaze& gaze_de
     std::vector<uint8_t> region(static_cast<size_t>(width) * static_cast<size_t>(height));
     std::vector<float> ly_img(region.size()), ly_ref(region.size());
     std::vector<Accum> acc(static_cast<size_t>(regions) + 1);
-    const size_t all = static_cast<size_t>(regions);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
             const size_t i =
@@ -142,16 +158,8 @@ std::vector<Accum> measureRegions(const HmdProfile& profile, const Gaze& gaze_de
                 static_cast<float>(luma(truth.at(x, y, 0), truth.at(x, y, 1), truth.at(x, y, 2)));
             if (reg == kOff)
                 continue;
-            double e2 = 0.0;
-            for (int c = 0; c < 3; ++c) {
-                const double d = image.at(x, y, c) - truth.at(x, y, c);
-                e2 += d * d;
-            }
-            for (Accum* a : {&acc[reg - 1u], &acc[all]}) {
-                a->sq_err += e2;
-                a->samples += 3;
-                a->pixels += 1;
-            }
+            addPixelError(acc, reg, {r, g, b},
+                          {truth.at(x, y, 0), truth.at(x, y, 1), truth.at(x, y, 2)});
         }
     }
     accumulateSsim(ly_img, ly_ref, region, width, height, acc);
@@ -222,7 +230,6 @@ std::vector<RegionQuality> measureLabelledQuality(const ImageRgba8& image,
     QVR_CHECK(regions >= 1 && regions < 256);
     std::vector<float> ly_img(labels.size()), ly_ref(labels.size());
     std::vector<Accum> acc(static_cast<size_t>(regions) + 1);
-    const size_t all = static_cast<size_t>(regions);
     for (size_t i = 0; i < labels.size(); ++i) {
         const uint8_t* a = image.data() + 4 * i;
         const uint8_t* b = reference.data() + 4 * i;
@@ -232,16 +239,8 @@ std::vector<RegionQuality> measureLabelledQuality(const ImageRgba8& image,
         if (reg == kOff)
             continue;
         QVR_CHECK(reg <= regions);
-        double e2 = 0.0;
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(a[c]) - double(b[c]);
-            e2 += d * d;
-        }
-        for (Accum* x : {&acc[reg - 1u], &acc[all]}) {
-            x->sq_err += e2;
-            x->samples += 3;
-            x->pixels += 1;
-        }
+        addPixelError(acc, reg, {double(a[0]), double(a[1]), double(a[2])},
+                      {double(b[0]), double(b[1]), double(b[2])});
     }
     accumulateSsim(ly_img, ly_ref, labels, width, height, acc);
     std::vector<RegionQuality> out;
