@@ -113,10 +113,12 @@ Status ReferenceTracker::admit(const FrameHeader& h) {
         return Status::success();
     if (h.refresh_frames > 0) {
         // Intra refresh: the moving intra column repairs the picture within one refresh period,
-        // so keep decoding (the codec conceals) and withhold pictures until the wave has passed.
+        // so keep decoding (the codec conceals) and withhold pictures until the wave has passed
+        // and one frame more: the first picture after the wave still carried the concealment
+        // (31.7 dB against 34.6 steady in IntraRefreshHealsALossWithoutAKeyframe).
         if (m_state != State::kRecovering || !consecutive) {
             m_state = State::kRecovering;
-            m_recover_left = h.refresh_frames + 1;
+            m_recover_left = h.refresh_frames + 2;
         }
         return Status::success();
     }

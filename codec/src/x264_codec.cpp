@@ -52,18 +52,34 @@ bool directOk(int width) {
     return (width * 4) % kRowAlignBytes == 0;
 }
 
-// Fills the canvas outside the layer by repeating its last column and row: flat padding costs
-// the encoder almost no bits and keeps the deblocking filter from bleeding colour inward.
-void padPlane(uint8_t* plane, int stride, int w, int h, int canvas_w, int canvas_h) {
-    if (w < canvas_w) {
-        for (int y = 0; y < h; ++y) {
-            uint8_t* row = plane + static_cast<ptrdiff_t>(y) * stride;
-            std::memset(row + w, row[w - 1], static_cast<size_t>(canvas_w - w));
-        }
+// Fills the canvas outside the layer. Up to the end of the coding block the layer's edge falls
+// in (and at least kEdgeMarginPx past the edge) the layer's last column and row repeat, so the
+// deblocking filter, which reaches 3 pixels across a block edge, finds no foreign colour to bleed
+// into the layer. Beyond that the padding is one constant, the same in every frame, which a
+// P-frame codes as skipped blocks. (Repeating the edge over the whole margin changed the padding
+// with the content every frame: each padding pixel cost half a layer pixel's bits,
+// padding_bits_ratio in docs/MODEL.md §9.)
+constexpr int kEdgeMarginPx = 4;
+constexpr double kQcomp = 0.6;  // x264's quantiser-curve compression (its default)
+int edgeEnd(int size, int canvas, int block) {
+    const int end = (size + kEdgeMarginPx + block - 1) / block * block;
+    return std::min(end, canvas);
+}
+void padPlane(uint8_t* plane, int stride, int w, int h, int canvas_w, int canvas_h, int block,
+              uint8_t fill) {
+    const int edge_w = edgeEnd(w, canvas_w, block);
+    const int edge_h = edgeEnd(h, canvas_h, block);
+    for (int y = 0; y < h; ++y) {
+        uint8_t* row = plane + static_cast<ptrdiff_t>(y) * stride;
+        std::memset(row + w, row[w - 1], static_cast<size_t>(edge_w - w));
+        std::memset(row + edge_w, fill, static_cast<size_t>(canvas_w - edge_w));
     }
     const uint8_t* last = plane + static_cast<ptrdiff_t>(h - 1) * stride;
-    for (int y = h; y < canvas_h; ++y)
+    for (int y = h; y < edge_h; ++y)
         std::memcpy(plane + static_cast<ptrdiff_t>(y) * stride, last,
+                    static_cast<size_t>(canvas_w));
+    for (int y = edge_h; y < canvas_h; ++y)
+        std::memset(plane + static_cast<ptrdiff_t>(y) * stride, fill,
                     static_cast<size_t>(canvas_w));
 }
 
@@ -115,6 +131,8 @@ public:
         }
         if (Status s = convert(image); !s)
             return makeError(s.error());
+        if (Status s = followPadding(w, h); !s)
+            return makeError(s.error());
 
         const bool key = force_keyframe || m_force_key;
         m_frame->pict_type = key ? AV_PICTURE_TYPE_I : AV_PICTURE_TYPE_NONE;
@@ -153,6 +171,27 @@ public:
     }
 
     void requestKeyframe() override { m_force_key = true; }
+
+    // x264's CRF takes a frame's quantiser from its mean complexity per macroblock
+    // (qscale ∝ (complexity / macroblocks)^(1 − qcomp)), and the canvas's constant padding has
+    // none: left alone, a layer far smaller than its canvas is coded finer, at several times the
+    // bytes, than the same layer in a snug one. Raising crf by 6·(1 − qcomp)·log2(canvas
+    // macroblocks / layer macroblocks) undoes that dilution (libavcodec hands a changed crf to
+    // x264_encoder_reconfig before the next frame).
+    Status followPadding(int w, int h) {
+        if (m_config.bitrate_bps > 0)
+            return Status::success();
+        const auto mbs = [](int a, int b) { return std::ceil(a / 16.0) * std::ceil(b / 16.0); };
+        const double dilution = mbs(m_ctx->width, m_ctx->height) / mbs(w, h);
+        const double crf =
+            std::min(51.0, m_config.crf + 6.0 * (1.0 - kQcomp) * std::log2(dilution));
+        if (std::abs(crf - m_crf) < 0.05)
+            return Status::success();
+        if (av_opt_set_double(m_ctx->priv_data, "crf", crf, 0) < 0)
+            return makeError("x264 encoder: libx264 rejected crf");
+        m_crf = crf;
+        return Status::success();
+    }
     const EncoderStats& stats() const override { return m_stats; }
     int canvasWidth() const override { return m_ctx ? m_ctx->width : 0; }
     int canvasHeight() const override { return m_ctx ? m_ctx->height : 0; }
@@ -184,7 +223,8 @@ private:
                 std::min<double>(2e9, m_config.bitrate_bps / m_config.frame_rate_hz));
         }
         void* priv = ctx->priv_data;
-        std::string params = "repeat-headers=1:scenecut=0";
+        // qcomp pinned at x264's default: followPadding() depends on it.
+        std::string params = fmt::format("repeat-headers=1:scenecut=0:qcomp={}", kQcomp);
         if (m_config.keyint_frames == 0)
             params += ":keyint=infinite";
         if (av_opt_set(priv, "preset", m_config.preset.c_str(), 0) < 0 ||
@@ -195,6 +235,7 @@ private:
         if (m_config.bitrate_bps == 0 &&
             av_opt_set(priv, "crf", std::to_string(m_config.crf).c_str(), 0) < 0)
             return makeError("x264 encoder: libx264 rejected crf");
+        m_crf = m_config.crf;
         if (m_config.intra_refresh && av_opt_set(priv, "intra-refresh", "1", 0) < 0)
             return makeError("x264 encoder: libx264 rejected intra-refresh");
         int err = avcodec_open2(ctx.get(), codec, nullptr);
@@ -242,10 +283,11 @@ private:
         sws_scale(m_sws, src_planes, src_strides, 0, h, m_frame->data, m_frame->linesize);
         const int cw = m_frame->width;
         const int ch = m_frame->height;
-        padPlane(m_frame->data[0], m_frame->linesize[0], w, h, cw, ch);
+        // H.264 codes 16×16 luma blocks, 8×8 in each 4:2:0 chroma plane; the constant is black.
+        padPlane(m_frame->data[0], m_frame->linesize[0], w, h, cw, ch, 16, 16);
         for (int p = 1; p < 3; ++p)
             padPlane(m_frame->data[p], m_frame->linesize[p], (w + 1) / 2, (h + 1) / 2, cw / 2,
-                     ch / 2);
+                     ch / 2, 8, 128);
         return Status::success();
     }
 
@@ -256,6 +298,7 @@ private:
     int64_t m_pts = 0;
     uint32_t m_next_id = 0;
     bool m_force_key = true;
+    double m_crf = 0.0;  // the crf libx264 holds now
 };
 
 class H264Decoder final : public FramedDecoder, private FfmpegState {
