@@ -5,13 +5,15 @@ One `qvr server` and N `qvr client`s on loopback. In a "stall" run the last clie
 with SIGSTOP for --stall-s seconds once every client has run --stall-at-s seconds, then resumed
 (SIGCONT); in a "control" run nothing is stopped. Runs alternate (control, stall, control, ...)
 so the host's drift falls on both alike. For every other headset the script counts displayed
-frames (telemetry.csv's display_ns on each client's CLOCK_MONOTONIC origin) in three windows of
-the stall's length: just before the stop, during it, and just after the resume, and prints
-their frame rates; the cost of the stall is 1 - fps(during or after) / fps(before), set beside
-the same windows of the control run.
+frames (telemetry.csv's display_ns on each client's CLOCK_MONOTONIC origin) in three windows:
+--window-s before the stop, the stop itself, and --window-s after the resume, and prints their
+frame rates. A headset's rate drifts by itself over a session (the control runs show it), so the
+cost of the stall is measured against the control runs: 1 - (mean over the stall runs' headsets
+of fps(window) / fps(before)) / (the same mean over the control runs), for the stop and for
+after it; the larger of the two is judged against issue 39's bar of 10%.
 
     scripts/validate_stall.py QVR OUT_DIR [--headsets 3] [--runs 3] [--design qvr]
-        [--profile run] [--frames 900] [--stall-at-s 20] [--stall-s 2]
+        [--profile run] [--frames 900] [--stall-at-s 20] [--stall-s 2] [--window-s 5]
 """
 import argparse
 import csv
@@ -36,10 +38,14 @@ def parse_args():
     p.add_argument("--frames", type=int, default=900)
     p.add_argument("--stall-at-s", type=float, default=20.0)
     p.add_argument("--stall-s", type=float, default=2.0)
+    p.add_argument("--window-s", type=float, default=5.0,
+                   help="length of the windows before and after the stop")
     p.add_argument("--port", type=int, default=7460)
     a = p.parse_args()
-    if a.headsets < 2 or a.runs < 1 or a.stall_s <= 0 or a.stall_at_s < a.stall_s:
-        p.error("need --headsets >= 2, --runs >= 1, --stall-s > 0, --stall-at-s >= --stall-s")
+    if (a.headsets < 2 or a.runs < 1 or a.stall_s <= 0 or a.window_s <= 0
+            or a.stall_at_s < a.window_s):
+        p.error("need --headsets >= 2, --runs >= 1, --stall-s > 0, --window-s > 0, "
+                "--stall-at-s >= --window-s")
     return a
 
 
@@ -99,7 +105,7 @@ def window_fps(times, lo_ns, hi_ns):
 
 def others_fps(a, run_dir, stop_ns, resume_ns):
     """Per other headset: FPS before, during and after the stall window."""
-    span = resume_ns - stop_ns
+    span = int(a.window_s * 1e9)
     rows = []
     for i in range(a.headsets - 1):
         t = displays_ns(os.path.join(run_dir, f"h{i}"))
@@ -135,12 +141,21 @@ def main():
                 summary["runs"].append({"kind": kind, "run": r, "headset": h, "fps_before": before,
                                         "fps_during": during, "fps_after": after,
                                         "cost_during": cd, "cost_after": ca})
-    worst = max(max(x["cost_during"], x["cost_after"]) for x in summary["runs"]
-                if x["kind"] == "stall")
-    summary["worst_stall_cost"] = worst
+    effect = {}
+    for w in ("during", "after"):
+        mean = {k: sum(x["fps_" + w] / x["fps_before"] for x in summary["runs"] if x["kind"] == k)
+                / sum(1 for x in summary["runs"] if x["kind"] == k) for k in ("control", "stall")}
+        effect[w] = 1 - mean["stall"] / mean["control"]
+        summary["stall_cost_" + w] = effect[w]
+        print(f"{w:>6}: fps / fps before, mean over headsets and runs: control "
+              f"{mean['control']:.3f}, stall {mean['stall']:.3f} -> cost of the stall "
+              f"{effect[w]:+.1%}")
+    worst = max(effect.values())
+    summary["stall_cost"] = worst
     json.dump(summary, open(os.path.join(a.out, "stall.json"), "w"), indent=1)
-    print(f"worst cost of the stall to another headset: {worst:+.1%} (criterion: <= 10%)")
+    print(f"cost of the stall to the other headsets: {worst:+.1%} (criterion: <= 10%)")
+    return 0 if worst <= 0.10 else 1
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
