@@ -56,9 +56,8 @@ bool directOk(int width) {
 // in (and at least kEdgeMarginPx past the edge) the layer's last column and row repeat, so the
 // deblocking filter, which reaches 3 pixels across a block edge, finds no foreign colour to bleed
 // into the layer. Beyond that the padding is one constant, the same in every frame, which a
-// P-frame codes as skipped blocks. (Repeating the edge over the whole margin changed the padding
-// with the content every frame: each padding pixel cost half a layer pixel's bits,
-// padding_bits_ratio in docs/MODEL.md §9.)
+// P-frame codes as skipped blocks; edge pixels repeated over the whole margin would change with
+// the content every frame and be paid for in every P-frame.
 constexpr int kEdgeMarginPx = 4;
 constexpr double kQcomp = 0.6;  // x264's quantiser-curve compression (its default)
 int edgeEnd(int size, int canvas, int block) {
