@@ -15,6 +15,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 namespace qvr::net {
@@ -141,8 +142,8 @@ TEST(AgonesSdk, NoSidecarIsAnErrorNamingThePort) {
     AgonesSdk sdk(optionsFor(port));
     const Status st = sdk.health();
     ASSERT_FALSE(st.ok());
-    EXPECT_NE(st.error().find(":" + std::to_string(port) + "/health"), std::string::npos)
-        << st.error();
+    const std::string where = fmt::format(":{}/health", port);
+    EXPECT_NE(st.error().find(where), std::string::npos) << st.error();
 }
 
 TEST(AgonesSdk, AReplyThatIsNotHttpIsAnError) {

@@ -104,9 +104,9 @@ struct TestBsp {
         out.insert(out.end(), more.begin(), more.end());
     }
     static void appendInt(std::vector<uint8_t>& out, int32_t v) {
-        uint8_t b[4];
-        std::memcpy(b, &v, 4);
-        out.insert(out.end(), b, b + 4);
+        const size_t at = out.size();
+        out.resize(at + 4);
+        std::memcpy(out.data() + at, &v, 4);
     }
 };
 
