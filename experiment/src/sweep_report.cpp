@@ -103,17 +103,15 @@ std::vector<SweepCriterion> sweepCriteria(const SweepResult& r) {
                         countVerdicts(
                             v, &ConditionVerdict::mtp_p99_over_best,
                             [](const auto&, double x) { return x <= kMtpOverBest; }, false)));
+    std::vector<ConditionVerdict> slow;  // the slow-link criterion counts slow links only
+    for (const ConditionVerdict& c : v)
+        if (c.link_mbps && *c.link_mbps <= kSlowLinkMbps)
+            slow.push_back(c);
     out.push_back(allOf(
         fmt::format("links <= {:g} Mbit/s: qvr >= {:.2f}x best fixed", kSlowLinkMbps, kNearBest),
-        countVerdicts(v, &ConditionVerdict::qvr_over_best, [](const ConditionVerdict& c, double x) {
-            return !(c.link_mbps && *c.link_mbps <= kSlowLinkMbps) || x >= kNearBest;
-        })));
-    {
-        Count slow;
-        for (const ConditionVerdict& c : v)
-            slow.judged += c.link_mbps && *c.link_mbps <= kSlowLinkMbps && c.qvr_over_best;
-        out.back().detail += fmt::format(" ({} slow)", slow.judged);
-    }
+        countVerdicts(slow, &ConditionVerdict::qvr_over_best,
+                      [](const auto&, double x) { return x >= kNearBest; })));
+    out.back().detail += " (slow links only)";
     double sum = 0.0, worst = 0.0;
     int n = 0;
     for (const SweepRow& row : r.rows)

@@ -257,5 +257,36 @@ TEST(SweepRun, FailsTheCriteriaWhereQvrFallsBehind) {
     EXPECT_EQ(by.at("qvr ahead of aimd on average").detail, "not measured (no aimd runs)");
 }
 
+// The slow-link criterion is judged on the slow links alone: a fast link where qvr trails does
+// not fail it, and its count is of slow conditions.
+TEST(SweepRun, JudgesTheSlowLinkCriterionOnSlowLinksOnly) {
+    const auto slowCriterion = [](double rate_mbps, double qvr_fps) {
+        SweepOptions o;
+        o.conditions = 1;
+        o.repeats = 1;
+        o.adaptive = {"qvr", "ffr"};
+        o.fixed_grid_deg = {10};
+        o.space.rate_min_mbps = o.space.rate_max_mbps = rate_mbps;
+        o.space.traces.clear();
+        FakeRunner runner;
+        runner.fps = {{"qvr", qvr_fps}, {"ffr", 20.0}, {"fixed:10", 40.0}};
+        std::FILE* null = std::fopen("/dev/null", "w");
+        const SweepResult r = executeSweep(o, runner, null);
+        std::fclose(null);
+        for (const SweepCriterion& c : sweepCriteria(r))
+            if (c.name.rfind("links <=", 0) == 0)
+                return c;
+        return SweepCriterion{};
+    };
+    const SweepCriterion fast_behind = slowCriterion(100.0, 30.0);
+    EXPECT_FALSE(fast_behind.pass);
+    EXPECT_NE(fast_behind.detail.find("not measured"), std::string::npos) << fast_behind.detail;
+    const SweepCriterion slow_behind = slowCriterion(2.0, 30.0);
+    EXPECT_FALSE(slow_behind.pass);
+    EXPECT_NE(slow_behind.detail.find("0/1 conditions"), std::string::npos) << slow_behind.detail;
+    const SweepCriterion slow_near = slowCriterion(2.0, 39.0);
+    EXPECT_TRUE(slow_near.pass) << slow_near.detail;
+}
+
 }  // namespace
 }  // namespace qvr::experiment
