@@ -63,6 +63,23 @@ Count countVerdicts(const std::vector<ConditionVerdict>& verdicts,
     return n;
 }
 
+// Mean and worst absolute FPS error over every run that has one.
+struct ErrorStats {
+    double sum = 0.0, worst = 0.0;
+    int n = 0;
+    double mean() const { return n > 0 ? sum / n : 0.0; }
+};
+ErrorStats errorStats(const SweepResult& r, std::optional<double> (DesignReading::*error)() const) {
+    ErrorStats s;
+    for (const SweepRow& row : r.rows)
+        if (const auto e = (row.reading.*error)()) {
+            s.sum += std::fabs(*e);
+            s.worst = std::max(s.worst, std::fabs(*e));
+            ++s.n;
+        }
+    return s;
+}
+
 SweepCriterion allOf(std::string name, const Count& n) {
     return {std::move(name), n.judged > 0 && n.met == n.judged,
             n.judged == 0 ? "not measured"
@@ -112,21 +129,23 @@ std::vector<SweepCriterion> sweepCriteria(const SweepResult& r) {
         countVerdicts(slow, &ConditionVerdict::qvr_over_best,
                       [](const auto&, double x) { return x >= kNearBest; })));
     out.back().detail += " (slow links only)";
-    double sum = 0.0, worst = 0.0;
-    int n = 0;
-    for (const SweepRow& row : r.rows)
-        if (const auto e = row.reading.fpsErrorPct()) {
-            sum += std::fabs(*e);
-            worst = std::max(worst, std::fabs(*e));
-            ++n;
-        }
-    const std::string runs = fmt::format("over {} runs", n);
+    const ErrorStats plain = errorStats(r, &DesignReading::fpsErrorPct);
+    const ErrorStats probed = errorStats(r, &DesignReading::fpsErrorAtProbeSpeedPct);
+    // Beside the bar, not in it: the same runs' errors with the costs at the probes' speed.
+    const std::string at_probe =
+        probed.n == 0 ? ""
+                      : fmt::format(
+                            "; at the probes' speed {:.1f}% mean, {:.1f}% worst over the "
+                            "{} runs with probes",
+                            probed.mean(), probed.worst, probed.n);
+    const std::string runs = fmt::format("over {} runs", plain.n);
     out.push_back({fmt::format("model FPS error mean <= {:g}%", kModelMeanPct),
-                   n > 0 && sum / n <= kModelMeanPct,
-                   n == 0 ? "not measured" : fmt::format("{:.1f}% {}", sum / n, runs)});
+                   plain.n > 0 && plain.mean() <= kModelMeanPct,
+                   plain.n == 0 ? "not measured"
+                                : fmt::format("{:.1f}% {}{}", plain.mean(), runs, at_probe)});
     out.push_back({fmt::format("model FPS error worst <= {:g}%", kModelWorstPct),
-                   n > 0 && worst <= kModelWorstPct,
-                   n == 0 ? "not measured" : fmt::format("{:.1f}% {}", worst, runs)});
+                   plain.n > 0 && plain.worst <= kModelWorstPct,
+                   plain.n == 0 ? "not measured" : fmt::format("{:.1f}% {}", plain.worst, runs)});
     const int conditions = static_cast<int>(v.size());
     out.push_back({fmt::format("at least {} conditions", kMinConditions),
                    conditions >= kMinConditions, fmt::format("{} measured", conditions)});
@@ -136,14 +155,17 @@ std::vector<SweepCriterion> sweepCriteria(const SweepResult& r) {
 std::string sweepCsv(const SweepResult& r) {
     std::string s =
         "condition,scene,link,headset_share,motion,take,design,fps,mtp_ms_p99,bytes_per_frame,"
-        "e1_deg,predicted_fps,fps_error_pct\n";
+        "e1_deg,predicted_fps,fps_error_pct,predicted_fps_at_probe_speed,"
+        "fps_error_at_probe_speed_pct\n";
     for (const SweepRow& row : r.rows) {
         const SweepCondition& c = r.conditions.at(static_cast<size_t>(row.condition));
         const DesignReading& d = row.reading;
-        s += fmt::format("{},{},{},{:g},{},{},{},{:.2f},{:.1f},{:.0f},{:.2f},{},{}\n",
+        s += fmt::format("{},{},{},{:g},{},{},{},{:.2f},{:.1f},{:.0f},{:.2f},{},{},{},{}\n",
                          row.condition + 1, c.scene, c.link, c.headset_share, c.motion,
                          row.take + 1, d.design, d.fps, d.mtp_ms_p99, d.bytes_per_frame, d.e1_deg,
-                         cell(d.predicted_fps, "{:.2f}"), cell(d.fpsErrorPct(), "{:.1f}"));
+                         cell(d.predicted_fps, "{:.2f}"), cell(d.fpsErrorPct(), "{:.1f}"),
+                         cell(d.predicted_fps_at_probe_speed, "{:.2f}"),
+                         cell(d.fpsErrorAtProbeSpeedPct(), "{:.1f}"));
     }
     return s;
 }
@@ -177,13 +199,15 @@ std::string sweepMarkdown(const SweepOptions& o, const SweepResult& r) {
     for (const SweepCriterion& c : sweepCriteria(r))
         s += fmt::format("- {} {}: {}\n", c.pass ? "PASS" : "FAIL", c.name, c.detail);
     s += "\n## Every run\n\n| # | take | design | FPS | MTP p99 ms | bytes/frame | e1° | "
-         "predicted FPS | error |\n|---|---|---|---|---|---|---|---|---|\n";
+         "predicted FPS | error | error at the probes' speed |\n"
+         "|---|---|---|---|---|---|---|---|---|---|\n";
     for (const SweepRow& row : r.rows) {
         const DesignReading& d = row.reading;
-        s += fmt::format("| {} | {} | {} | {:.1f} | {:.0f} | {:.0f} | {:.1f} | {} | {} |\n",
+        s += fmt::format("| {} | {} | {} | {:.1f} | {:.0f} | {:.0f} | {:.1f} | {} | {} | {} |\n",
                          row.condition + 1, row.take + 1, d.design, d.fps, d.mtp_ms_p99,
                          d.bytes_per_frame, d.e1_deg, cell(d.predicted_fps, "{:.1f}"),
-                         cell(d.fpsErrorPct(), "{:+.1f}%"));
+                         cell(d.fpsErrorPct(), "{:+.1f}%"),
+                         cell(d.fpsErrorAtProbeSpeedPct(), "{:+.1f}%"));
     }
     if (r.failed_runs > 0 || r.stop_signal != 0)
         s += fmt::format(
@@ -238,7 +262,9 @@ json sweepJson(const SweepOptions& o, const SweepResult& r) {
                         {"bytes_per_frame", d.bytes_per_frame},
                         {"e1_deg", d.e1_deg},
                         {"predicted_fps", optJson(d.predicted_fps)},
-                        {"fps_error_pct", optJson(d.fpsErrorPct())}});
+                        {"fps_error_pct", optJson(d.fpsErrorPct())},
+                        {"predicted_fps_at_probe_speed", optJson(d.predicted_fps_at_probe_speed)},
+                        {"fps_error_at_probe_speed_pct", optJson(d.fpsErrorAtProbeSpeedPct())}});
     }
     j["runs"] = runs;
     json criteria = json::array();

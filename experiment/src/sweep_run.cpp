@@ -62,10 +62,28 @@ std::pair<std::string, double> bestFixedOf(const std::vector<SweepRow>& rows, in
 
 }  // namespace
 
-std::optional<double> DesignReading::fpsErrorPct() const {
-    if (!predicted_fps || fps <= 0.0)
+namespace {
+std::optional<double> errorPct(std::optional<double> predicted, double measured) {
+    if (!predicted || measured <= 0.0)
         return std::nullopt;
-    return 100.0 * (*predicted_fps - fps) / fps;
+    return 100.0 * (*predicted - measured) / measured;
+}
+// summary.json's designs.<d>.<object>.fps_mean, if it is a number.
+std::optional<double> fpsMeanIn(const json& design, const char* object) {
+    if (!design.contains(object) || !design[object].is_object())
+        return std::nullopt;
+    const json& o = design[object];
+    if (!o.contains("fps_mean") || !o["fps_mean"].is_number())
+        return std::nullopt;
+    return o["fps_mean"].get<double>();
+}
+}  // namespace
+
+std::optional<double> DesignReading::fpsErrorPct() const {
+    return errorPct(predicted_fps, fps);
+}
+std::optional<double> DesignReading::fpsErrorAtProbeSpeedPct() const {
+    return errorPct(predicted_fps_at_probe_speed, fps);
 }
 
 std::vector<DesignReading> readingsFromSummary(const json& summary,
@@ -87,9 +105,8 @@ std::vector<DesignReading> readingsFromSummary(const json& summary,
         r.mtp_ms_p99 = num(d, "mtp_ms_p99");
         r.bytes_per_frame = num(d, "bytes_per_frame_mean");
         r.e1_deg = num(d, "e1_deg_mean");
-        if (d.contains("predicted") && d["predicted"].is_object() &&
-            d["predicted"].contains("fps_mean") && d["predicted"]["fps_mean"].is_number())
-            r.predicted_fps = d["predicted"]["fps_mean"].get<double>();
+        r.predicted_fps = fpsMeanIn(d, "predicted");
+        r.predicted_fps_at_probe_speed = fpsMeanIn(d, "predicted_at_probe_speed");
         out.push_back(std::move(r));
     }
     return out;

@@ -97,8 +97,13 @@ Expected<SweepOptions> sweepOptions(const SweepArgs& args);
 struct DesignReading {
     std::string design;
     double fps = 0.0, mtp_ms_p99 = 0.0, bytes_per_frame = 0.0, e1_deg = 0.0;
-    std::optional<double> predicted_fps;        // the calibrated model's
+    std::optional<double> predicted_fps;  // the calibrated model's
+    // The model with the design's costs at the speed the run's probes measured (docs/MODEL.md
+    // §11): how much of the error is the host running faster or slower than when calibrated.
+    // None under --headset-share (no probes there).
+    std::optional<double> predicted_fps_at_probe_speed;
     std::optional<double> fpsErrorPct() const;  // signed, percent of the measurement
+    std::optional<double> fpsErrorAtProbeSpeedPct() const;
 };
 
 // The designs of one `qvr run` summary.json, in the order given (missing ones left out).
