@@ -255,10 +255,15 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
     }
     const double hi = std::min(m_config.e1_max_deg, m_cover_deg);
     const double lo = m_config.e1_min_deg;
-    if (m_first_decision) {
-        // Nothing measured yet: the first frame runs at the initial e1 (Fig. 14 starts at 5°).
+    // Nothing measured yet: the first frame runs at the initial e1 (Fig. 14 starts at 5°). With
+    // the period objective e1 also holds until a frame that held has been observed: before it,
+    // the costs are the cold-start priors (1 bit a pixel, 20-50x a P-frame's) and the session's
+    // opening key frames, no basis for a move.
+    const bool cold = m_first_decision || (m_config.frame_period_objective && !m_seen_held_frame);
+    if (cold) {
+        if (m_first_decision)
+            m_e1_deg = std::clamp(m_config.e1_initial_deg, lo, std::max(lo, hi));
         m_first_decision = false;
-        m_e1_deg = std::clamp(m_config.e1_initial_deg, lo, std::max(lo, hi));
         Decision d{m_e1_deg, localMs(m_e1_deg), remoteMs(frame.gaze, m_e1_deg)};
         remember(d);
         if (m_config.frame_period_objective)
@@ -326,6 +331,9 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // A frame whose e1 moved carries the move's bytes (a key frame, a new canvas): what it
     // cost is learned apart (learnMoveCost), and the table and the bits law, which predict a
     // frame that holds, learn from the others (frame_period_objective).
+    // The session's first frame: its remote chain opened the encoders and its link carried their
+    // key frames, so it teaches neither the server's fit nor the bits law.
+    const bool opening = m_last_observed_e1_deg < 0.0;
     const bool moved_apart = m_config.frame_period_objective &&
                              learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
                                                   m.outer_pixels * bitsPerPixelAt(m.s2));
@@ -364,9 +372,10 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
         const double server_ms = std::max(0.0, m.t_remote_ms - sent_bits / bps * 1000.0);
-        m_server_fit.add(
-            {1.0, decided->periphery_triangles * 1e-5, decided->periphery_pixels * 1e-5},
-            server_ms);
+        if (!opening)
+            m_server_fit.add(
+                {1.0, decided->periphery_triangles * 1e-5, decided->periphery_pixels * 1e-5},
+                server_ms);
     } else if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double transmission_ms = sent_bits / m_throughput_bps * 1000.0;
@@ -381,14 +390,18 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double lo = std::log(m.outer_bytes * 8.0 / m.outer_pixels);
         const double gamma = std::clamp((lo - lm) / (std::log(m.s2) - std::log(m.s1)), 0.0, 2.0);
         const double log_b1 = lm - gamma * std::log(m.s1);
-        m_bits_exponent = (1.0 - b) * m_bits_exponent + b * gamma;
-        m_log_bits_at_1 = (1.0 - b) * m_log_bits_at_1 + b * log_b1;
+        const double w = replacesPrior() ? 1.0 : b;  // a measurement replaces the prior
+        m_bits_exponent = (1.0 - w) * m_bits_exponent + w * gamma;
+        m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
+        m_bits_law_measured = true;
     } else if (have_mid || have_out) {
         const double bits = have_mid ? m.middle_bytes * 8.0 / m.middle_pixels
                                      : m.outer_bytes * 8.0 / m.outer_pixels;
         const double s = have_mid ? m.s1 : m.s2;
         const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
-        m_log_bits_at_1 = (1.0 - b) * m_log_bits_at_1 + b * log_b1;
+        const double w = replacesPrior() ? 1.0 : b;
+        m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
+        m_bits_law_measured = true;
     }
     // The next candidates step from the newest decision; the measured e1 replaces it only when
     // no later decision is already out (a pipelined headset has one in flight).
@@ -402,10 +415,13 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     // on all frames) predicted, beside the same ratio for frames that held, is what a move costs.
     const bool moved =
         m_last_observed_e1_deg >= 0.0 && std::fabs(m.e1_deg - m_last_observed_e1_deg) > 0.05;
+    // The session's first frame opens every encoder (a key frame on each stream): like a move's,
+    // its bits are not what a frame that holds costs, so it is kept apart too.
     const bool first = m_last_observed_e1_deg < 0.0;
     m_last_observed_e1_deg = m.e1_deg;
     if (first)
-        return false;
+        return true;
+    m_seen_held_frame = m_seen_held_frame || !moved;
     constexpr double kWeight = 0.2;
     if (moved) {
         m_frames_between_moves =

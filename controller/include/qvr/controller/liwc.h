@@ -113,7 +113,8 @@ private:
     // The measured extra bits of a frame whose e1 moved, as a fraction of the bits predicted
     // for it, spread over the frames a chosen e1 is measured to hold (docs/LIWC.md).
     double moveCostFraction() const;
-    // Whether the measured frame's e1 moved from the previous one's.
+    // Whether the measured frame is kept apart from the steady-state fits: its e1 moved from the
+    // previous one's, or it is the session's first (its encoders' opening key frames).
     bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
     // Both eyes' middle and outer layers' bits at e1 (0 once the fovea covers the frame).
     double peripheryBits(const Gaze& gaze, double e1_deg) const;
@@ -151,6 +152,10 @@ private:
     double m_moved_bits_ratio = 1.0;
     double m_held_bits_ratio = 1.0;
     bool m_have_moved_ratio = false, m_have_held_ratio = false;
+    bool m_seen_held_frame = false;    // a frame whose e1 held has been observed
+    bool m_bits_law_measured = false;  // the bits law has been measured
+    // The period objective's bits law takes its first measurement outright (the prior is far off).
+    bool replacesPrior() const { return m_config.frame_period_objective && !m_bits_law_measured; }
     double m_frames_between_moves = 1.0;
     int m_frames_since_move = 0;
     double m_last_observed_e1_deg = -1.0;
