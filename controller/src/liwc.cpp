@@ -333,7 +333,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // frame that holds, learn from the others (frame_period_objective).
     // The session's first frame: its remote chain opened the encoders and its link carried their
     // key frames, so it teaches neither the server's fit nor the bits law.
-    const bool opening = m_last_observed_e1_deg < 0.0;
+    const bool opening = m_observed == 0;
     const bool moved_apart = m_config.frame_period_objective &&
                              learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
                                                   m.outer_pixels * bitsPerPixelAt(m.s2));
@@ -385,24 +385,22 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
     const bool have_mid = !moved_apart && m.middle_pixels > 0 && m.middle_bytes > 0;
     const bool have_out = !moved_apart && m.outer_pixels > 0 && m.outer_bytes > 0;
+    const double w = replacesPrior() ? 1.0 : b;  // a first measurement replaces the prior
     if (have_mid && have_out && m.s2 > 1.05 * m.s1) {
         const double lm = std::log(m.middle_bytes * 8.0 / m.middle_pixels);
         const double lo = std::log(m.outer_bytes * 8.0 / m.outer_pixels);
         const double gamma = std::clamp((lo - lm) / (std::log(m.s2) - std::log(m.s1)), 0.0, 2.0);
         const double log_b1 = lm - gamma * std::log(m.s1);
-        const double w = replacesPrior() ? 1.0 : b;  // a measurement replaces the prior
         m_bits_exponent = (1.0 - w) * m_bits_exponent + w * gamma;
         m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
-        m_bits_law_measured = true;
     } else if (have_mid || have_out) {
         const double bits = have_mid ? m.middle_bytes * 8.0 / m.middle_pixels
                                      : m.outer_bytes * 8.0 / m.outer_pixels;
         const double s = have_mid ? m.s1 : m.s2;
         const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
-        const double w = replacesPrior() ? 1.0 : b;
         m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
-        m_bits_law_measured = true;
     }
+    m_bits_law_measured = m_bits_law_measured || have_mid || have_out;
     // The next candidates step from the newest decision; the measured e1 replaces it only when
     // no later decision is already out (a pipelined headset has one in flight).
     if (m_pending.empty())

@@ -60,9 +60,6 @@ std::pair<std::string, double> bestFixedOf(const std::vector<SweepRow>& rows, in
     return best;
 }
 
-}  // namespace
-
-namespace {
 std::optional<double> errorPct(std::optional<double> predicted, double measured) {
     if (!predicted || measured <= 0.0)
         return std::nullopt;
