@@ -29,6 +29,10 @@ int runSweepCommand(const SweepArgs& args) {
         return 1;
     }
     options->executable = *exe;
+    if (!options->from.empty()) {
+        StoredConditionRunner stored(options->from);
+        return runSweep(*options, stored);
+    }
     ProcessRunner children;  // from here SIGINT and SIGTERM stop the sweep
     ProcessConditionRunner runner(*options, children);
     return runSweep(*options, runner);
@@ -69,6 +73,9 @@ static Registered registerSweep(CLI::App& app) {
     addProfileOption(cmd, a->profile, ProfileNames::kRuntime);
     addOutputFolderOption(cmd, a->out, "Output folder");
     cmd->add_flag("--dry-run", a->dry_run, "Print the conditions without running them");
+    cmd->add_option("--from", a->from,
+                    "Judge the runs an earlier sweep wrote in this folder (its seed, conditions, "
+                    "repeats and designs) instead of running them");
     return {cmd, [a] { return runSweepCommand(*a); }};
 }
 

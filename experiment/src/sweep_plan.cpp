@@ -275,6 +275,10 @@ Expected<SweepOptions> sweepOptions(const SweepArgs& a) {
     o.profile = a.profile;
     o.out = a.out;
     o.dry_run = a.dry_run;
+    if (!a.from.empty() && !fs::is_directory(a.from))
+        return makeError(
+            fmt::format("--from '{}' is not a folder of an earlier sweep's runs", a.from));
+    o.from = a.from;
     return o;
 }
 

@@ -30,24 +30,55 @@ bool isFixedLabel(const std::string& design) {
     return design == "ffr" || design.rfind("fixed:", 0) == 0;
 }
 
-// One condition's readings by design: every take's.
-using ByDesign = std::map<std::string, std::vector<const DesignReading*>>;
+// One condition's rows by design: every take's.
+using ByDesign = std::map<std::string, std::vector<const SweepRow*>>;
 
-std::optional<double> medianOf(const ByDesign& by, const std::string& design,
-                               double DesignReading::*field) {
-    const auto it = by.find(design);
-    if (it == by.end() || it->second.empty())
-        return std::nullopt;
+double freshFpsOf(const DesignReading& r) {
+    return r.freshFps();
+}
+double mtpP99Of(const DesignReading& r) {
+    return r.mtp_ms_p99;
+}
+
+// The takes that ran both designs: the repeats, or the grid's take when no repeat ran both.
+std::vector<int> commonTakes(const ByDesign& by, const std::string& a, const std::string& b) {
+    const auto ia = by.find(a), ib = by.find(b);
+    if (ia == by.end() || ib == by.end())
+        return {};
+    std::vector<int> both, repeats;
+    for (const SweepRow* ra : ia->second)
+        for (const SweepRow* rb : ib->second)
+            if (ra->take == rb->take)
+                both.push_back(ra->take);
+    for (int t : both)
+        if (t > 0)
+            repeats.push_back(t);
+    return repeats.empty() ? both : repeats;
+}
+
+std::optional<double> medianOver(const ByDesign& by, const std::string& design,
+                                 const std::vector<int>& takes,
+                                 double (*value)(const DesignReading&)) {
     std::vector<double> v;
-    for (const DesignReading* r : it->second)
-        v.push_back(r->*field);
+    for (const SweepRow* r : by.at(design))
+        if (std::find(takes.begin(), takes.end(), r->take) != takes.end())
+            v.push_back(value(r->reading));
+    if (v.empty())
+        return std::nullopt;
     return median(v);
 }
 
-std::optional<double> ratio(std::optional<double> a, std::optional<double> b) {
-    if (!a || !b || *b <= 0.0)
+// a's median over b's, both over the takes that ran both (commonTakes).
+std::optional<double> ratioOver(const ByDesign& by, const std::string& a, const std::string& b,
+                                double (*value)(const DesignReading&) = freshFpsOf) {
+    const std::vector<int> takes = commonTakes(by, a, b);
+    if (takes.empty())
         return std::nullopt;
-    return *a / *b;
+    const std::optional<double> x = medianOver(by, a, takes, value);
+    const std::optional<double> y = medianOver(by, b, takes, value);
+    if (!x || !y || *y <= 0.0)
+        return std::nullopt;
+    return *x / *y;
 }
 
 // The fixed design (ffr is fixed:5) with the highest FPS in the condition's first take.
@@ -55,8 +86,8 @@ std::pair<std::string, double> bestFixedOf(const std::vector<SweepRow>& rows, in
     std::pair<std::string, double> best{"", 0.0};
     for (const SweepRow& r : rows)
         if (r.condition == condition && r.take == 0 && isFixedLabel(r.reading.design) &&
-            r.reading.fps > best.second)
-            best = {r.reading.design, r.reading.fps};
+            r.reading.freshFps() > best.second)
+            best = {r.reading.design, r.reading.freshFps()};
     return best;
 }
 
@@ -82,30 +113,71 @@ std::optional<double> DesignReading::fpsErrorPct() const {
 std::optional<double> DesignReading::fpsErrorAtProbeSpeedPct() const {
     return errorPct(predicted_fps_at_probe_speed, fps);
 }
+double DesignReading::freshFps() const {
+    if (frames <= 0)
+        return fps;
+    return fps * double(frames - std::clamp(frames_reused, 0, frames)) / double(frames);
+}
+
+namespace {
+
+DesignReading readingOf(const std::string& name, const json& d) {
+    const auto num = [&](const char* key) {
+        return d.contains(key) && d[key].is_number() ? d[key].get<double>() : 0.0;
+    };
+    DesignReading r;
+    r.design = name;
+    r.fps = num("fps_mean");
+    r.mtp_ms_p99 = num("mtp_ms_p99");
+    r.bytes_per_frame = num("bytes_per_frame_mean");
+    r.e1_deg = num("e1_deg_mean");
+    r.frames = static_cast<int>(std::clamp(num("frames"), 0.0, 1e9));
+    r.frames_reused = static_cast<int>(std::clamp(num("frames_reused"), 0.0, double(r.frames)));
+    r.predicted_fps = fpsMeanIn(d, "predicted");
+    r.predicted_fps_at_probe_speed = fpsMeanIn(d, "predicted_at_probe_speed");
+    return r;
+}
+
+const json* designsOf(const json& summary) {
+    if (!summary.is_object() || !summary.contains("designs") || !summary["designs"].is_object())
+        return nullptr;
+    return &summary["designs"];
+}
+
+}  // namespace
 
 std::vector<DesignReading> readingsFromSummary(const json& summary,
                                                const std::vector<std::string>& designs) {
     std::vector<DesignReading> out;
-    if (!summary.is_object() || !summary.contains("designs") || !summary["designs"].is_object())
+    if (const json* all = designsOf(summary))
+        for (const std::string& name : designs)
+            if (all->contains(name) && (*all)[name].is_object())
+                out.push_back(readingOf(name, (*all)[name]));
+    return out;
+}
+
+std::vector<DesignReading> readingsFromSummary(const json& summary) {
+    std::vector<DesignReading> out;
+    if (const json* all = designsOf(summary))
+        for (const auto& [name, d] : all->items())
+            if (d.is_object())
+                out.push_back(readingOf(name, d));
+    return out;
+}
+
+ConditionRun StoredConditionRunner::run(const SweepCondition&, const std::vector<std::string>&,
+                                        const std::string& tag) {
+    const fs::path path = fs::path(m_dir) / tag / "summary.json";
+    ConditionRun out;
+    std::ifstream f(path);
+    if (!f) {
+        out.note = fmt::format("no {}", path.string());
         return out;
-    const json& all = summary["designs"];
-    const auto num = [](const json& j, const char* key) {
-        return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
-    };
-    for (const std::string& name : designs) {
-        if (!all.contains(name) || !all[name].is_object())
-            continue;
-        const json& d = all[name];
-        DesignReading r;
-        r.design = name;
-        r.fps = num(d, "fps_mean");
-        r.mtp_ms_p99 = num(d, "mtp_ms_p99");
-        r.bytes_per_frame = num(d, "bytes_per_frame_mean");
-        r.e1_deg = num(d, "e1_deg_mean");
-        r.predicted_fps = fpsMeanIn(d, "predicted");
-        r.predicted_fps_at_probe_speed = fpsMeanIn(d, "predicted_at_probe_speed");
-        out.push_back(std::move(r));
     }
+    out.designs = readingsFromSummary(json::parse(f, nullptr, false));
+    out.ok = !out.designs.empty();
+    if (!out.ok)
+        out.note = fmt::format("{} holds no design", path.string());
     return out;
 }
 
@@ -150,19 +222,19 @@ std::vector<ConditionVerdict> conditionVerdicts(const SweepOptions& options,
         ByDesign by;
         for (const SweepRow& r : result.rows)
             if (r.condition == c.index)
-                by[r.reading.design].push_back(&r.reading);
+                by[r.reading.design].push_back(&r);
         if (by.empty())
             continue;
         ConditionVerdict v;
         v.condition = c.index;
         v.link_mbps = linkMeanMbps(c.link);
         std::tie(v.best_fixed, v.best_fixed_fps) = bestFixedOf(result.rows, c.index);
-        const auto fps = [&](const std::string& d) { return medianOf(by, d, &DesignReading::fps); };
-        v.qvr_over_best = ratio(fps("qvr"), fps(v.best_fixed));
-        v.qvr_over_ffr = ratio(fps("qvr"), fps("ffr"));
-        v.qvr_over_aimd = ratio(fps("qvr"), fps("aimd"));
-        v.mtp_p99_over_best = ratio(medianOf(by, "qvr", &DesignReading::mtp_ms_p99),
-                                    medianOf(by, v.best_fixed, &DesignReading::mtp_ms_p99));
+        v.qvr_over_best = ratioOver(by, "qvr", v.best_fixed);
+        v.qvr_over_best_all_frames =
+            ratioOver(by, "qvr", v.best_fixed, [](const DesignReading& r) { return r.fps; });
+        v.qvr_over_ffr = ratioOver(by, "qvr", "ffr");
+        v.qvr_over_aimd = ratioOver(by, "qvr", "aimd");
+        v.mtp_p99_over_best = ratioOver(by, "qvr", v.best_fixed, mtpP99Of);
         std::vector<std::string> spread_designs = options.adaptive;
         if (!v.best_fixed.empty() && std::find(spread_designs.begin(), spread_designs.end(),
                                                v.best_fixed) == spread_designs.end())
@@ -172,8 +244,8 @@ std::vector<ConditionVerdict> conditionVerdicts(const SweepOptions& options,
             if (it == by.end() || it->second.size() < 2)
                 continue;
             std::vector<double> f;
-            for (const DesignReading* r : it->second)
-                f.push_back(r->fps);
+            for (const SweepRow* r : it->second)
+                f.push_back(r->reading.freshFps());
             const double m = median(f);
             if (m > 0.0)
                 v.spread_pct.emplace_back(d, 100.0 *

@@ -165,10 +165,13 @@ TEST(SweepRead, ReadsTheDesignsOfASummaryInTheOrderAsked) {
     EXPECT_TRUE(readingsFromSummary(nullptr, {"qvr"}).empty());
 }
 
-// FPS per design from a table; the prediction 5% high; MTP p99 1000 / FPS.
+// FPS per design from a table; the prediction 5% high; MTP p99 1000 / FPS. 100 frames a run,
+// `reused` of them re-warping older layers; `grid_luck` multiplies a design's grid take.
 class FakeRunner final : public ConditionRunner {
 public:
     std::map<std::string, double> fps;
+    std::map<std::string, int> reused;
+    std::map<std::string, double> grid_luck;
     std::vector<std::vector<std::string>> calls;
     ConditionRun run(const SweepCondition& c, const std::vector<std::string>& designs,
                      const std::string& tag) override {
@@ -180,6 +183,10 @@ public:
             DesignReading r;
             r.design = d;
             r.fps = fps.at(d) * (c.index == 1 ? 0.5 : 1.0) * (calls.size() % 2 ? 1.0 : 1.1);
+            if (tag.ends_with("_grid") && grid_luck.contains(d))
+                r.fps *= grid_luck.at(d);
+            r.frames = 100;
+            r.frames_reused = reused.contains(d) ? reused.at(d) : 0;
             r.mtp_ms_p99 = 1000.0 / r.fps;
             r.predicted_fps = 1.05 * r.fps;
             if (c.index == 0)
@@ -298,6 +305,105 @@ TEST(SweepRun, JudgesTheSlowLinkCriterionOnSlowLinksOnly) {
     EXPECT_NE(slow_behind.detail.find("0/1 conditions"), std::string::npos) << slow_behind.detail;
     const SweepCriterion slow_near = slowCriterion(2.0, 39.0);
     EXPECT_TRUE(slow_near.pass) << slow_near.detail;
+}
+
+SweepResult sweepOf(FakeRunner& runner, int repeats) {
+    SweepOptions o;
+    o.conditions = 1;
+    o.repeats = repeats;
+    o.adaptive = {"qvr", "ffr"};
+    o.fixed_grid_deg = {2, 10};
+    std::FILE* null = std::fopen("/dev/null", "w");
+    SweepResult r = executeSweep(o, runner, null);
+    std::fclose(null);
+    return r;
+}
+
+// A design whose frames re-warp an older periphery keeps its frame rate; the sweep judges the
+// frames shown with their own layers, so it neither wins the grid nor sets the bar.
+TEST(SweepRun, JudgesTheFramesShownWithTheirOwnLayers) {
+    FakeRunner runner;
+    runner.fps = {{"qvr", 30.0}, {"ffr", 20.0}, {"fixed:2", 55.0}, {"fixed:10", 32.0}};
+    runner.reused = {{"fixed:2", 100}, {"qvr", 10}};
+    const SweepResult r = sweepOf(runner, 1);
+    ASSERT_EQ(r.verdicts.size(), 1u);
+    const ConditionVerdict& v = r.verdicts[0];
+    EXPECT_EQ(v.best_fixed, "fixed:10");
+    EXPECT_NEAR(*v.qvr_over_best, 27.0 / 32.0, 1e-9);
+    EXPECT_NEAR(*v.qvr_over_best_all_frames, 30.0 / 32.0, 1e-9);
+    EXPECT_NEAR(*v.qvr_over_ffr, 27.0 / 20.0, 1e-9);
+    DesignReading d;
+    d.fps = 40.0;
+    d.frames = 80;
+    d.frames_reused = 20;
+    EXPECT_DOUBLE_EQ(d.freshFps(), 30.0);
+    d.frames = 0;  // no counts (an older summary): every frame its own
+    EXPECT_DOUBLE_EQ(d.freshFps(), 40.0);
+    const std::string csv = sweepCsv(r);
+    EXPECT_NE(csv.find(",fixed:2,55.00,100,100,0.00,"), std::string::npos) << csv;
+}
+
+// The best fixed e1 is the grid take's highest of several noisy values: judged on that value it
+// is favoured, so it is judged on the repeats, qvr on the same takes.
+TEST(SweepRun, ChoosesTheBestFixedOnTheGridAndJudgesItOnTheRepeats) {
+    FakeRunner runner;
+    runner.fps = {{"qvr", 38.0}, {"ffr", 20.0}, {"fixed:2", 15.0}, {"fixed:10", 40.0}};
+    runner.grid_luck = {{"fixed:10", 1.2}};
+    const SweepResult repeated = sweepOf(runner, 2);
+    ASSERT_EQ(repeated.verdicts.size(), 1u);
+    EXPECT_EQ(repeated.verdicts[0].best_fixed, "fixed:10");
+    EXPECT_NEAR(repeated.verdicts[0].best_fixed_fps, 48.0, 1e-9);
+    EXPECT_NEAR(*repeated.verdicts[0].qvr_over_best, 0.95, 1e-9);  // the repeats alone
+    FakeRunner once = runner;
+    once.calls.clear();
+    once.tags.clear();
+    const SweepResult grid_only = sweepOf(once, 0);  // no repeat: the grid's take is all there is
+    EXPECT_NEAR(*grid_only.verdicts[0].qvr_over_best, 38.0 / 48.0, 1e-9);
+}
+
+void writeSummary(const std::filesystem::path& dir, const std::string& text) {
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "summary.json") << text;
+}
+
+// `qvr sweep --from DIR` reads each take's summary.json; a missing or unreadable one is a failed
+// run with its path, never a silent zero.
+TEST(SweepStored, JudgesAnEarlierSweepsRunsAndNamesWhatIsMissing) {
+    const auto dir = std::filesystem::temp_directory_path() / "qvr_sweep_stored_test";
+    std::filesystem::remove_all(dir);
+    writeSummary(dir / "c01_grid", R"({"designs": {
+        "qvr": {"fps_mean": 30, "frames": 100, "frames_reused": 0},
+        "ffr": {"fps_mean": 20, "frames": 100, "frames_reused": 0},
+        "fixed:2": {"fps_mean": 50, "frames": 100, "frames_reused": 90},
+        "fixed:10": {"fps_mean": 32, "frames": 100, "frames_reused": 0}}})");
+    writeSummary(dir / "c01_r2", R"({"designs": {
+        "qvr": {"fps_mean": 31, "frames": 100, "frames_reused": 0},
+        "fixed:2": {"fps_mean": 51, "frames": 100, "frames_reused": 90}}})");
+    writeSummary(dir / "c01_r3", "{not json");
+    SweepOptions o;
+    o.conditions = 1;
+    o.repeats = 3;
+    o.adaptive = {"qvr", "ffr"};
+    o.fixed_grid_deg = {2, 10};
+    StoredConditionRunner stored(dir.string());
+    std::FILE* null = std::fopen("/dev/null", "w");
+    const SweepResult r = executeSweep(o, stored, null);
+    std::fclose(null);
+    EXPECT_EQ(r.failed_runs, 2);  // c01_r3 unreadable, c01_r4 missing
+    ASSERT_EQ(r.verdicts.size(), 1u);
+    EXPECT_EQ(r.verdicts[0].best_fixed, "fixed:10");
+    // fixed:10 has no repeat: qvr and it are judged on the grid's take, the one both ran.
+    EXPECT_NEAR(*r.verdicts[0].qvr_over_best, 30.0 / 32.0, 1e-9);
+    EXPECT_EQ(r.rows.size(), 6u);
+    const ConditionRun missing = stored.run({}, {}, "c09_grid");
+    EXPECT_FALSE(missing.ok);
+    EXPECT_NE(missing.note.find("c09_grid"), std::string::npos) << missing.note;
+    SweepArgs a = defaultSweepArgs();
+    a.from = (dir / "nowhere").string();
+    const auto refused = sweepOptions(a);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().find("--from"), std::string::npos) << refused.error();
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

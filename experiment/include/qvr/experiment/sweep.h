@@ -69,6 +69,7 @@ struct SweepOptions {
     std::string profile = "default";
     std::string out = "qvr-sweep";
     bool dry_run = false;
+    std::string from;  // an earlier sweep's folder: its runs judged, none run (empty: run them)
     std::vector<std::string> skipped_designs;  // named, but refused by the runtime: why
 };
 
@@ -82,7 +83,7 @@ struct SweepArgs {
     double rate_min_mbps = 1.0, rate_max_mbps = 200.0;
     int repeats = 3;
     int frames = 150;
-    std::string hardware, profile = "default", out = "qvr-sweep";
+    std::string hardware, profile = "default", out = "qvr-sweep", from;
     bool dry_run = false;
 };
 // The defaults of a list the arguments leave empty: the shared Mahimahi traces (each also at a
@@ -97,6 +98,8 @@ Expected<SweepOptions> sweepOptions(const SweepArgs& args);
 struct DesignReading {
     std::string design;
     double fps = 0.0, mtp_ms_p99 = 0.0, bytes_per_frame = 0.0, e1_deg = 0.0;
+    // The counted frames, and those that re-warped older layers because their own came late.
+    int frames = 0, frames_reused = 0;
     std::optional<double> predicted_fps;  // the calibrated model's
     // The model with the design's costs at the speed the run's probes measured (docs/MODEL.md
     // §11): how much of the error is the host running faster or slower than when calibrated.
@@ -104,11 +107,17 @@ struct DesignReading {
     std::optional<double> predicted_fps_at_probe_speed;
     std::optional<double> fpsErrorPct() const;  // signed, percent of the measurement
     std::optional<double> fpsErrorAtProbeSpeedPct() const;
+    // Frames per second shown with their own layers: fps × (frames − frames_reused) / frames.
+    // What the sweep judges designs on: `fps` also counts frames that re-warped an older
+    // periphery, so a design whose layers stop arriving keeps its frame rate (docs/MODEL.md §12).
+    double freshFps() const;
 };
 
 // The designs of one `qvr run` summary.json, in the order given (missing ones left out).
 std::vector<DesignReading> readingsFromSummary(const nlohmann::json& summary,
                                                const std::vector<std::string>& designs);
+// Every design of one `qvr run` summary.json.
+std::vector<DesignReading> readingsFromSummary(const nlohmann::json& summary);
 
 // What one run of a condition gave.
 struct ConditionRun {
@@ -126,6 +135,19 @@ public:
                              const std::vector<std::string>& designs, const std::string& tag) = 0;
     // The signal that stopped the sweep (0: none): no run starts after it.
     virtual int stopSignal() const { return 0; }
+};
+
+// The runs an earlier sweep wrote (`qvr sweep --from DIR`): each take read from
+// DIR/<tag>/summary.json, every design it holds, nothing run. The same seed, conditions and
+// repeats give the same tags.
+class StoredConditionRunner final : public ConditionRunner {
+public:
+    explicit StoredConditionRunner(std::string dir) : m_dir(std::move(dir)) {}
+    ConditionRun run(const SweepCondition& condition, const std::vector<std::string>& designs,
+                     const std::string& tag) override;
+
+private:
+    std::string m_dir;
 };
 
 // `qvr run` in a child process per run (through a ChildRunner), read from its summary.json.
@@ -158,13 +180,18 @@ struct SweepRow {
     DesignReading reading;
 };
 
-// A condition's verdicts, each from the medians of its takes.
+// A condition's verdicts. Every FPS is DesignReading::freshFps. The best fixed e1 is chosen on
+// the grid's take and judged on the others: a ratio is of the medians over the takes that ran
+// both designs, the grid's take left out when a repeat ran both (choosing the highest of nine
+// noisy values and judging on that same value favours it; docs/MODEL.md §13).
 struct ConditionVerdict {
     int condition = 0;
     std::optional<double> link_mbps;
     std::string best_fixed;  // the fixed design with the highest FPS in the grid's take
     double best_fixed_fps = 0.0;
     std::optional<double> qvr_over_best, qvr_over_ffr, qvr_over_aimd, mtp_p99_over_best;
+    // qvr over the best fixed e1 by `fps`, reused frames counted: beside the verdict, not in it.
+    std::optional<double> qvr_over_best_all_frames;
     // (max − min) / median of FPS over the takes, percent, by design (qvr, best fixed, …).
     std::vector<std::pair<std::string, double>> spread_pct;
 };
