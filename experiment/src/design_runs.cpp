@@ -30,6 +30,17 @@ namespace qvr::experiment {
 namespace fs = std::filesystem;
 using namespace qvr::runtime;
 
+std::optional<std::string> reusedPeripheryWarning(const runtime::DesignSummary& s) {
+    if (s.frames <= 0 || 2 * s.frames_reused <= s.frames)
+        return std::nullopt;
+    const double own = s.fps_mean * double(s.frames - s.frames_reused) / double(s.frames);
+    return fmt::format(
+        "warning: {}: {} of {} frames re-warped an older periphery (their own layers came after "
+        "the wait limit); its {:.1f} FPS counts them, {:.1f} FPS had their own (summary.json "
+        "frames_reused)",
+        s.design, s.frames_reused, s.frames, s.fps_mean, own);
+}
+
 namespace {
 
 // Progress on a terminal while a design runs (design, frame k of N, FPS so far), redrawn at
@@ -509,6 +520,8 @@ void DesignRunner::keepRun(const DesignSpec& spec, HeadsetResult result,
         "displayed {} reused {}\n",
         s.design, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean, s.e1_deg_mean,
         s.frames_displayed, s.frames_reused);
+    if (const auto warning = reusedPeripheryWarning(s))
+        fmt::print("  {}\n", *warning);
     if (s.startup_unfinished && m_plan.warmup_frames > 0) {
         m_m.never_shown.push_back(label);
         fmt::print(

@@ -154,6 +154,23 @@ TEST(BestFixed, TheFastestFixedDesignAndTheAdaptiveOnesOverIt) {
     EXPECT_FALSE(bestFixed({design(Design::Qvr, 0.0, 60.0, 0.0)}));
 }
 
+// A design whose layers stop arriving keeps its frame rate by re-warping an old periphery: the
+// console says so rather than let the FPS stand alone.
+TEST(ReusedPeripheryWarning, NamesADesignShowingMostlyOldLayers) {
+    runtime::DesignSummary s;
+    s.design = "fixed:2";
+    s.frames = 100;
+    s.fps_mean = 55.0;
+    s.frames_reused = 50;
+    EXPECT_FALSE(reusedPeripheryWarning(s));
+    s.frames_reused = 90;
+    const auto w = reusedPeripheryWarning(s);
+    ASSERT_TRUE(w);
+    EXPECT_NE(w->find("fixed:2: 90 of 100 frames"), std::string::npos) << *w;
+    EXPECT_NE(w->find("5.5 FPS had their own"), std::string::npos) << *w;
+    EXPECT_FALSE(reusedPeripheryWarning(runtime::DesignSummary{}));
+}
+
 TEST(HeadlineRatios, MeasuredAndPaperModel) {
     DesignResult local = design(Design::Local, 0.0, 20.0, 0.0);
     DesignResult remote = design(Design::Remote, 0.0, 30.0, 10000.0);

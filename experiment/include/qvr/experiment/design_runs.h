@@ -131,4 +131,9 @@ struct DisplayVideo {
 DisplayVideo writeDisplayVideo(const RunOptions& plan, const HmdProfile& profile,
                                const RunMeasurement& measurement);
 
+// The warning a design's console line gets when most of its counted frames re-warped an older
+// periphery (their own layers came after the wait limit): its FPS then counts frames whose
+// periphery is stale. None when half or fewer did.
+std::optional<std::string> reusedPeripheryWarning(const runtime::DesignSummary& s);
+
 }  // namespace qvr::experiment
