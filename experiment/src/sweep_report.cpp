@@ -34,7 +34,10 @@ std::string cell(const std::optional<double>& v, const char* spec) {
     return v ? fmt::format(fmt::runtime(spec), *v) : "—";
 }
 
+// JSON has no infinity: a ratio over a design with none of its own frames is the string "inf".
 json optJson(const std::optional<double>& v) {
+    if (v && std::isinf(*v))
+        return "inf";
     return v ? json(*v) : json(nullptr);
 }
 

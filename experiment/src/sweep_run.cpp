@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -76,19 +77,29 @@ std::optional<double> ratioOver(const ByDesign& by, const std::string& a, const 
         return std::nullopt;
     const std::optional<double> x = medianOver(by, a, takes, value);
     const std::optional<double> y = medianOver(by, b, takes, value);
-    if (!x || !y || *y <= 0.0)
+    if (!x || !y || (*y <= 0.0 && *x <= 0.0))
         return std::nullopt;
-    return *x / *y;
+    // b showed none of its own frames and a did: a is ahead by any ratio.
+    return *y <= 0.0 ? INFINITY : *x / *y;
 }
 
-// The fixed design (ffr is fixed:5) with the highest FPS in the condition's first take.
+// The fixed design (ffr is fixed:5) with the highest FPS in the condition's first take. The
+// display's pacing makes equal rates common (two designs showing 89 frames over the same
+// vsyncs): a tie goes to the lower MTP p99, then to the name, whatever order the runs came in.
 std::pair<std::string, double> bestFixedOf(const std::vector<SweepRow>& rows, int condition) {
-    std::pair<std::string, double> best{"", 0.0};
-    for (const SweepRow& r : rows)
-        if (r.condition == condition && r.take == 0 && isFixedLabel(r.reading.design) &&
-            r.reading.freshFps() > best.second)
-            best = {r.reading.design, r.reading.freshFps()};
-    return best;
+    const DesignReading* best = nullptr;
+    for (const SweepRow& r : rows) {
+        if (r.condition != condition || r.take != 0 || !isFixedLabel(r.reading.design))
+            continue;
+        const DesignReading& d = r.reading;
+        if (!best || d.freshFps() > best->freshFps() ||
+            (d.freshFps() == best->freshFps() &&
+             std::tie(d.mtp_ms_p99, d.design) < std::tie(best->mtp_ms_p99, best->design)))
+            best = &d;
+    }
+    if (!best || best->freshFps() <= 0.0)
+        return {"", 0.0};
+    return {best->design, best->freshFps()};
 }
 
 std::optional<double> errorPct(std::optional<double> predicted, double measured) {

@@ -1,6 +1,7 @@
 // The sweep without processes: the conditions a seed draws, the designs of each take, the
 // options checked, summary.json read, and a whole sweep through a fake runner with its ratios
 // and criteria.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -319,6 +320,30 @@ SweepResult sweepOf(FakeRunner& runner, int repeats) {
     return r;
 }
 
+// Two fixed designs at the same rate (the display's vsyncs quantise it): the lower MTP p99 is the
+// best fixed e1, in whichever order they ran.
+TEST(SweepRun, BreaksATieForTheBestFixedByMtpWhateverTheOrder) {
+    for (bool reversed : {false, true}) {
+        SweepResult r;
+        r.conditions.resize(1);
+        std::vector<DesignReading> grid(2);
+        grid[0].design = "fixed:8";
+        grid[0].fps = 33.375;
+        grid[0].mtp_ms_p99 = 80.0;
+        grid[1].design = "fixed:12";
+        grid[1].fps = 33.375;
+        grid[1].mtp_ms_p99 = 70.0;
+        if (reversed)
+            std::swap(grid[0], grid[1]);
+        for (const DesignReading& d : grid)
+            r.rows.push_back({0, 0, d});
+        SweepOptions o;
+        const auto v = conditionVerdicts(o, r);
+        ASSERT_EQ(v.size(), 1u);
+        EXPECT_EQ(v[0].best_fixed, "fixed:12") << (reversed ? "reversed" : "in order");
+    }
+}
+
 // A design whose frames re-warp an older periphery keeps its frame rate; the sweep judges the
 // frames shown with their own layers, so it neither wins the grid nor sets the bar.
 TEST(SweepRun, JudgesTheFramesShownWithTheirOwnLayers) {
@@ -332,6 +357,12 @@ TEST(SweepRun, JudgesTheFramesShownWithTheirOwnLayers) {
     EXPECT_NEAR(*v.qvr_over_best, 27.0 / 32.0, 1e-9);
     EXPECT_NEAR(*v.qvr_over_best_all_frames, 30.0 / 32.0, 1e-9);
     EXPECT_NEAR(*v.qvr_over_ffr, 27.0 / 20.0, 1e-9);
+    // ffr showing none of its own frames: qvr, which did, is ahead of it.
+    FakeRunner stale = runner;
+    stale.calls.clear();
+    stale.tags.clear();
+    stale.reused["ffr"] = 100;
+    EXPECT_TRUE(std::isinf(*sweepOf(stale, 1).verdicts[0].qvr_over_ffr));
     DesignReading d;
     d.fps = 40.0;
     d.frames = 80;
