@@ -33,7 +33,7 @@ using namespace qvr::runtime;
 std::optional<std::string> reusedPeripheryWarning(const runtime::DesignSummary& s) {
     if (s.frames <= 0 || 2 * s.frames_reused <= s.frames)
         return std::nullopt;
-    const double own = s.fps_mean * double(s.frames - s.frames_reused) / double(s.frames);
+    const double own = ownLayersFps(s.fps_mean, s.frames, s.frames_reused);
     return fmt::format(
         "warning: {}: {} of {} frames re-warped an older periphery (their own layers came after "
         "the wait limit); its {:.1f} FPS counts them, {:.1f} FPS had their own (summary.json "

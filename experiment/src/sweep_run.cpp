@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "qvr/core/run_summary.h"
 #include "qvr/core/shell_quote.h"
 #include "qvr/experiment/sweep.h"
 
@@ -125,9 +126,7 @@ std::optional<double> DesignReading::fpsErrorAtProbeSpeedPct() const {
     return errorPct(predicted_fps_at_probe_speed, fps);
 }
 double DesignReading::freshFps() const {
-    if (frames <= 0)
-        return fps;
-    return fps * double(frames - std::clamp(frames_reused, 0, frames)) / double(frames);
+    return ownLayersFps(fps, frames, frames_reused);
 }
 
 namespace {

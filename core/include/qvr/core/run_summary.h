@@ -114,4 +114,14 @@ private:
 // FrameSummarizer over a vector.
 RunStats summarizeFrames(const std::vector<FrameSample>& frames, int warmup_frames);
 
+// The frames per second shown with their own layers: fps_mean × (frames − frames_reused) /
+// frames (a reused frame re-warped an older periphery). What `qvr sweep` judges designs on and
+// `qvr run`'s stale-periphery warning prints; fps_mean itself when no frame was counted.
+inline double ownLayersFps(double fps_mean, int frames, int frames_reused) {
+    if (frames <= 0)
+        return fps_mean;
+    const int reused = frames_reused < 0 ? 0 : frames_reused > frames ? frames : frames_reused;
+    return fps_mean * double(frames - reused) / double(frames);
+}
+
 }  // namespace qvr
