@@ -2,6 +2,7 @@
 // sched-bwc.rst): cpu.cfs_quota_us / cpu.cfs_period_us in v1, "quota period" in cpu.max in v2.
 #include "qvr/runtime/cpu_share.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -59,7 +60,11 @@ Expected<CpuShareGroup> CpuShareGroup::create(double share, int period_us,
             "mount): cannot limit the headset's share");
     }
     g.m_parent = base;
-    g.m_path = fmt::format("{}/qvr-headset-{}", base, ::getpid());
+    // One group per call, not per process: `qvr run --headsets N` makes a group for each
+    // headset from the same process, and a name by pid alone put all N headsets under one quota
+    // (N headsets sharing one headset's share of the core).
+    static std::atomic<unsigned> made{0};
+    g.m_path = fmt::format("{}/qvr-headset-{}-{}", base, ::getpid(), made.fetch_add(1));
     if (::mkdir(g.m_path.c_str(), 0755) != 0 && errno != EEXIST)
         return makeError(
             fmt::format("cannot create the cgroup {} ({}): run as root, or without "

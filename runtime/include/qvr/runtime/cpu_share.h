@@ -18,9 +18,10 @@ public:
     // Shares outside (kMinShare, 1] are refused: 1 means the whole core (no group needed).
     static constexpr double kMinShare = 0.05;
 
-    // Makes a cgroup (v1 cpu controller at /sys/fs/cgroup/cpu, else v2 cpu.max) with quota
-    // share · period. An error naming the file that could not be written when the cgroup
-    // cannot be made (not root, read-only cgroup fs, no cpu controller).
+    // Makes a cgroup of its own (qvr-headset-<pid>-<n>: every call a new one; v1 cpu controller
+    // at /sys/fs/cgroup/cpu, else v2 cpu.max) with quota share · period. An error naming the file
+    // that could not be written when the cgroup cannot be made (not root, read-only cgroup fs, no
+    // cpu controller).
     static Expected<CpuShareGroup> create(double share, int period_us = kDefaultPeriodUs,
                                           const std::string& root = "");
     CpuShareGroup(CpuShareGroup&& other) noexcept;
