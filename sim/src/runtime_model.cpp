@@ -40,6 +40,9 @@ struct FrameState {
     int expected = 0;  // streams
     int decoded = 0;
     double last_rx_ms = 0.0;
+    // When the server could start on it: its request, or the last packet of a frame requested
+    // before it, whichever came later (the runtime's PendingFrame::service_start_ns).
+    double service_start_ms = 0.0;
     double received_bytes = 0.0;
     double middle_bytes = 0.0, outer_bytes = 0.0;
     bool served = false;
@@ -503,6 +506,13 @@ void PassReplay::decodeNext() {
     if (++fs.decoded == fs.expected) {
         rf.remote_done_ms = m_hs;
         m_last_complete_rx_ms = std::max(m_last_complete_rx_ms, fs.last_rx_ms);
+        // Frames requested after it waited for it; not the frame itself, nor any before it (a
+        // frame whose streams were decoded before its own wait kept its remote time).
+        // (A frame not yet prepared has no request; the runtime holds at most 64 pending.)
+        const size_t end = std::min(m_state.size(), size_t(s.frame) + 65);
+        for (size_t k = size_t(s.frame) + 1; k < end; ++k)
+            if (m_result.frames[k].requested)
+                m_state[k].service_start_ms = std::max(m_state[k].service_start_ms, fs.last_rx_ms);
     }
 }
 
@@ -559,6 +569,7 @@ void PassReplay::prepare(int64_t i) {
     if (fs.expected > 0) {
         rf.requested = true;
         rf.request_ms = m_hs;
+        fs.service_start_ms = std::max(m_hs, m_last_complete_rx_ms);
         advanceServer(m_hs);
         m_queue.push_back({i, m_hs});
         while (m_queue.size() > m_queue_cap) {
@@ -598,7 +609,7 @@ void PassReplay::renderFovea(int64_t i) {
 bool PassReplay::waitForStreams(int64_t i) {
     RuntimeFrame& rf = m_result.frames[static_cast<size_t>(i)];
     FrameState& fs = m_state[static_cast<size_t>(i)];
-    const double service_start = std::max(rf.request_ms, m_last_complete_rx_ms);
+    const double service_start = std::max(rf.request_ms, fs.service_start_ms);
     // A server that has delivered no stream for a whole wait limit: wait one refresh (the
     // runtime's silent_server_frames, docs/RUNTIME.md step 5).
     const bool silent = m_silence.silent(rf.local_end_ms, m_config.wait_limit_ms);

@@ -347,6 +347,21 @@ TEST(RuntimeModel, TwoFramesInFlightOverlapAsFarAsTheShorterStageAllows) {
     EXPECT_NEAR(hb1.summary.headset_busy_ms_mean, 85.0, 1e-6);
 }
 
+TEST(RuntimeModel, AFrameDecodedBeforeItsWaitKeepsItsRemoteTime) {
+    // Headset-bound with two frames in flight: the server's four 5 ms layers (20 ms) are done
+    // long before the headset's 85 ms frame ends, and the streams are decoded at the next pump,
+    // before the frame's own wait. Its remote time still runs from when the server could start
+    // on it (its request, the server idle) to its last packet: 20 ms, as the runtime measures
+    // it. The model took the start from the newest completed frame, which by then was this very
+    // frame, and reported 0 ms: LIWC's server fit then learned that the server costs nothing.
+    const RuntimeRunResult r = run(Design::Ffr, flatCosts(40.0, 5.0, 5.0), 2);
+    ASSERT_GT(r.frames.size(), 30u);
+    for (size_t k = 10; k < r.frames.size(); ++k) {
+        ASSERT_TRUE(r.frames[k].requested);
+        EXPECT_NEAR(r.frames[k].t_remote_ms, 20.0, 1e-6) << "frame " << k;
+    }
+}
+
 TEST(RuntimeModel, CoRunEndSlowsOnlyWhereTheOtherSideIsBusy) {
     const std::vector<BusySpan> other{{10.0, 20.0}, {30.0, 40.0}};
     // Nothing of the other side's in the way, or no slowdown: the work's own length.
