@@ -1,5 +1,6 @@
 // `qvr capacity`: headsets per render server at a target frame rate, from a calibration and a
 // workload through the calibrated runtime model (sim/capacity.h holds the model and its limits).
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -9,6 +10,9 @@
 #include "commands.h"
 #include "qvr/core/design.h"
 #include "qvr/core/text_file.h"
+#include "qvr/experiment/prediction.h"
+#include "qvr/render/draw_list.h"
+#include "qvr/scene/scene_loader.h"
 #include "qvr/sim/capacity.h"
 
 namespace qvr::cli {
@@ -16,9 +20,31 @@ namespace qvr::cli {
 namespace {
 
 struct CapacityCmdOptions {
-    std::string hardware, trace, design = "qvr", json;
+    std::string hardware, trace, design = "qvr", json, scene;
+    float lod_px = 1.0f;
     CapacityOptions model;
 };
+
+// With --scene, the layers' triangles as the renderer draws them at the trace's head poses (what
+// qvr run's prediction charges); without, the trace's ring counts.
+Expected<CapacityLayerTriangles> drawnTriangles(const CapacityCmdOptions& o,
+                                                const WorkloadTrace& trace) {
+    if (o.scene.empty())
+        return CapacityLayerTriangles{};
+    auto scene = loadScene(o.scene);
+    if (!scene)
+        return makeError("--scene: " + scene.error());
+    auto list = std::make_shared<DrawList>(buildDrawList(*scene));
+    if (o.lod_px > 0.0f)
+        buildLods(*list, *scene);
+    auto heads = std::make_shared<std::vector<Pose>>();
+    for (const WorkloadFrame& f : trace.frames)
+        heads->push_back(f.head);
+    return experiment::drawnLayerTriangles(
+        std::move(list), trace.header.profile, o.lod_px, true, [heads](int64_t frame) {
+            return (*heads)[size_t(std::clamp<int64_t>(frame, 0, int64_t(heads->size()) - 1))];
+        });
+}
 
 int runCapacity(CapacityCmdOptions& o) {
     auto design = parseDesign(o.design, DesignScope::Runtime);
@@ -28,7 +54,17 @@ int runCapacity(CapacityCmdOptions& o) {
     }
     o.model.design = design->design;
     o.model.fixed_e1_deg = design->fixed_e1_deg;
-    auto r = planCapacity(o.hardware, o.trace, o.model);
+    auto in = loadCapacityInputs(o.hardware, o.trace);
+    if (!in) {
+        std::fprintf(stderr, "qvr capacity: %s\n", in.error().c_str());
+        return 2;
+    }
+    auto triangles = drawnTriangles(o, in->trace);
+    if (!triangles) {
+        std::fprintf(stderr, "qvr capacity: %s\n", triangles.error().c_str());
+        return 2;
+    }
+    auto r = predictCapacity(in->trace, in->costs, o.model, *triangles);
     if (!r) {
         std::fprintf(stderr, "qvr capacity: %s\n", r.error().c_str());
         return 2;
@@ -55,6 +91,11 @@ static Registered registerCapacity(CLI::App& app) {
     cmd->add_option("--target-fps", o->model.target_fps, "Every headset's frame-rate floor")
         ->required()
         ->check(finiteRange(0.1, 1000.0));
+    cmd->add_option("--scene", o->scene,
+                    "The workload's scene: count the triangles each layer draws at its poses "
+                    "(level of detail, holes), as qvr run's prediction does (default: the trace's "
+                    "ring counts)");
+    addLodOption(cmd, o->lod_px);
     cmd->add_option("--design", o->design, "Runtime design (qvr, ffr, fixed:E, remote, …)")
         ->capture_default_str();
     cmd->add_option("--net", o->model.net, "Each headset's link (qvr run --net)")

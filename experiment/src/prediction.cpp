@@ -17,6 +17,7 @@
 #include "qvr/render/draw_list.h"
 #include "qvr/render/renderer.h"
 #include "qvr/runtime/workload_probe.h"
+#include "qvr/sim/capacity.h"
 #include "qvr/sim/network.h"
 #include "qvr/sim/simulator.h"
 #include "qvr/workload/trace_io.h"
@@ -130,14 +131,22 @@ ModelSettings modelSettings(const RunOptions& plan) {
     s.warmup_frames = plan.warmup_frames;  // the same frames left out as measured
     s.record_scanout = plan.video;         // every design's headset copies its scan-out
     s.headset_share = plan.headset_share;
+    s.headsets = plan.headsets;
     return s;
 }
 
 namespace {
 
-DesignMetrics metricsOf(const RuntimeSummary& s) {
-    return {s.fps_mean,    s.mtp_ms_mean,          s.mtp_ms_p99,         s.bytes_per_frame_mean,
-            s.e1_deg_mean, s.headset_busy_ms_mean, s.server_busy_ms_mean};
+// `server_factor`: the model ran the server N times slower for N headsets; its time per
+// headset-frame, what the run measures, is 1/N of the modelled frame's.
+DesignMetrics metricsOf(const RuntimeSummary& s, double server_factor = 1.0) {
+    return {s.fps_mean,
+            s.mtp_ms_mean,
+            s.mtp_ms_p99,
+            s.bytes_per_frame_mean,
+            s.e1_deg_mean,
+            s.headset_busy_ms_mean,
+            s.server_busy_ms_mean / server_factor};
 }
 
 // One pass of the calibrated runtime model with `costs` on the run's link (none: the model
@@ -180,12 +189,14 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     p.speed = inputs.speed;
     // A quota of `share` of the core per period: the headset's work takes 1 / share the wall
     // time (docs/MODEL.md, the headset's share).
-    const RuntimeCosts costs = settings.headset_share < 1.0
-                                   ? calibrated.atSpeed(1.0 / settings.headset_share, 1.0)
-                                   : calibrated;
+    // With N headsets on one server the server serves each 1/N of its time, and the headsets
+    // share the headset's core (sim/capacity.h).
+    const CapacityFactors f = capacityFactors(settings.headsets, settings.headset_share, true);
+    const RuntimeCosts costs =
+        f.headset != 1.0 || f.server != 1.0 ? calibrated.atSpeed(f.headset, f.server) : calibrated;
     if (auto r = runModel(trace, sd, fixed_e1, costs, settings, inputs)) {
-        p.calibrated = RuntimePrediction{metricsOf(r->summary), r->summary.t_remote_ms_mean,
-                                         r->summary.frames_reused};
+        p.calibrated = RuntimePrediction{metricsOf(r->summary, f.server),
+                                         r->summary.t_remote_ms_mean, r->summary.frames_reused};
         if (frames)
             *frames = std::move(r->frames);
         // With probes: the same model with the costs at the probes' speed, beside it.
@@ -193,7 +204,7 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
             if (auto at = runModel(trace, sd, fixed_e1,
                                    costs.atSpeed(inputs.speed->headset, inputs.speed->server),
                                    settings, inputs))
-                p.at_probe_speed = metricsOf(at->summary);
+                p.at_probe_speed = metricsOf(at->summary, f.server);
     }
     if (paper_net) {
         auto sim_link = makeLink(*paper_net, settings.seed);
@@ -211,33 +222,40 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     return p;
 }
 
-namespace {
-
-// The layers' triangles as the renderer draws them (level of detail, the periphery's holes) for
-// the run's poses and the plan the model chose, counted off the clock.
-LayerTrianglesFn makeLayerTriangles(const RunOptions& plan, const HmdProfile& profile,
-                                    const runtime::HeadsetInputs& inputs,
-                                    std::shared_ptr<const DrawList> draw_list) {
+LayerTrianglesFn drawnLayerTriangles(std::shared_ptr<const DrawList> draw_list,
+                                     const HmdProfile& profile, float lod_px, bool holes,
+                                     std::function<Pose(int64_t frame)> head_pose_at) {
     // By (frame, e1 in 1/1000°, eye, kind): LIWC revisits the same candidates.
     auto cache = std::make_shared<std::map<std::tuple<int64_t, int64_t, int, int>, double>>();
-    const LayerHoles server_holes{.enabled = !plan.no_holes};
-    const float lod_px = plan.lod_px;
-    const PoseTrace* motion = &inputs.traces.motion;
+    const LayerHoles server_holes{.enabled = holes};
     return [=](int64_t frame, const LayerPlan& layer_plan, int eye, int kind) {
         const auto key = std::make_tuple(
             frame, static_cast<int64_t>(std::llround(layer_plan.e1_deg * 1000.0)), eye, kind);
         if (auto it = cache->find(key); it != cache->end())
             return it->second;
-        const double content_ms = contentTimeMs(frame, profile.refresh_hz);
         const LayerKind lk = kind == 0   ? LayerKind::kFovea
                              : kind == 1 ? LayerKind::kMiddle
                                          : LayerKind::kOuter;
         const double tris = double(layerTriangles(
-            *draw_list, profile, layer_plan, poseAt(*motion, content_ms), static_cast<Eye>(eye), lk,
-            lod_px, CameraOptions{}, lk == LayerKind::kFovea ? LayerHoles{} : server_holes));
+            *draw_list, profile, layer_plan, head_pose_at(frame), static_cast<Eye>(eye), lk, lod_px,
+            CameraOptions{}, lk == LayerKind::kFovea ? LayerHoles{} : server_holes));
         cache->emplace(key, tris);
         return tris;
     };
+}
+
+namespace {
+
+// The layers' triangles for the run's poses and the plan the model chose.
+LayerTrianglesFn makeLayerTriangles(const RunOptions& plan, const HmdProfile& profile,
+                                    const runtime::HeadsetInputs& inputs,
+                                    std::shared_ptr<const DrawList> draw_list) {
+    const PoseTrace* motion = &inputs.traces.motion;
+    const double refresh_hz = profile.refresh_hz;
+    return drawnLayerTriangles(std::move(draw_list), profile, plan.lod_px, !plan.no_holes,
+                               [motion, refresh_hz](int64_t frame) {
+                                   return poseAt(*motion, contentTimeMs(frame, refresh_hz));
+                               });
 }
 
 // The fragments a design's fovea pass shaded at frame k, as its own run's headset counted them

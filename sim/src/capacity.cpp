@@ -27,7 +27,8 @@ int headsetsAtTarget(const std::vector<CapacityPoint>& points, double target_fps
 }
 
 Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const RuntimeCosts& costs,
-                                         const CapacityOptions& o) {
+                                         const CapacityOptions& o,
+                                         const CapacityLayerTriangles& layer_triangles) {
     if (o.target_fps <= 0.0)
         return makeError("the target FPS must be positive");
     CapacityResult result;
@@ -49,6 +50,7 @@ Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const Runti
         cfg.wait_limit_ms = o.wait_limit_ms;
         cfg.frames = o.frames;
         cfg.warmup_frames = o.warmup_frames;
+        cfg.layer_triangles = layer_triangles;
         p.summary = simulateRuntime(trace, cfg, **link).summary;
         // The summary's server time is the N-fold one: each headset's own share of it is 1/N.
         p.server_utilisation =
@@ -60,8 +62,8 @@ Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const Runti
     return result;
 }
 
-Expected<CapacityResult> planCapacity(const std::string& hardware_path,
-                                      const std::string& trace_path, const CapacityOptions& o) {
+Expected<CapacityInputs> loadCapacityInputs(const std::string& hardware_path,
+                                            const std::string& trace_path) {
     auto hw = loadHardwareConfig(hardware_path, 500.0);
     if (!hw)
         return makeError("--hardware: " + hw.error());
@@ -73,7 +75,7 @@ Expected<CapacityResult> planCapacity(const std::string& hardware_path,
         return makeError("--trace: " + trace.error());
     if (trace->frames.empty())
         return makeError("--trace: the workload has no frames");
-    return predictCapacity(*trace, hw->runtime, o);
+    return CapacityInputs{std::move(*trace), hw->runtime};
 }
 
 std::string capacityText(const CapacityResult& r, const CapacityOptions& o) {

@@ -294,6 +294,21 @@ for args in "--trace x --target-fps 30" \
         fail "capacity $args exits 2" "exit $rc"
     fi
 done
+# --scene counts the layers' drawn triangles at the trace's poses: a scene that cannot load exits 2
+# naming the option; one that loads gives a count.
+expect_error "capacity --scene /nonexistent.glb" capacity --hardware "$tmp/rt.toml" \
+    --trace "$tmp/good.jsonl" --target-fps 5 --max-headsets 2 --frames 20 --scene /nonexistent.glb
+if ! grep -q -- "--scene" "$tmp/bad_err.txt"; then
+    fail "capacity --scene /nonexistent.glb names --scene" "$(head -c 200 "$tmp/bad_err.txt")"
+fi
+if run_ok "capacity --scene builtin:room" capacity --hardware "$tmp/rt.toml" \
+    --trace "$tmp/good.jsonl" --target-fps 5 --max-headsets 2 --frames 20 --scene builtin:room; then
+    if grep -q "headsets per server at 5 FPS" "$tmp/out.json"; then
+        pass "capacity --scene builtin:room gives a count"
+    else
+        fail "capacity --scene builtin:room gives a count" "$(head -c 300 "$tmp/out.json")"
+    fi
+fi
 expect_error "validate --depths 3" validate --depths 3 --dry-run --out "$tmp/val"
 expect_error "validate --frames 2" validate --frames 2 --dry-run --out "$tmp/val"
 expect_error "validate --reps 0" validate --reps 0 --dry-run --out "$tmp/val"

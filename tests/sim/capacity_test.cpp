@@ -97,6 +97,27 @@ TEST(PredictCapacity, ServerBoundRemoteFollowsOneOverN) {
     EXPECT_EQ(r->headsets, 3);
 }
 
+TEST(PredictCapacity, ChargesTheTrianglesTheCallerSaysEachLayerDraws) {
+    // 1 ms per thousand triangles and nothing else on the server. On the flat trace's rings
+    // remote's frame is light enough for several headsets at 20 FPS. Counted as drawn (qvr
+    // capacity --scene) at 20,000 triangles an eye it is 40 ms a frame: 25 FPS for one
+    // headset, 12.5 for two.
+    RuntimeCosts c = serverBoundCosts(0.0);
+    c.server_render = {0.0, 0.0, 1.0};
+    const auto rings = predictCapacity(flatTrace(120), c, remoteOptions(20.0));
+    ASSERT_TRUE(rings) << rings.error();
+    EXPECT_GE(rings->headsets, 3);
+    int calls = 0;
+    const auto drawn =
+        predictCapacity(flatTrace(120), c, remoteOptions(20.0),
+                        [&calls](int64_t, const LayerPlan&, int, int) { return ++calls, 20000.0; });
+    ASSERT_TRUE(drawn) << drawn.error();
+    EXPECT_GT(calls, 0);
+    EXPECT_EQ(drawn->headsets, 1);
+    ASSERT_FALSE(drawn->points.empty());
+    EXPECT_NEAR(drawn->points[0].summary.server_busy_ms_mean, 40.0, 1e-6);
+}
+
 TEST(PredictCapacity, StopsAfterTwoCountsBelowTheTarget) {
     const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), remoteOptions(60.0));
     ASSERT_TRUE(r) << r.error();

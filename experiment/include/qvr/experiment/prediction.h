@@ -8,12 +8,15 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "qvr/core/design.h"
+#include "qvr/core/pose.h"
 #include "qvr/experiment/design_runs.h"
+#include "qvr/render/draw_list.h"
 #include "qvr/sim/hardware.h"
 #include "qvr/sim/runtime_model.h"
 #include "qvr/workload/workload.h"
@@ -81,6 +84,13 @@ using LayerTrianglesFn =
     std::function<double(int64_t frame, const LayerPlan& plan, int eye, int kind)>;
 using FoveaFragmentsFn = std::function<double(int64_t frame, const LayerPlan& plan, int eye)>;
 
+// The triangles each layer draws as the renderer draws them (level of detail `lod_px`, the
+// periphery's holes unless `holes` is false) at frame k's head pose, counted off the clock: what
+// qvr run's prediction and `qvr capacity --scene` charge the fovea and the server.
+LayerTrianglesFn drawnLayerTriangles(std::shared_ptr<const DrawList> draw_list,
+                                     const HmdProfile& profile, float lod_px, bool holes,
+                                     std::function<Pose(int64_t frame)> head_pose_at);
+
 // The run's knobs the models replay.
 struct ModelSettings {
     std::string net;  // the run's --net spec
@@ -92,6 +102,9 @@ struct ModelSettings {
     // The headset's CFS share of its core (--headset-share): its busy time stretches by 1 / share
     // in wall time, so the model takes the headset's costs at that speed.
     double headset_share = 1.0;
+    // Headsets on the one server (qvr run --headsets), all on the headset's core: the model runs
+    // one of them with the capacity model's factors (sim/capacity.h capacityFactors).
+    int headsets = 1;
 };
 ModelSettings modelSettings(const RunOptions& plan);
 

@@ -59,16 +59,24 @@ struct CapacityResult {
 // point below the target ends the count).
 int headsetsAtTarget(const std::vector<CapacityPoint>& points, double target_fps);
 
+// The triangles each layer draws at frame k (RuntimeSimConfig::layer_triangles); empty: the
+// trace's ring counts.
+using CapacityLayerTriangles = decltype(RuntimeSimConfig::layer_triangles);
+
 // Every headset count from 1 to max_headsets predicted on `trace` with `costs` (a calibration's
 // [runtime]); stops after the first two counts below the target unless every_count.
 Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const RuntimeCosts& costs,
-                                         const CapacityOptions& options);
+                                         const CapacityOptions& options,
+                                         const CapacityLayerTriangles& layer_triangles = {});
 
-// predictCapacity with a calibration file (qvr calibrate --out; its [runtime] pipeline) and a
-// workload trace file (a qvr run's workload.jsonl, data/workloads/*.jsonl).
-Expected<CapacityResult> planCapacity(const std::string& hardware_path,
-                                      const std::string& trace_path,
-                                      const CapacityOptions& options);
+// The calibration file (qvr calibrate --out; its [runtime] pipeline) and the workload trace file
+// (a qvr run's workload.jsonl, data/workloads/*.jsonl) predictCapacity takes.
+struct CapacityInputs {
+    WorkloadTrace trace;
+    RuntimeCosts costs;
+};
+Expected<CapacityInputs> loadCapacityInputs(const std::string& hardware_path,
+                                            const std::string& trace_path);
 
 // The result for the console: a line per count and the count at the target.
 std::string capacityText(const CapacityResult& result, const CapacityOptions& options);
