@@ -194,8 +194,6 @@ std::unique_ptr<SpeedProbe> makeSpeedProbe(const RunOptions& plan, const Runtime
         note =
             "the calibration's speed reference was taken on another machine, scene, profile, "
             "codec or level of detail than this run's: no speed probes";
-    else if (plan.headset_share < 1.0)
-        note = "--headset-share: a probe would run under the headset's quota: no speed probes";
     else if (auto made = SpeedProbe::make(runCalibrateOptions(plan)); !made)
         note = "no speed probes: " + made.error();
     else
@@ -269,6 +267,13 @@ std::optional<RunError> DesignRunner::start(const RuntimeCosts& calibrated) {
     if (auto* error = std::get_if<RunError>(&server))
         return *error;
     m_server.emplace(std::move(std::get<ServerProcess>(server)));
+    // The machine's speed before each design and after the last, on the headset's core while
+    // the server waits between sessions: the run reports how far the probes moved, warns when
+    // they moved much, and predicts each design a second time with its costs at the ratio of the
+    // probes around it to the calibration's reference (docs/MODEL.md §11 says why it is not the
+    // prediction). Its process is made before this one joins the headset's CPU share group, so
+    // it measures the machine, not the quota (the model applies the share).
+    m_speed_probe = makeSpeedProbe(m_plan, calibrated, m_m.speed_note);
     // The headset's share of its core (CFS quota on this process; the server child was made
     // before, so it keeps its whole core).
     if (m_plan.headset_share < 1.0) {
@@ -297,12 +302,6 @@ std::optional<RunError> DesignRunner::start(const RuntimeCosts& calibrated) {
             std::fprintf(stderr, "qvr run: %s (the main thread runs unpinned)\n",
                          m_main_pin->error().c_str());
     }
-    // The machine's speed before each design and after the last, on the headset's core while
-    // the server waits between sessions: the run reports how far the probes moved, warns when
-    // they moved much, and predicts each design a second time with its costs at the ratio of the
-    // probes around it to the calibration's reference (docs/MODEL.md §11 says why
-    // it is not the prediction).
-    m_speed_probe = makeSpeedProbe(m_plan, calibrated, m_m.speed_note);
     m_m.recorder =
         std::make_unique<ScanoutRecorder>(m_profile, m_plan.video_max_frames, m_plan.fovea_border);
     if (m_plan.quality_every > 0)
