@@ -1,71 +1,102 @@
 #!/usr/bin/env bash
 # Validates `qvr capacity` against `qvr run --headsets N` for N = 1…MAX on this machine: runs the
 # qvr design with N headsets (the same motion and gaze for all, so their FPS differ only by the
-# server's sharing), predicts the same counts with the run's calibration and the N = 1 run's
-# workload, and prints per N the measured mean FPS per headset beside the predicted one, the
-# error, and the headsets per server each says at the target FPS.
+# server's sharing) REPEATS times, each round in a rotated order of N (the host's speed drifts by
+# 20–40% over minutes: one run per N is not a measurement), predicts the same counts with the
+# first round's calibration and N = 1 workload, and prints per N the median over the rounds of the
+# mean FPS per headset, each round's, the predicted one, the error, the run's own prediction (qvr
+# run predicts N headsets with the same factors) and the headsets per server each says at the
+# target FPS.
 #
 # Two cores cannot show a real deployment: the N headsets share core 0 (each limited to
-# --headset-share of it, so N × share ≤ 1 keeps them from taking each other's time; beyond that
-# the model charges max(1/share, N)), the server renders on one core with llvmpipe rather than a
-# GPU, and the link is loopback through the emulator. What it does show is the server's one
-# render thread divided among N sessions, which is what the capacity model predicts.
+# --headset-share of it, each in its own CPU share group, so N × share ≤ 1 keeps them from taking
+# each other's time; beyond that the model charges max(1/share, N)), the server renders on one
+# core with llvmpipe rather than a GPU, and the link is loopback through the emulator. What it
+# does show is the server's one render thread divided among N sessions, which is what the
+# capacity model predicts.
 #
 # Usage: scripts/validate_capacity.sh QVR OUT_DIR [MAX_HEADSETS=4] [SHARE=0.25] [FRAMES=90]
-#        [TARGET_FPS=5] [extra qvr run options, e.g. --profile small --hardware FILE]
+#        [TARGET_FPS=5] [REPEATS=3] [extra qvr run options, e.g. --profile small]
 set -euo pipefail
-qvr=${1:?usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [run options]}
-out=${2:?usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [run options]}
+usage="usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [REPEATS] [options]"
+qvr=${1:?$usage}
+out=${2:?$usage}
 max=${3:-4}
 share=${4:-0.25}
 frames=${5:-90}
 target=${6:-5}
-shift $(($# < 6 ? $# : 6))
+repeats=${7:-3}
+shift $(($# < 7 ? $# : 7))
 mkdir -p "$out"
-for n in $(seq 1 "$max"); do
-    nice -n 5 "$qvr" run --headsets "$n" --identical-workloads --designs qvr --frames "$frames" \
-        --headset-share "$share" --no-video --quality-every 0 --quiet --out "$out/h$n" "$@" \
-        >"$out/h$n.log" 2>&1 || { echo "validate_capacity: run N=$n failed (see $out/h$n.log)" >&2; exit 1; }
+for r in $(seq 1 "$repeats"); do
+    mkdir -p "$out/r$r"
+    for k in $(seq 0 $((max - 1))); do
+        n=$(((k + r - 1) % max + 1))
+        dir="$out/r$r/h$n"
+        nice -n 5 "$qvr" run --headsets "$n" --identical-workloads --designs qvr \
+            --frames "$frames" --headset-share "$share" --no-video --quality-every 0 --quiet \
+            --out "$dir" "$@" >"$dir.log" 2>&1 ||
+            { echo "validate_capacity: run N=$n failed (see $dir.log)" >&2; exit 1; }
+    done
 done
-cal=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['calibration']['path'])" \
-    "$out/h1/summary.json")
-net=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['net'])" "$out/h1/summary.json")
-nice -n 5 "$qvr" capacity --hardware "$cal" --trace "$out/h1/workload.jsonl" --net "$net" \
+first="$out/r1/h1/summary.json"
+field() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$1)" "$first"; }
+cal=$(field "['calibration']['path']")
+net=$(field "['net']")
+scene=$(field "['scene']")
+lod=$(python3 -c "import json,re,sys; m=re.search(r'--lod-px (\S+)', json.load(open(sys.argv[1]))['command']); print(m.group(1) if m else 1)" "$first")
+nice -n 5 "$qvr" capacity --hardware "$cal" --trace "$out/r1/h1/workload.jsonl" --net "$net" \
+    --scene "$scene" --lod-px "$lod" \
     --target-fps "$target" --headset-share "$share" --headsets-share-one-core \
     --max-headsets "$max" --every-count --frames "$frames" --json "$out/capacity.json" \
     >"$out/capacity.log"
-python3 - "$out" "$max" "$target" <<'EOF'
-import json, sys
-out, n_max, target = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
+python3 - "$out" "$max" "$target" "$repeats" <<'EOF'
+import json, statistics, sys
+out, n_max, target, repeats = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
 pred = {p["headsets"]: p for p in json.load(open(f"{out}/capacity.json"))["points"]}
-rows, measured_cap, predicted_cap, worst = [], 0, 0, 0.0
-for n in range(1, n_max + 1):
-    s = json.load(open(f"{out}/h{n}/summary.json"))
+
+
+def reading(path):
+    s = json.load(open(path))
     if "headsets" not in s:  # one headset's summary keeps its keys: the qvr design's
         q = s["designs"]["qvr"]
         s["headsets"] = [q]
         s["server_ms_per_headset_frame"] = q.get("server_busy_ms_mean")
     fps = [h["fps_mean"] for h in s["headsets"] if "fps_mean" in h]
-    m = sum(fps) / len(fps) if fps else 0.0
-    p = pred[n]["fps_mean"]
+    return {"fps": sum(fps) / len(fps) if fps else 0.0, "fps_min": min(fps, default=0.0),
+            "jain": s.get("jain_fairness_fps", 1.0),
+            "server_ms": s.get("server_ms_per_headset_frame") or float("nan"),
+            "own": s["designs"]["qvr"].get("predicted", {}).get("fps_mean", float("nan"))}
+
+
+rows, measured_cap, predicted_cap, worst = [], 0, 0, 0.0
+for n in range(1, n_max + 1):
+    takes = [reading(f"{out}/r{r}/h{n}/summary.json") for r in range(1, repeats + 1)]
+    med = {k: statistics.median(t[k] for t in takes) for k in takes[0]}
+    p, m = pred[n]["fps_mean"], med["fps"]
     err = 100.0 * (p - m) / m if m > 0 else float("nan")
     worst = max(worst, abs(err))
-    if min(fps, default=0.0) >= target and measured_cap == n - 1:
+    if med["fps_min"] >= target and measured_cap == n - 1:
         measured_cap = n
     if p >= target and predicted_cap == n - 1:
         predicted_cap = n
-    rows.append((n, m, min(fps, default=0.0), p, err, s.get("jain_fairness_fps", 1.0),
-                 s.get("server_ms_per_headset_frame"), pred[n]["server_ms_per_headset_frame"]))
-print("N  measured FPS/headset (min)  predicted  error   Jain   server ms/headset-frame meas/pred")
-for n, m, lo, p, err, jain, sm, sp in rows:
-    sm_text = f"{sm:.1f}" if sm is not None else "-"
-    print(f"{n}  {m:8.2f} ({lo:6.2f})          {p:8.2f}  {err:+6.1f}%  {jain:.3f}  {sm_text} / {sp:.1f}")
+    rows.append({"headsets": n, "measured_fps": m, "measured_fps_takes": [t["fps"] for t in takes],
+                 "measured_fps_min": med["fps_min"], "predicted_fps": p, "error_pct": err,
+                 "jain_fairness_fps": med["jain"], "server_ms_measured": med["server_ms"],
+                 "server_ms_predicted": pred[n]["server_ms_per_headset_frame"],
+                 "run_predicted_fps": med["own"]})
+print(f"N  measured FPS/headset: median [each round]   predicted  error   Jain   "
+      "server ms/headset-frame meas/pred   run's own prediction")
+for r in rows:
+    m, own = r["measured_fps"], r["run_predicted_fps"]
+    takes = ", ".join(f"{x:.2f}" for x in r["measured_fps_takes"])
+    own_text = f"{own:.2f} ({100.0 * (own - m) / m:+.1f}%)" if own == own and m > 0 else "-"
+    print(f"{r['headsets']}  {m:6.2f} [{takes}]   {r['predicted_fps']:6.2f}  "
+          f"{r['error_pct']:+6.1f}%  {r['jain_fairness_fps']:.3f}  "
+          f"{r['server_ms_measured']:.1f} / {r['server_ms_predicted']:.1f}   {own_text}")
 print(f"headsets per server at {target:g} FPS: measured {measured_cap}, predicted {predicted_cap}")
 print(f"largest FPS error {worst:.1f}% (criterion: within 15%)")
-json.dump({"rows": [dict(zip(["headsets", "measured_fps", "measured_fps_min", "predicted_fps",
-                              "error_pct", "jain_fairness_fps", "server_ms_measured",
-                              "server_ms_predicted"], r)) for r in rows],
-           "target_fps": target, "measured_headsets": measured_cap,
-           "predicted_headsets": predicted_cap, "max_error_pct": worst},
-          open(f"{out}/validation.json", "w"), indent=2)
+json.dump({"rows": rows, "repeats": repeats, "target_fps": target,
+           "measured_headsets": measured_cap, "predicted_headsets": predicted_cap,
+           "max_error_pct": worst}, open(f"{out}/validation.json", "w"), indent=2)
 EOF
