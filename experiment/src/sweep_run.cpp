@@ -84,18 +84,16 @@ std::optional<double> ratioOver(const ByDesign& by, const std::string& a, const 
     return *y <= 0.0 ? INFINITY : *x / *y;
 }
 
-// The fixed design (ffr is fixed:5) with the highest FPS in the condition's first take. The
-// display's pacing makes equal rates common (two designs showing 89 frames over the same
-// vsyncs): a tie goes to the lower MTP p99, then to the name, whatever order the runs came in.
+// The fixed design (ffr is fixed:5) with the highest FPS in the condition's first take
+// (beatsForBestFixed: ties to the lower MTP p99, then the name).
 std::pair<std::string, double> bestFixedOf(const std::vector<SweepRow>& rows, int condition) {
     const DesignReading* best = nullptr;
     for (const SweepRow& r : rows) {
         if (r.condition != condition || r.take != 0 || !isFixedLabel(r.reading.design))
             continue;
         const DesignReading& d = r.reading;
-        if (!best || d.freshFps() > best->freshFps() ||
-            (d.freshFps() == best->freshFps() &&
-             std::tie(d.mtp_ms_p99, d.design) < std::tie(best->mtp_ms_p99, best->design)))
+        if (!best || beatsForBestFixed(d.freshFps(), d.mtp_ms_p99, d.design, best->freshFps(),
+                                       best->mtp_ms_p99, best->design))
             best = &d;
     }
     if (!best || best->freshFps() <= 0.0)

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace qvr::experiment {
 namespace {
 
@@ -152,6 +154,36 @@ TEST(BestFixed, TheFastestFixedDesignAndTheAdaptiveOnesOverIt) {
     EXPECT_EQ(bf->fps_over_best[1].first, "sw");
     EXPECT_DOUBLE_EQ(bf->fps_over_best[1].second, 0.5);
     EXPECT_FALSE(bestFixed({design(Design::Qvr, 0.0, 60.0, 0.0)}));
+}
+
+// As qvr sweep judges: a fixed design whose layers stopped coming re-warped an old periphery at
+// full rate (seed 2027 c13's fixed:2 "ran" at 55.7 FPS with 100 of 100 frames reused); the best
+// fixed e1 is the one showing the most frames with their own layers, a tie going to the lower
+// MTP p99, and a ratio over a fixed design with none of its own is infinite ("inf" in JSON).
+TEST(BestFixed, ChoosesByFramesWithTheirOwnLayersAndBreaksATieByMtp) {
+    std::vector<DesignResult> designs = {
+        design(Design::Fixed, 2.0, 55.7, 0.0), design(Design::Fixed, 8.0, 30.0, 0.0),
+        design(Design::Fixed, 12.0, 30.0, 0.0), design(Design::Qvr, 0.0, 33.0, 0.0)};
+    designs[0].summary.frames = 100;
+    designs[0].summary.frames_reused = 100;
+    designs[1].summary.mtp_ms_p99 = 90.0;
+    designs[2].summary.mtp_ms_p99 = 80.0;
+    designs[3].summary.frames = 100;
+    designs[3].summary.frames_reused = 10;  // 29.7 FPS with its own layers
+    auto bf = bestFixed(designs);
+    ASSERT_TRUE(bf);
+    EXPECT_EQ(bf->design, "fixed:12");
+    EXPECT_DOUBLE_EQ(bf->fps_mean, 30.0);
+    ASSERT_EQ(bf->fps_over_best.size(), 1u);
+    EXPECT_DOUBLE_EQ(bf->fps_over_best[0].second, 0.99);
+    // The same runs in the other order: the same choice.
+    std::swap(designs[1], designs[2]);
+    EXPECT_EQ(bestFixed(designs)->design, "fixed:12");
+    // Only the stale one: qvr over it is infinite.
+    bf = bestFixed({designs[0], designs[3]});
+    ASSERT_TRUE(bf);
+    EXPECT_TRUE(std::isinf(bf->fps_over_best[0].second));
+    EXPECT_EQ(bestFixedJson(*bf)["qvr_fps_over_best_fixed"], "inf");
 }
 
 // A design whose layers stop arriving keeps its frame rate by re-warping an old periphery: the

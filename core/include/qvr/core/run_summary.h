@@ -6,6 +6,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
+#include <tuple>
 #include <vector>
 
 namespace qvr {
@@ -122,6 +124,17 @@ inline double ownLayersFps(double fps_mean, int frames, int frames_reused) {
         return fps_mean;
     const int reused = frames_reused < 0 ? 0 : frames_reused > frames ? frames : frames_reused;
     return fps_mean * double(frames - reused) / double(frames);
+}
+
+// Whether fixed design a beats b for "the best fixed e1": more frames a second with their own
+// layers; the display's pacing makes equal rates common (two designs showing 89 frames over the
+// same vsyncs), so a tie goes to the lower MTP p99, then to the name, whatever order they ran in.
+// `qvr sweep` and `qvr run`'s best_fixed both choose by it.
+inline bool beatsForBestFixed(double own_fps_a, double mtp_p99_a, const std::string& name_a,
+                              double own_fps_b, double mtp_p99_b, const std::string& name_b) {
+    if (own_fps_a != own_fps_b)
+        return own_fps_a > own_fps_b;
+    return std::tie(mtp_p99_a, name_a) < std::tie(mtp_p99_b, name_b);
 }
 
 }  // namespace qvr

@@ -88,14 +88,17 @@ RunOutcome runOutcome(const RunOptions& plan, const HmdProfile& profile,
                       const CalibrationChoice& calibration, const RunMeasurement& measurement,
                       const RunPrediction& prediction, DisplayVideo video, double run_seconds);
 
-// The fixed design run (ffr is fixed:5) with the best displayed FPS, in hindsight, and the
-// adaptive designs' (qvr, sw) FPS over it.
+// The fixed design run (ffr is fixed:5) with the most frames a second shown with their own layers
+// (core/run_summary.h ownLayersFps, beatsForBestFixed), in hindsight, and the adaptive designs'
+// (qvr, sw) such FPS over it (infinite over a fixed design that showed none of its own).
 struct BestFixed {
     std::string design;
     double e1_deg = 0.0, fps_mean = 0.0, mtp_ms_p99 = 0.0;
     std::vector<std::pair<std::string, double>> fps_over_best;  // adaptive design → ratio
 };
 std::optional<BestFixed> bestFixed(const std::vector<DesignResult>& designs);
+// summary.json's "best_fixed".
+nlohmann::json bestFixedJson(const BestFixed& best);
 
 // The headline ratios: measured here, the paper's, the paper-hardware model's.
 struct HeadlineRatios {
