@@ -39,6 +39,8 @@ FrameSummarizer::FrameSummarizer(int warmup_frames, size_t exact_mtp_frames)
 }
 
 void FrameSummarizer::add(const FrameSample& f) {
+    const bool new_layers = f.shown_frame > m_newest_shown;
+    m_newest_shown = std::max(m_newest_shown, f.shown_frame);
     if (!m_startup_done) {
         // The first m_warmup frames, and then every frame that still shows none of the
         // server's layers (RunStats::warmup_frames).
@@ -55,10 +57,10 @@ void FrameSummarizer::add(const FrameSample& f) {
             m_s.startup_mtp_ms_max = std::max(m_s.startup_mtp_ms_max, s.mtp_ms);
         std::vector<FrameSample>().swap(m_startup);
     }
-    count(f);
+    count(f, new_layers);
 }
 
-void FrameSummarizer::count(const FrameSample& f) {
+void FrameSummarizer::count(const FrameSample& f, bool new_layers) {
     if (m_s.frames == 0)
         m_first_pose_ms = f.pose_ms;
     m_last_frame_display_ms = f.display_ms;
@@ -71,6 +73,8 @@ void FrameSummarizer::count(const FrameSample& f) {
     }
     if (f.reused)
         ++m_s.frames_reused;
+    if (new_layers)
+        ++m_s.frames_new_layers;
     if (f.fallback_local)
         m_s.frames_fallback_local += 1;
     m_mtp_sum += f.mtp_ms;
@@ -98,6 +102,7 @@ void FrameSummarizer::count(const FrameSample& f) {
     if (f.remote_requested) {
         m_t_remote += f.t_remote_ms;
         ++m_remote_frames;
+        ++m_s.frames_remote_requested;
     }
 }
 

@@ -41,6 +41,10 @@ std::optional<std::string> reusedPeripheryWarning(const runtime::DesignSummary& 
         s.design, s.frames_reused, s.frames, s.fps_mean, own);
 }
 
+bool showedNoNewLayers(const runtime::DesignSummary& s) {
+    return !s.startup_unfinished && s.frames_remote_requested > 0 && s.frames_new_layers == 0;
+}
+
 namespace {
 
 // Progress on a terminal while a design runs (design, frame k of N, FPS so far), redrawn at
@@ -521,6 +525,14 @@ void DesignRunner::keepRun(const DesignSpec& spec, HeadsetResult result,
         s.frames_displayed, s.frames_reused);
     if (const auto warning = reusedPeripheryWarning(s))
         fmt::print("  {}\n", *warning);
+    if (showedNoNewLayers(s)) {
+        m_m.stale_only.push_back(label);
+        fmt::print(
+            "  warning: {}: none of its {} counted frames showed server layers newer than its "
+            "start-up's: it re-warped the same old periphery throughout (summary.json "
+            "frames_new_layers)\n",
+            s.design, s.frames);
+    }
     if (s.startup_unfinished && m_plan.warmup_frames > 0) {
         m_m.never_shown.push_back(label);
         fmt::print(

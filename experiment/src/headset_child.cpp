@@ -47,6 +47,8 @@ void visitSentFields(Summary& s, Visit visit) {
     visit("frames", s.frames);
     visit("frames_displayed", s.frames_displayed);
     visit("frames_reused", s.frames_reused);
+    visit("frames_new_layers", s.frames_new_layers);
+    visit("frames_remote_requested", s.frames_remote_requested);
     visit("fps_mean", s.fps_mean);
     visit("mtp_ms_mean", s.mtp_ms_mean);
     visit("mtp_ms_p99", s.mtp_ms_p99);

@@ -109,6 +109,14 @@ int runExitStatus(const RunOutcome& o, const std::string& out) {
                      fmt::format("{}", fmt::join(o.never_shown, ", ")).c_str(), out.c_str());
         return 1;
     }
+    if (!o.stale_only.empty()) {
+        std::fprintf(stderr,
+                     "qvr run: %s showed no server layers newer than its start-up's in its "
+                     "counted frames (summary.json frames_new_layers 0); wrote what was measured "
+                     "to %s\n",
+                     fmt::format("{}", fmt::join(o.stale_only, ", ")).c_str(), out.c_str());
+        return 1;
+    }
     return 0;
 }
 

@@ -131,6 +131,7 @@ RunOutcome runOutcome(const RunOptions& plan, const HmdProfile& profile,
     o.identical_workloads = plan.identical_workloads;
     o.headsets_by_design = m.headsets;
     o.never_shown = m.never_shown;
+    o.stale_only = m.stale_only;
     return o;
 }
 

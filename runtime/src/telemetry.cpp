@@ -23,6 +23,7 @@ FrameSample frameSample(const FrameTelemetry& t) {
     f.remote_requested = t.remote_requested;
     f.remote_shown = t.shown_frame >= 0;
     f.reused = t.reused;
+    f.shown_frame = t.shown_frame;
     f.fallback_local = t.fallback_local;
     return f;
 }

@@ -12,6 +12,7 @@ TEST(RunStatsJson, SpellsTheHeadlineStatisticsWithTheirValues) {
     RunStats s;
     s.frames = 120;
     s.frames_reused = 7;
+    s.frames_new_layers = 100;
     s.fps_mean = 71.5;
     s.mtp_ms_mean = 40.25;
     s.mtp_ms_p99 = 80.5;
@@ -19,9 +20,10 @@ TEST(RunStatsJson, SpellsTheHeadlineStatisticsWithTheirValues) {
     s.e1_deg_mean = 9.5;
     s.frames_displayed = 99;  // not a headline key: each summary adds what it has
     const nlohmann::json j = runStatsJson(s);
-    EXPECT_EQ(j.size(), 7u);
+    EXPECT_EQ(j.size(), 8u);
     EXPECT_EQ(j["frames"], 120);
     EXPECT_EQ(j["frames_reused"], 7);
+    EXPECT_EQ(j["frames_new_layers"], 100);
     EXPECT_EQ(j["fps_mean"], 71.5);
     EXPECT_EQ(j["mtp_ms_mean"], 40.25);
     EXPECT_EQ(j["mtp_ms_p99"], 80.5);

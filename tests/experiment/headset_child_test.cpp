@@ -14,6 +14,8 @@ TEST(HeadsetChildSummary, RoundTripsEverySentField) {
     s.frames = 300;
     s.frames_displayed = 290;
     s.frames_reused = 10;
+    s.frames_new_layers = 280;
+    s.frames_remote_requested = 299;
     s.fps_mean = 71.5;
     s.mtp_ms_mean = 18.25;
     s.mtp_ms_p99 = 31.0;
@@ -25,12 +27,14 @@ TEST(HeadsetChildSummary, RoundTripsEverySentField) {
     s.warmup_frames = 12;
     s.startup_unfinished = true;
     const nlohmann::json j = summaryToJson(s);
-    EXPECT_EQ(j.size(), 14u);
+    EXPECT_EQ(j.size(), 16u);
     const runtime::DesignSummary back = summaryFromJson(j);
     EXPECT_EQ(back.design, "qvr");
     EXPECT_EQ(back.frames, 300);
     EXPECT_EQ(back.frames_displayed, 290);
     EXPECT_EQ(back.frames_reused, 10);
+    EXPECT_EQ(back.frames_new_layers, 280);
+    EXPECT_EQ(back.frames_remote_requested, 299);
     EXPECT_DOUBLE_EQ(back.fps_mean, 71.5);
     EXPECT_DOUBLE_EQ(back.mtp_ms_mean, 18.25);
     EXPECT_DOUBLE_EQ(back.mtp_ms_p99, 31.0);

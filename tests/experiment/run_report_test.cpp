@@ -65,6 +65,7 @@ TEST(DesignJson, MeasuredPredictedErrorsAndSpeed) {
                                                 "e1_deg_mean",
                                                 "frames_displayed",
                                                 "frames_reused",
+                                                "frames_new_layers",
                                                 "frames",
                                                 "frames_fallback_local",
                                                 "t_local_ms_mean",
@@ -184,6 +185,25 @@ TEST(BestFixed, ChoosesByFramesWithTheirOwnLayersAndBreaksATieByMtp) {
     ASSERT_TRUE(bf);
     EXPECT_TRUE(std::isinf(bf->fps_over_best[0].second));
     EXPECT_EQ(bestFixedJson(*bf)["qvr_fps_over_best_fixed"], "inf");
+}
+
+// A design whose layers came in its start-up and none newer after: qvr run exits 1 for it (never
+// for one that showed late frames' layers, nor for one that asked for none).
+TEST(ShowedNoNewLayers, OnlyADesignThatAskedAndShowedNothingNew) {
+    runtime::DesignSummary s;
+    s.frames = 100;
+    s.frames_reused = 100;
+    s.frames_remote_requested = 100;
+    s.frames_new_layers = 0;
+    EXPECT_TRUE(showedNoNewLayers(s));
+    s.frames_new_layers = 40;  // remote on a slow server: every frame late, each new
+    EXPECT_FALSE(showedNoNewLayers(s));
+    s.frames_new_layers = 0;
+    s.frames_remote_requested = 0;  // local
+    EXPECT_FALSE(showedNoNewLayers(s));
+    s.frames_remote_requested = 100;
+    s.startup_unfinished = true;  // never showed one: its own exit message
+    EXPECT_FALSE(showedNoNewLayers(s));
 }
 
 // A design whose layers stop arriving keeps its frame rate by re-warping an old periphery: the

@@ -55,7 +55,7 @@ TEST(SessionOutputs, ClientSummaryHasTheSharedKeysAndItsOwn) {
     // The client reports its own key-frame requests; `qvr run` adds the transport's.
     EXPECT_EQ(j["key_frame_requests"], 4);
     EXPECT_EQ(j["capacity_refusals"], 0);  // refusals by a server at its frame-rate floor
-    EXPECT_EQ(j.size(), 36u);              // the keys `qvr client` writes
+    EXPECT_EQ(j.size(), 37u);              // the keys `qvr client` writes
 }
 
 TEST(SessionOutputs, ClientWritesTraceAndSummaryAndWarnsOfForgedControl) {

@@ -47,7 +47,7 @@ TEST(SimRun, WritesTheRuntimePipelinesFramesAndSummary) {
     EXPECT_EQ(j["pipeline_depth"], 1);
     EXPECT_EQ(j["requests_dropped"], 1);
     EXPECT_EQ(j["frames"], 2);
-    EXPECT_EQ(j.size(), 16u);
+    EXPECT_EQ(j.size(), 17u);
     std::ifstream csv(out / "frames.csv");
     int lines = 0;
     for (std::string line; std::getline(csv, line);)

@@ -38,7 +38,11 @@ struct FrameSample {
     // Some layers from the server have been on screen by this frame: a design that asks for
     // layers has finished its start-up only then.
     bool remote_shown = true;
-    bool reused = false;          // the display re-warped older layers
+    bool reused = false;  // the display re-warped older layers
+    // The frame whose server layers were on screen (−1: none yet). A reused frame that shows a
+    // late frame's layers for the first time shows new content; one that re-warps the same
+    // layers again does not.
+    int64_t shown_frame = -1;
     bool fallback_local = false;  // the server was gone: everything rendered locally
 };
 
@@ -47,6 +51,11 @@ struct RunStats {
     int frames = 0;
     int frames_displayed = 0;
     int frames_reused = 0;
+    // Counted frames that put server layers on screen newer than any shown before (late ones
+    // included), and counted frames that asked for layers: a design that asked and showed none
+    // new re-warped the same old periphery the whole time (qvr run exits 1).
+    int frames_new_layers = 0;
+    int frames_remote_requested = 0;
     double fps_mean = 0.0;  // displayed frames per second of scan-out, first to last display
     double mtp_ms_mean = 0.0;
     double mtp_ms_p99 = 0.0;  // percentile(…, 99)
@@ -92,7 +101,7 @@ public:
     RunStats finish() const;
 
 private:
-    void count(const FrameSample& f);
+    void count(const FrameSample& f, bool new_layers);
     double mtpP99() const;
 
     RunStats m_s;
@@ -111,6 +120,7 @@ private:
     std::vector<double> m_mtp_exact;   // while no more than kExactMtpFrames
     std::vector<uint32_t> m_mtp_hist;  // after that (fixed size)
     double m_mtp_min = 0.0, m_mtp_max = 0.0;
+    int64_t m_newest_shown = -1;  // over every frame, the start-up's too
 };
 
 // FrameSummarizer over a vector.

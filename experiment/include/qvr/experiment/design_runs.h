@@ -91,6 +91,9 @@ struct RunMeasurement {
     // Designs that asked for the server's layers and never showed one: their display was stale
     // throughout.
     std::vector<std::string> never_shown;
+    // Designs that showed the server's layers in their start-up and none newer in every counted
+    // frame after: the same old periphery re-warped at full rate (showedNoNewLayers).
+    std::vector<std::string> stale_only;
     std::string speed_note;  // why there are no speed probes (empty: there are)
     RunSpeed speed;
     int client_core = 0, server_core = -1, cores = 1;
@@ -135,5 +138,8 @@ DisplayVideo writeDisplayVideo(const RunOptions& plan, const HmdProfile& profile
 // periphery (their own layers came after the wait limit): its FPS then counts frames whose
 // periphery is stale. None when half or fewer did.
 std::optional<std::string> reusedPeripheryWarning(const runtime::DesignSummary& s);
+// A design that asked for the server's layers in its counted frames, came past its start-up, and
+// put none newer on screen: its FPS is a re-warp of the start-up's periphery.
+bool showedNoNewLayers(const runtime::DesignSummary& s);
 
 }  // namespace qvr::experiment

@@ -76,6 +76,7 @@ struct RunOutcome {
     std::string quality_note;
     DisplayVideo video;
     std::vector<std::string> never_shown;
+    std::vector<std::string> stale_only;
     // Every design's headsets (one each unless qvr run --headsets N), in the order they ran.
     int headsets = 1;
     bool identical_workloads = false;
