@@ -70,6 +70,9 @@ static Registered registerSweep(CLI::App& app) {
         ->capture_default_str();
     addFramesOption(cmd, a->frames, 20, 100000, "Frames per design per run");
     addHardwareOption(cmd, a->hardware, "Calibration for every run's prediction");
+    cmd->add_flag("--cached-calibration", a->cached_calibration,
+                  "Each scene's cached calibration as it is (default: measured afresh at the "
+                  "scene's first run)");
     addProfileOption(cmd, a->profile, ProfileNames::kRuntime);
     addOutputFolderOption(cmd, a->out, "Output folder");
     cmd->add_flag("--dry-run", a->dry_run, "Print the conditions without running them");

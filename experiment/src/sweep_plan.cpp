@@ -272,6 +272,7 @@ Expected<SweepOptions> sweepOptions(const SweepArgs& a) {
     o.repeats = a.repeats;
     o.frames = a.frames;
     o.hardware = a.hardware;
+    o.cached_calibration = a.cached_calibration;
     o.profile = a.profile;
     o.out = a.out;
     o.dry_run = a.dry_run;

@@ -191,24 +191,26 @@ ConditionRun StoredConditionRunner::run(const SweepCondition&, const std::vector
 
 ChildCommand ProcessConditionRunner::command(const SweepCondition& c,
                                              const std::vector<std::string>& designs,
-                                             const std::string& tag) const {
+                                             const std::string& tag, bool recalibrate) const {
     const SweepOptions& o = m_options;
     ChildCommand cmd = runChildIn((fs::path(o.out) / tag).string());
     cmd.line = fmt::format(
         "{} run --scene {} --motion {} --seed {} --net {} --headset-share {:g} --designs {} "
-        "--frames {} --profile {}{} --no-video --quality-every 0 --quiet --out {} > {} 2>&1",
+        "--frames {} --profile {}{}{} --no-video --quality-every 0 --quiet --out {} > {} 2>&1",
         shellQuote(o.executable), shellQuote(c.scene), shellQuote(c.motion), c.gaze_seed,
         shellQuote(c.link), c.headset_share, shellQuote(fmt::format("{}", fmt::join(designs, ","))),
         o.frames, shellQuote(o.profile),
-        o.hardware.empty() ? "" : " --hardware " + shellQuote(o.hardware), shellQuote(cmd.output),
-        shellQuote(cmd.log_path));
+        o.hardware.empty() ? "" : " --hardware " + shellQuote(o.hardware),
+        recalibrate ? " --recalibrate" : "", shellQuote(cmd.output), shellQuote(cmd.log_path));
     return cmd;
 }
 
 ConditionRun ProcessConditionRunner::run(const SweepCondition& c,
                                          const std::vector<std::string>& designs,
                                          const std::string& tag) {
-    const ChildCommand cmd = command(c, designs, tag);
+    const bool recalibrate = m_options.hardware.empty() && !m_options.cached_calibration &&
+                             m_calibrated.insert(c.scene).second;
+    const ChildCommand cmd = command(c, designs, tag, recalibrate);
     ChildOutcome outcome = m_children.run(cmd);
     ConditionRun out;
     // A run that exits 1 (a design never showed the server's layers) still wrote its summary.

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "qvr/experiment/sweep.h"
@@ -435,6 +436,46 @@ TEST(SweepStored, JudgesAnEarlierSweepsRunsAndNamesWhatIsMissing) {
     ASSERT_FALSE(refused);
     EXPECT_NE(refused.error().find("--from"), std::string::npos) << refused.error();
     std::filesystem::remove_all(dir);
+}
+
+// Records the command lines it is given; every run "fails" (no summary), which is all the
+// command's test needs.
+class RecordingChildren final : public ChildRunner {
+public:
+    ChildOutcome run(const ChildCommand& command) override {
+        lines.push_back(command.line);
+        return {};
+    }
+    int stopSignal() const override { return 0; }
+    std::vector<std::string> lines;
+};
+
+// A scene's first run measures its calibration afresh (a cached one from another hour of a
+// drifting host biased a whole scene's predictions: oa_dm1's ffr +40%, −2…+8% once measured
+// again); its later runs, --hardware and --cached-calibration do not.
+TEST(SweepProcessRunner, RecalibratesEachSceneAtItsFirstRunOnly) {
+    SweepOptions o;
+    o.executable = "qvr";
+    o.out = "/tmp/qvr-sweep-test";
+    SweepCondition room{0, "wifi", 1.0, "builtin:room", "m1.bvh", 1};
+    SweepCondition dm5{1, "wifi", 0.5, "openarena:oa_dm5", "m2.bvh", 2};
+    const auto recalibrating = [&](const SweepOptions& options) {
+        RecordingChildren children;
+        ProcessConditionRunner runner(options, children);
+        for (const SweepCondition& c : {room, dm5, room, dm5, room})
+            runner.run(c, {"qvr"}, fmt::format("c{}", c.index));
+        std::vector<bool> out;
+        for (const std::string& line : children.lines)
+            out.push_back(line.find(" --recalibrate") != std::string::npos);
+        return out;
+    };
+    EXPECT_EQ(recalibrating(o), (std::vector<bool>{true, true, false, false, false}));
+    SweepOptions cached = o;
+    cached.cached_calibration = true;
+    EXPECT_EQ(recalibrating(cached), std::vector<bool>(5, false));
+    SweepOptions given = o;
+    given.hardware = "/tmp/cal.toml";
+    EXPECT_EQ(recalibrating(given), std::vector<bool>(5, false));
 }
 
 }  // namespace

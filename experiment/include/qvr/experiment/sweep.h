@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,10 @@ struct SweepOptions {
     int frames = 150;
     std::string executable;  // the qvr the runs start
     std::string hardware;    // a calibration for every run (empty: each run's own choice)
+    // Without --hardware, a scene's first run measures its calibration afresh (qvr run
+    // --recalibrate) and the scene's later runs use it: a cached one from another hour of a
+    // drifting host biased every prediction of a scene alike. True: the cache as it is.
+    bool cached_calibration = false;
     std::string profile = "default";
     std::string out = "qvr-sweep";
     bool dry_run = false;
@@ -85,6 +90,7 @@ struct SweepArgs {
     int frames = 150;
     std::string hardware, profile = "default", out = "qvr-sweep", from;
     bool dry_run = false;
+    bool cached_calibration = false;
 };
 // The defaults of a list the arguments leave empty: the shared Mahimahi traces (each also at a
 // 2 Mbit/s mean) and the repository's data/network/*.down; builtin:room, two OpenArena levels
@@ -158,13 +164,14 @@ public:
     ConditionRun run(const SweepCondition& condition, const std::vector<std::string>& designs,
                      const std::string& tag) override;
     int stopSignal() const override { return m_children.stopSignal(); }
-    // The run's command line and where it writes.
+    // The run's command line and where it writes; `recalibrate`: the scene's first run.
     ChildCommand command(const SweepCondition& condition, const std::vector<std::string>& designs,
-                         const std::string& tag) const;
+                         const std::string& tag, bool recalibrate = false) const;
 
 private:
     const SweepOptions& m_options;
     ChildRunner& m_children;
+    std::set<std::string> m_calibrated;  // scenes whose calibration this sweep measured
 };
 
 // The designs of a condition's take, in the order it runs them: take 0 the adaptive designs and
