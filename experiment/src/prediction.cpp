@@ -188,9 +188,8 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
         return p;
     p.speed = inputs.speed;
     // A quota of `share` of the core per period: the headset's work takes 1 / share the wall
-    // time (docs/MODEL.md, the headset's share).
-    // With N headsets on one server the server serves each 1/N of its time, and the headsets
-    // share the headset's core (sim/capacity.h).
+    // time (docs/MODEL.md, the headset's share); N headsets on one server each get 1/N of its
+    // time and share the headset's core (sim/capacity.h capacityFactors).
     const CapacityFactors f = capacityFactors(settings.headsets, settings.headset_share, true);
     const RuntimeCosts costs =
         f.headset != 1.0 || f.server != 1.0 ? calibrated.atSpeed(f.headset, f.server) : calibrated;
