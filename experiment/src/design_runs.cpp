@@ -525,22 +525,23 @@ void DesignRunner::keepRun(const DesignSpec& spec, HeadsetResult result,
         s.frames_displayed, s.frames_reused);
     if (const auto warning = reusedPeripheryWarning(s))
         fmt::print("  {}\n", *warning);
-    if (showedNoNewLayers(s)) {
-        m_m.stale_only.push_back(label);
-        fmt::print(
-            "  warning: {}: none of its {} counted frames showed server layers newer than its "
-            "start-up's: it re-warped the same old periphery throughout (summary.json "
-            "frames_new_layers)\n",
-            s.design, s.frames);
-    }
-    if (s.startup_unfinished && m_plan.warmup_frames > 0) {
-        m_m.never_shown.push_back(label);
-        fmt::print(
-            "  warning: {}: the start-up never ended (none of the server's layers reached the "
-            "screen in {} frames); its statistics are over every frame, not a steady state "
-            "(summary.json startup_unfinished)\n",
-            s.design, s.frames);
-    }
+    // A display the server's layers did not keep new: listed (qvr run exits 1) and said.
+    const auto stale = [&](std::vector<std::string>& list, const char* key,
+                           const std::string& why) {
+        list.push_back(label);
+        fmt::print("  warning: {}: {} (summary.json {})\n", s.design, why, key);
+    };
+    if (showedNoNewLayers(s))
+        stale(m_m.stale_only, "frames_new_layers",
+              fmt::format("none of its {} counted frames showed server layers newer than its "
+                          "start-up's: it re-warped the same old periphery throughout",
+                          s.frames));
+    if (s.startup_unfinished && m_plan.warmup_frames > 0)
+        stale(m_m.never_shown, "startup_unfinished",
+              fmt::format("the start-up never ended (none of the server's layers reached the "
+                          "screen in {} frames); its statistics are over every frame, not a "
+                          "steady state",
+                          s.frames));
     std::fflush(stdout);
     for (const FrameTelemetry& t : result.frames)
         m_all_csv << telemetryCsvRow(label, t);
