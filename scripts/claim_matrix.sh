@@ -3,7 +3,9 @@
 # For each condition (scene × link × headset share) it runs the fixed sweep
 # e1 ∈ {2,5,10,15,20,30}° once (with sw and qvr), picks the best fixed e1 in hindsight, then runs
 # ffr, sw, qvr and that best fixed e1 twice more, and writes a table of medians with their
-# spread (min–max over the three runs) to OUT/matrix.md and OUT/matrix.json.
+# spread (min–max over the three runs) to OUT/matrix.md and OUT/matrix.json. The host's speed
+# drifts, so every run takes its designs in another order (the sweep reversed on odd conditions,
+# the repeats rotated by one design each).
 #
 #   bash scripts/claim_matrix.sh [OUT] [--frames N] [--quick]
 #
@@ -44,21 +46,27 @@ conditions+=("openarena:oa_dm5|wifi|1.0" "openarena:oa_dm5|trace:$traces/ATT-LTE
 if [ "$quick" = 1 ]; then
     conditions=("builtin:room|wifi|1.0" "builtin:room|trace:$traces/ATT-LTE-driving-2016.down|1.0")
 fi
-sweep=fixed:2,fixed:5,fixed:10,fixed:15,fixed:20,fixed:30
+sweep=fixed:2,fixed:5,fixed:10,fixed:15,fixed:20,fixed:30,sw,qvr
+# A comma list rotated left by N designs.
+rotated() { python3 -c "import sys; d=sys.argv[1].split(','); n=int(sys.argv[2])%len(d); print(','.join(d[n:]+d[:n]))" "$1" "$2"; }
 start=$(date +%s)
+index=0
 for c in "${conditions[@]}"; do
+    index=$((index + 1))
     IFS='|' read -r scene link share <<<"$c"
     name=$(echo "${scene}_${link##*/}_${share}" | tr ':/' '__')
     echo "== $scene $link share $share"
     common=(--scene "$scene" --net "$link" --headset-share "$share" --frames "$frames" --no-video
         --quality-every 0 --quiet)
-    "$qvr" run "${common[@]}" --designs "$sweep,sw,qvr" --out "$out/$name/run1" | grep -E '^  [a-z]'
+    first=$sweep
+    [ $((index % 2)) = 1 ] && first=$(echo "$sweep" | tr ',' '\n' | tac | paste -sd,)
+    "$qvr" run "${common[@]}" --designs "$first" --out "$out/$name/run1" | grep -E '^  [a-z]'
     best=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['best_fixed']['design'])" \
         "$out/$name/run1/summary.json")
     designs=ffr,sw,qvr
     [ "$best" != fixed:5 ] && designs="$designs,$best"
     for rep in 2 3; do
-        "$qvr" run "${common[@]}" --designs "$designs" --out "$out/$name/run$rep" | grep -E '^  [a-z]'
+        "$qvr" run "${common[@]}" --designs "$(rotated "$designs" $((rep - 1 + index)))" --out "$out/$name/run$rep" | grep -E '^  [a-z]'
     done
 done
 echo "matrix: $(( $(date +%s) - start )) s"
