@@ -289,8 +289,9 @@ void addPeripheryPassFlags(CLI::App* cmd, bool& one_pass_periphery, bool& no_hol
 CLI::Option* addSharePeripheryOption(CLI::App* cmd, std::string& mode) {
     return cmd
         ->add_option("--share-periphery", mode,
-                     "Server shares one outer layer among headsets of close pose: off, auto "
-                     "(while its SSIM by eccentricity band holds) or on (docs/RUNTIME.md)")
+                     "Server shares one outer layer among headsets of close pose, one middle "
+                     "layer among those of close gaze too: off, auto (while its SSIM by "
+                     "eccentricity band holds) or on (docs/RUNTIME.md)")
         ->check(CLI::IsMember({"off", "auto", "on"}))
         ->capture_default_str();
 }

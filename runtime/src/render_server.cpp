@@ -416,8 +416,8 @@ struct RenderServer::Impl final : net::ServerHandler {
                 continue;
             ++w.layers_planned;
             w.render_start_ns = clock->nowNs();
-            auto rs = sharing && kind == LayerKind::kOuter
-                          ? renderOuter(r, images, plan, static_cast<Eye>(eye), w)
+            auto rs = sharing
+                          ? renderShareable(r, images, plan, static_cast<Eye>(eye), kind, w)
                           : renderLayer(r, config.profile, plan, w.req->pose, static_cast<Eye>(eye),
                                         kind, images.image, CameraOptions{}, config.holes);
             w.render_end_ns = clock->nowNs();
@@ -437,52 +437,53 @@ struct RenderServer::Impl final : net::ServerHandler {
         }
     }
 
-    // An outer layer into images.image with sharing on: another member's shared render reduced
-    // to this headset's layer; or its own beside such a candidate when a measurement is due;
-    // or the group's layer, rendered, kept for the others and reduced; or its own alone.
-    Expected<RenderStats> renderOuter(Renderer& r, Images& images, const LayerPlan& plan, Eye eye,
-                                      const Work& w) {
+    // A middle or outer layer into images.image with sharing on: another member's shared render
+    // reduced to this headset's layer; or its own beside such a candidate when a measurement is
+    // due; or the group's layer, rendered, kept for the others and reduced; or its own alone.
+    Expected<RenderStats> renderShareable(Renderer& r, Images& images, const LayerPlan& plan,
+                                          Eye eye, LayerKind kind, const Work& w) {
         const Pose& pose = w.req->pose;
+        const LayerRect& mine = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
         SharedPeriphery::Decision d =
-            sharing->decide(w.id, eye, pose, plan, config.profile, config.holes);
+            sharing->decide(w.id, eye, kind, pose, plan, config.profile, config.holes);
         switch (d.action) {
             case SharedPeriphery::Action::kReuse:
                 images.image = std::move(d.image);
                 return RenderStats{};
             case SharedPeriphery::Action::kRenderShared: {
-                auto rs =
-                    renderLayer(r, config.profile, d.shared.plan, pose, eye, LayerKind::kOuter,
-                                images.outer, CameraOptions{}, d.shared.holes);
+                auto rs = renderLayer(r, config.profile, d.shared.plan, pose, eye, kind,
+                                      images.outer, CameraOptions{}, d.shared.holes);
                 if (!rs)
                     return rs;
-                const LayerRect& shared_rect = d.shared.plan.eyes[static_cast<size_t>(eye)].outer;
-                reduceSharedOuter(images.outer, shared_rect,
-                                  plan.eyes[static_cast<size_t>(eye)].outer, images.image,
-                                  config.profile, pose.orientation, pose.orientation);
-                sharing->store(w.id, eye, pose, shared_rect, images.outer);
+                reduceSharedLayer(images.outer,
+                                  layerOf(d.shared.plan.eyes[static_cast<size_t>(eye)], kind), mine,
+                                  images.image, config.profile, pose.orientation, pose.orientation);
+                sharing->store(w.id, eye, kind, pose, d.shared, images.outer);
                 return rs;
             }
             case SharedPeriphery::Action::kMeasure:
             case SharedPeriphery::Action::kOwn:
                 break;
         }
-        auto rs = renderLayer(r, config.profile, plan, pose, eye, LayerKind::kOuter, images.image,
+        auto rs = renderLayer(r, config.profile, plan, pose, eye, kind, images.image,
                               CameraOptions{}, config.holes);
         if (!rs)
             return rs;
-        sharing->countOwn();
-        if (d.action == SharedPeriphery::Action::kMeasure) {
-            // What the compositor shows of the outer layer: beyond the middle layer's disc, or
-            // beyond the fovea's when there is no middle layer.
-            const double hide_deg = plan.eyes[static_cast<size_t>(eye)].middle.empty()
-                                        ? plan.e1_deg
-                                        : layerHoleDeg(config.profile, plan, eye, LayerKind::kOuter,
-                                                       LayerHoles{.enabled = true});
-            sharing->measured(w.id, eye,
-                              outerSsimByBand(config.profile, plan, eye, d.image, images.image,
-                                              sharing->config().band_deg, hide_deg));
-        }
+        sharing->countOwn(kind);
+        if (d.action == SharedPeriphery::Action::kMeasure)
+            sharing->measured(
+                w.id, eye, kind,
+                layerSsimByBand(config.profile, plan, eye, kind, d.image, images.image,
+                                sharing->config().band_deg, shownBeyondDeg(plan, eye, kind)));
         return rs;
+    }
+
+    // Where the compositor starts to show a layer: beyond the finer layer's disc (the outer
+    // layer beyond the fovea's when there is no middle layer).
+    double shownBeyondDeg(const LayerPlan& plan, Eye eye, LayerKind kind) const {
+        if (kind == LayerKind::kOuter && plan.eyes[static_cast<size_t>(eye)].middle.empty())
+            return plan.e1_deg;
+        return layerHoleDeg(config.profile, plan, eye, kind, LayerHoles{.enabled = true});
     }
 
     // Encodes one layer with its stream's encoder and hands it to the transport, which never

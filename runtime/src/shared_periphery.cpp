@@ -1,9 +1,10 @@
-// Shared periphery: grouping by pose, the group's outer layer, and the SSIM gate by eccentricity
-// band (shared_periphery.h).
+// Shared periphery: grouping by pose (and gaze), the group's layer, and the SSIM gate by
+// eccentricity band (shared_periphery.h).
 #include "qvr/runtime/shared_periphery.h"
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
@@ -43,6 +44,14 @@ bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c) {
            double(glm::length(a.position_m - b.position_m)) <= c.max_position_m;
 }
 
+bool gazesClose(const Gaze& a, const Gaze& b, const SharePeripheryConfig& c) {
+    return std::hypot(a.x_deg - b.x_deg, a.y_deg - b.y_deg) <= c.max_gaze_deg;
+}
+
+bool isShareable(LayerKind kind) {
+    return kind == LayerKind::kMiddle || kind == LayerKind::kOuter;
+}
+
 std::vector<std::vector<size_t>> groupByPose(const std::vector<Pose>& poses,
                                              const SharePeripheryConfig& c) {
     std::vector<std::vector<size_t>> groups;
@@ -58,12 +67,13 @@ std::vector<std::vector<size_t>> groupByPose(const std::vector<Pose>& poses,
     return groups;
 }
 
-std::vector<BandSsim> outerSsimByBand(const HmdProfile& profile, const LayerPlan& plan, Eye eye,
-                                      const ImageRgba8& shared, const ImageRgba8& own,
-                                      double band_deg, double hide_below_deg) {
+std::vector<BandSsim> layerSsimByBand(const HmdProfile& profile, const LayerPlan& plan, Eye eye,
+                                      LayerKind kind, const ImageRgba8& shared,
+                                      const ImageRgba8& own, double band_deg,
+                                      double hide_below_deg) {
     QVR_CHECK(band_deg >= 1.0);
     QVR_CHECK(shared.width() == own.width() && shared.height() == own.height());
-    const LayerRect& outer = plan.eyes[static_cast<size_t>(eye)].outer;
+    const LayerRect& outer = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
     const EyeGeometry geometry(profile);
     const int bands = static_cast<int>(std::ceil(180.0 / band_deg));
     std::vector<uint8_t> labels(static_cast<size_t>(own.width()) * size_t(own.height()), 0);
@@ -93,15 +103,23 @@ bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim) {
                        [&](const BandSsim& b) { return b.ssim >= min_ssim; });
 }
 
-SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
-                            Eye eye, const LayerHoles& holes, double margin_deg) {
-    QVR_CHECK(!members.empty());
+namespace {
+
+LayerRect& mutableLayerOf(EyeLayers& layers, LayerKind kind) {
+    return kind == LayerKind::kMiddle ? layers.middle : layers.outer;
+}
+
+}  // namespace
+
+SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
+                            Eye eye, LayerKind kind, const LayerHoles& holes, double margin_deg) {
+    QVR_CHECK(!members.empty() && isShareable(kind));
     const size_t e = static_cast<size_t>(eye);
-    SharedOuter s{members.front(), holes};
-    LayerRect& u = s.plan.eyes[e].outer;
+    SharedLayer s{members.front(), holes};
+    LayerRect& u = mutableLayerOf(s.plan.eyes[e], kind);
     double min_hole_deg = 1e9;
     for (const LayerPlan& m : members) {
-        const LayerRect& o = m.eyes[e].outer;
+        const LayerRect& o = layerOf(m.eyes[e], kind);
         if (o.empty())
             continue;
         if (u.empty()) {
@@ -111,8 +129,7 @@ SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPl
                       std::max(u.rect.x1, o.rect.x1), std::max(u.rect.y1, o.rect.y1)};
             u.scale = std::min(u.scale, o.scale);
         }
-        min_hole_deg =
-            std::min(min_hole_deg, layerHoleDeg(profile, m, eye, LayerKind::kOuter, holes));
+        min_hole_deg = std::min(min_hole_deg, layerHoleDeg(profile, m, eye, kind, holes));
         const bool same_gaze = std::fabs(m.gaze.x_deg - s.plan.gaze.x_deg) < 1e-6 &&
                                std::fabs(m.gaze.y_deg - s.plan.gaze.y_deg) < 1e-6;
         if (!same_gaze)
@@ -124,12 +141,13 @@ SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPl
               u.rect.y1 + margin_px};
     u.width_px = static_cast<int>(std::ceil(u.rect.width() / u.scale - 1e-9));
     u.height_px = static_cast<int>(std::ceil(u.rect.height() / u.scale - 1e-9));
-    s.plan.s2 = u.scale;
+    (kind == LayerKind::kMiddle ? s.plan.s1 : s.plan.s2) = u.scale;
     if (!(min_hole_deg > 0.0 && min_hole_deg < 1e9))
         s.holes.enabled = false;
     if (s.holes.enabled)  // the hole every member can take: the smallest of theirs
-        s.plan.e2_deg = min_hole_deg + (holes.band_texels + holes.margin_texels) * u.scale *
-                                           profile.pixelAngleDeg();
+        (kind == LayerKind::kMiddle ? s.plan.e1_deg : s.plan.e2_deg) =
+            min_hole_deg +
+            (holes.band_texels + holes.margin_texels) * u.scale * profile.pixelAngleDeg();
     return s;
 }
 
@@ -153,7 +171,7 @@ void sampleBilinear(const ImageRgba8& img, double u, double v, uint8_t* dst) {
 
 }  // namespace
 
-void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
+void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                        const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
                        const glm::quat& shared_orientation, const glm::quat& member_orientation) {
     if (angleBetweenDeg(shared_orientation, member_orientation) > 1e-6 && !shared.empty()) {
@@ -186,7 +204,8 @@ void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
 nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame) {
     nlohmann::json bands = nlohmann::json::array();
     for (const SharePeripheryStats::Band& b : s.ssim_by_band)
-        bands.push_back({{"lo_deg", b.lo_deg},
+        bands.push_back({{"layer", b.layer},
+                         {"lo_deg", b.lo_deg},
                          {"hi_deg", b.hi_deg},
                          {"ssim_mean", b.ssim_mean},
                          {"ssim_min", b.ssim_min},
@@ -194,9 +213,12 @@ nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_m
     return {{"mode", s.mode},
             {"min_ssim", s.min_ssim},
             {"band_deg", s.band_deg},
-            {"outer_layers_own", s.outer_layers_own},
-            {"outer_layers_shared", s.outer_layers_shared},
-            {"outer_layers_reused", s.outer_layers_reused},
+            {"outer_layers_own", s.outer.own},
+            {"outer_layers_shared", s.outer.shared},
+            {"outer_layers_reused", s.outer.reused},
+            {"middle_layers_own", s.middle.own},
+            {"middle_layers_shared", s.middle.shared},
+            {"middle_layers_reused", s.middle.reused},
             {"measurements", s.measurements},
             {"measurements_failed", s.measurements_failed},
             {"service_ms_per_headset_frame", service_ms_per_frame},
@@ -229,7 +251,12 @@ void SharedPeriphery::forget(Id id) {
     m_sessions.erase(id);
 }
 
-std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id) const {
+size_t SharedPeriphery::slotOf(LayerKind kind, Eye eye) {
+    QVR_CHECK(isShareable(kind));
+    return (kind == LayerKind::kMiddle ? 0 : 2) + static_cast<size_t>(eye);
+}
+
+std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id, LayerKind kind) const {
     std::vector<Id> ids;
     std::vector<Pose> poses;
     for (const auto& [k, s] : m_sessions) {
@@ -238,66 +265,84 @@ std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id) const {
         ids.push_back(k);
         poses.push_back(s.pose);
     }
+    const Gaze& gaze = m_sessions.at(id).plan.gaze;
     for (const std::vector<size_t>& g : groupByPose(poses, m_config)) {
         std::vector<Id> out;
         for (size_t i : g)
-            out.push_back(ids[i]);
+            if (kind == LayerKind::kOuter ||
+                gazesClose(m_sessions.at(ids[i]).plan.gaze, gaze, m_config))
+                out.push_back(ids[i]);
         if (std::find(out.begin(), out.end(), id) != out.end())
             return out;
     }
     return {id};
 }
 
-bool SharedPeriphery::dueLocked(const Session& s, size_t eye) const {
-    return !s.verdict[eye] || s.frames_since_measure[eye] > m_config.remeasure_frames;
+bool SharedPeriphery::dueLocked(const Session& s, size_t slot) const {
+    return !s.verdict[slot] || s.frames_since_measure[slot] > m_config.remeasure_frames;
 }
 
-bool SharedPeriphery::anyDueLocked(const std::vector<Id>& group, size_t eye) const {
+bool SharedPeriphery::anyDueLocked(const std::vector<Id>& group, size_t slot) const {
     return std::any_of(group.begin(), group.end(),
-                       [&](Id x) { return dueLocked(m_sessions.at(x), eye); });
+                       [&](Id x) { return dueLocked(m_sessions.at(x), slot); });
 }
 
-SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& pose,
+bool SharedPeriphery::usableLocked(const Entry& entry, Id id, Eye eye, LayerKind kind,
+                                   const Pose& pose, const LayerPlan& plan,
+                                   const HmdProfile& profile, const LayerHoles& holes) const {
+    const LayerRect& mine = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
+    const LayerRect& theirs = layerOf(entry.shared.plan.eyes[static_cast<size_t>(eye)], kind);
+    if (entry.consumed.contains(id) || !posesClose(entry.pose, pose, m_config) ||
+        !theirs.rect.contains(mine.rect) || theirs.scale > mine.scale + 1e-9)
+        return false;
+    if (kind == LayerKind::kMiddle && !gazesClose(entry.shared.plan.gaze, plan.gaze, m_config))
+        return false;
+    if (!entry.shared.holes.enabled)
+        return true;
+    // A hole is a disc about the render's gaze: it must lie inside this headset's own.
+    const Gaze& g = entry.shared.plan.gaze;
+    const double off_deg = std::hypot(g.x_deg - plan.gaze.x_deg, g.y_deg - plan.gaze.y_deg);
+    return layerHoleDeg(profile, entry.shared.plan, eye, kind, entry.shared.holes) + off_deg <=
+           layerHoleDeg(profile, plan, eye, kind, holes) + 1e-9;
+}
+
+SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind, const Pose& pose,
                                                   const LayerPlan& plan, const HmdProfile& profile,
                                                   const LayerHoles& holes) {
     Decision d;
     if (m_config.mode == SharePeripheryMode::kOff)
         return d;
-    const size_t e = static_cast<size_t>(eye);
-    const LayerRect& outer = plan.eyes[e].outer;
+    const size_t slot = slotOf(kind, eye);
     std::shared_ptr<const ImageRgba8> from;
     LayerRect from_rect;
     glm::quat from_orientation;
     {
         std::lock_guard lock(m_mutex);
         auto self = m_sessions.find(id);
-        if (self == m_sessions.end())
-            return d;  // gone while its frame was served
-        const std::vector<Id> group = groupOfLocked(id);
+        if (self == m_sessions.end() || !self->second.posed)
+            return d;  // gone while its frame was served, or not noted
+        const std::vector<Id> group = groupOfLocked(id, kind);
         if (group.size() < 2)
             return d;
         Session& me = self->second;
-        ++me.frames_since_measure[e];
-        // The newest usable shared render of another member: close to this pose, covering this
-        // headset's outer layer at least as finely, not given to it yet.
+        ++me.frames_since_measure[slot];
+        // The newest usable shared render of another member.
         Entry* best = nullptr;
         for (Id other : group) {
-            if (other == id)
-                continue;
-            auto& entry = m_sessions[other].entries[e];
-            if (entry && !entry->consumed.contains(id) && posesClose(entry->pose, pose, m_config) &&
-                entry->rect.rect.contains(outer.rect) && entry->rect.scale <= outer.scale + 1e-9 &&
+            auto& entry = m_sessions[other].entries[slot];
+            if (other != id && entry &&
+                usableLocked(*entry, id, eye, kind, pose, plan, profile, holes) &&
                 (!best || entry->serial > best->serial))
                 best = &*entry;
         }
-        const bool due = dueLocked(me, e);
+        const bool due = dueLocked(me, slot);
         if (best && m_config.mode == SharePeripheryMode::kAuto && due) {
             d.action = Action::kMeasure;
-        } else if (best && (m_config.mode == SharePeripheryMode::kOn || *me.verdict[e])) {
+        } else if (best && (m_config.mode == SharePeripheryMode::kOn || *me.verdict[slot])) {
             d.action = Action::kReuse;
-            ++m_stats.outer_layers_reused;
-        } else if (m_config.mode == SharePeripheryMode::kAuto && me.verdict[e] == false &&
-                   !anyDueLocked(group, e)) {
+            ++m_stats.of(kind).reused;
+        } else if (m_config.mode == SharePeripheryMode::kAuto && me.verdict[slot] == false &&
+                   !anyDueLocked(group, slot)) {
             return d;  // it does not share, and nobody needs its render to measure against
         } else {
             std::vector<LayerPlan> plans = {plan};
@@ -305,58 +350,58 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, const Pose& po
                 if (other != id)
                     plans.push_back(m_sessions[other].plan);
             d.action = Action::kRenderShared;
-            d.shared = sharedOuterPlan(profile, plans, eye, holes, m_config.max_angle_deg);
-            ++m_stats.outer_layers_shared;
+            d.shared = sharedLayerPlan(profile, plans, eye, kind, holes, m_config.max_angle_deg);
+            ++m_stats.of(kind).shared;
             return d;
         }
         best->consumed.insert(id);
         from = best->image;
-        from_rect = best->rect;
+        from_rect = layerOf(best->shared.plan.eyes[static_cast<size_t>(eye)], kind);
         from_orientation = best->pose.orientation;
     }
-    reduceSharedOuter(*from, from_rect, outer, d.image, profile, from_orientation,
-                      pose.orientation);
+    reduceSharedLayer(*from, from_rect, layerOf(plan.eyes[static_cast<size_t>(eye)], kind), d.image,
+                      profile, from_orientation, pose.orientation);
     return d;
 }
 
-void SharedPeriphery::store(Id renderer, Eye eye, const Pose& pose, const LayerRect& rect,
-                            ImageRgba8 image) {
+void SharedPeriphery::store(Id renderer, Eye eye, LayerKind kind, const Pose& pose,
+                            const SharedLayer& shared, ImageRgba8 image) {
     std::lock_guard lock(m_mutex);
     auto it = m_sessions.find(renderer);
     if (it == m_sessions.end())
         return;
-    it->second.entries[static_cast<size_t>(eye)] =
-        Entry{pose, rect, std::make_shared<const ImageRgba8>(std::move(image)), {}, ++m_serial};
+    it->second.entries[slotOf(kind, eye)] =
+        Entry{pose, shared, std::make_shared<const ImageRgba8>(std::move(image)), {}, ++m_serial};
 }
 
-void SharedPeriphery::measured(Id id, Eye eye, const std::vector<BandSsim>& bands) {
+void SharedPeriphery::measured(Id id, Eye eye, LayerKind kind, const std::vector<BandSsim>& bands) {
     std::lock_guard lock(m_mutex);
     const bool pass = bandsPass(bands, m_config.min_ssim);
     ++m_stats.measurements;
     m_stats.measurements_failed += pass ? 0 : 1;
     auto it = m_sessions.find(id);
     if (it != m_sessions.end()) {
-        it->second.verdict[static_cast<size_t>(eye)] = pass;
-        it->second.frames_since_measure[static_cast<size_t>(eye)] = 0;
+        it->second.verdict[slotOf(kind, eye)] = pass;
+        it->second.frames_since_measure[slotOf(kind, eye)] = 0;
     }
+    const std::string layer = layerName(kind);
+    auto& v = m_stats.ssim_by_band;
     for (const BandSsim& b : bands) {
-        auto& v = m_stats.ssim_by_band;
-        auto x =
-            std::find_if(v.begin(), v.end(), [&](const auto& y) { return y.lo_deg == b.lo_deg; });
-        if (x == v.end()) {
-            x = v.insert(std::upper_bound(v.begin(), v.end(), b.lo_deg,
-                                          [](double lo, const auto& y) { return lo < y.lo_deg; }),
-                         SharePeripheryStats::Band{b.lo_deg, b.hi_deg, 0.0, 1.0, 0});
-        }
+        auto key = [](const SharePeripheryStats::Band& y) { return std::tie(y.layer, y.lo_deg); };
+        const SharePeripheryStats::Band probe{layer, b.lo_deg, b.hi_deg, 0.0, 1.0, 0};
+        auto x = std::lower_bound(v.begin(), v.end(), probe,
+                                  [&](const auto& l, const auto& r) { return key(l) < key(r); });
+        if (x == v.end() || key(*x) != key(probe))
+            x = v.insert(x, probe);
         ++x->measurements;
         x->ssim_mean += (b.ssim - x->ssim_mean) / double(x->measurements);
         x->ssim_min = std::min(x->ssim_min, b.ssim);
     }
 }
 
-void SharedPeriphery::countOwn() {
+void SharedPeriphery::countOwn(LayerKind kind) {
     std::lock_guard lock(m_mutex);
-    ++m_stats.outer_layers_own;
+    ++m_stats.of(kind).own;
 }
 
 SharePeripheryStats SharedPeriphery::stats() const {

@@ -86,12 +86,12 @@ std::unique_ptr<RenderServer> startServer(const RenderServerConfig& c) {
     return server.ok() ? std::move(*server) : nullptr;
 }
 
-net::ClientOptions clientOptions() {
+net::ClientOptions clientOptions(const HmdProfile& display = profile()) {
     net::ClientOptions o;
     o.key = testKey();
     o.connect_timeout_ms = 3000;
-    o.settings = net::makeSessionSettings("raw", profile().name, profile().width_px,
-                                          profile().height_px, profile().refresh_hz);
+    o.settings = net::makeSessionSettings("raw", display.name, display.width_px, display.height_px,
+                                          display.refresh_hz);
     return o;
 }
 
@@ -107,12 +107,14 @@ struct FakeHeadset {
     std::chrono::milliseconds period{10};
     std::chrono::milliseconds duration{1000};
     int stall_after = 0;
+    const HmdProfile* display = &profile();
+    std::function<net::FrameRequest(uint32_t)> request = [](uint32_t f) { return frameRequest(f); };
     std::function<bool()> done;  // stops early once this holds (checked every frame)
     std::atomic<bool> connected{false};
     std::atomic<int> sent{0};
 
     void run(uint16_t port) {
-        net::Client client(clientOptions());
+        net::Client client(clientOptions(*display));
         if (!client.connect("127.0.0.1", port).ok())
             return;
         connected = true;
@@ -125,7 +127,7 @@ struct FakeHeadset {
         }
         auto next = std::chrono::steady_clock::now();
         for (uint32_t f = 1; std::chrono::steady_clock::now() < end && !(done && done()); ++f) {
-            sent += client.sendFrameRequest(frameRequest(f)).ok() ? 1 : 0;
+            sent += client.sendFrameRequest(request(f)).ok() ? 1 : 0;
             next += period;
             while (std::chrono::steady_clock::now() < next) {
                 auto s = client.nextStream(1);
@@ -325,11 +327,16 @@ TEST(RenderServerPool, AHeadsetOverTheFloorIsRefusedWithTheReason) {
 
 // Without a calibration the server measures its own service time per headset-frame and
 // admission goes by it once it has served measure_frames frames.
-// Two headsets at one pose with sharing on auto: after a measurement, the outer layers one
-// renders the other reuses, and every frame's outer layers are accounted for.
-TEST(RenderServerPool, CoLocatedSessionsShareTheOuterLayer) {
+// Two headsets at one pose and gaze with sharing on auto: after a measurement, the middle and
+// outer layers one renders the other reuses, and every frame's layers are accounted for.
+TEST(RenderServerPool, CoLocatedSessionsShareTheMiddleAndOuterLayers) {
     RenderServerConfig c = poolConfig(1, 1ms);
     c.share_periphery.mode = SharePeripheryMode::kAuto;
+    // The small display: the tiny one has no middle layer.
+    c.profile = runtimeProfileByName("small").value();
+    static const HmdProfile small = c.profile;
+    static const LayerPlan plan = LayerPlanner(small).plan(Gaze{}, 10.0);
+    ASSERT_FALSE(plan.eyes[0].middle.empty());
     auto server = startServer(c);
     ASSERT_TRUE(server);
     std::vector<std::unique_ptr<FakeHeadset>> headsets;
@@ -338,8 +345,13 @@ TEST(RenderServerPool, CoLocatedSessionsShareTheOuterLayer) {
     for (int i = 0; i < 2; ++i) {
         headsets.push_back(std::make_unique<FakeHeadset>());
         headsets.back()->duration = 30s;
+        headsets.back()->display = &small;
+        headsets.back()->request = [](uint32_t f) {
+            return net::makeFrameRequest(f, 0, Pose{}, plan);
+        };
         headsets.back()->done = [&server] {
-            return server->stats().share_periphery.outer_layers_reused >= 4;
+            const SharePeripheryStats sp = server->stats().share_periphery;
+            return sp.outer.reused >= 4 && sp.middle.reused >= 4;
         };
     }
     runAll(headsets, server->port());
@@ -349,9 +361,11 @@ TEST(RenderServerPool, CoLocatedSessionsShareTheOuterLayer) {
     EXPECT_EQ(sp.mode, "auto");
     EXPECT_GE(sp.measurements, 1u);
     EXPECT_EQ(sp.measurements_failed, 0u);  // the same pose: the same layer
-    EXPECT_GT(sp.outer_layers_reused, 0u);
-    EXPECT_EQ(sp.outer_layers_own + sp.outer_layers_shared + sp.outer_layers_reused,
-              2 * s.frames_rendered);
+    EXPECT_GE(sp.measurements, 2u);         // each layer measured before it is reused
+    for (const SharePeripheryStats::Layers& l : {sp.middle, sp.outer}) {
+        EXPECT_GT(l.reused, 0u);
+        EXPECT_EQ(l.own + l.shared + l.reused, 2 * s.frames_rendered);
+    }
     for (const SessionStats& x : s.sessions)
         EXPECT_GT(x.frames_sent, 0u);
 }

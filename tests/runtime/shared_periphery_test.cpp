@@ -1,4 +1,4 @@
-// Shared periphery: grouping by pose, the group's outer layer and the SSIM gate by band.
+// Shared periphery: grouping by pose and gaze, the group's layer and the SSIM gate by band.
 #include "qvr/runtime/shared_periphery.h"
 
 #include <cmath>
@@ -57,7 +57,8 @@ TEST(SharedPeriphery, SsimByBandSeesOnlyTheBandsThatDiffer) {
     const LayerRect& outer = plan.eyes[0].outer;
     ASSERT_FALSE(outer.empty());
     const ImageRgba8 own = testPattern(outer.width_px, outer.height_px);
-    const auto same = outerSsimByBand(profile, plan, Eye::kLeft, own, own, 10.0, 0.0);
+    const auto same =
+        layerSsimByBand(profile, plan, Eye::kLeft, LayerKind::kOuter, own, own, 10.0, 0.0);
     ASSERT_GE(same.size(), 3u);
     for (const BandSsim& b : same)
         EXPECT_NEAR(b.ssim, 1.0, 1e-9) << b.lo_deg;
@@ -77,7 +78,8 @@ TEST(SharedPeriphery, SsimByBandSeesOnlyTheBandsThatDiffer) {
                 shared.at(x, y, c) = own.at(x - 1, y, c);
         }
     }
-    const auto shifted = outerSsimByBand(profile, plan, Eye::kLeft, shared, own, 10.0, 0.0);
+    const auto shifted =
+        layerSsimByBand(profile, plan, Eye::kLeft, LayerKind::kOuter, shared, own, 10.0, 0.0);
     ASSERT_EQ(shifted.size(), same.size());
     bool outer_dropped = false;
     for (const BandSsim& b : shifted) {
@@ -90,7 +92,8 @@ TEST(SharedPeriphery, SsimByBandSeesOnlyTheBandsThatDiffer) {
     EXPECT_TRUE(outer_dropped);
     EXPECT_FALSE(bandsPass(shifted, 0.9));
     // Texels nearer than hide_below_deg are left out.
-    const auto hidden = outerSsimByBand(profile, plan, Eye::kLeft, shared, own, 10.0, 30.0);
+    const auto hidden =
+        layerSsimByBand(profile, plan, Eye::kLeft, LayerKind::kOuter, shared, own, 10.0, 30.0);
     EXPECT_GE(hidden.front().lo_deg, 30.0);
 }
 
@@ -114,7 +117,7 @@ ImageRgba8 directionLayer(const HmdProfile& profile, const LayerRect& l, const g
 TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
     const HmdProfile profile = smallProfile();
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
-    const SharedOuter s = sharedOuterPlan(profile, {plan}, Eye::kLeft, {}, 3.0);
+    const SharedLayer s = sharedLayerPlan(profile, {plan}, Eye::kLeft, LayerKind::kOuter, {}, 3.0);
     const LayerRect& shared_rect = s.plan.eyes[0].outer;
     const LayerRect& member = plan.eyes[0].outer;
     EXPECT_LT(shared_rect.rect.x0, 0);  // widened beyond the image by the margin
@@ -123,8 +126,8 @@ TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
     const ImageRgba8 shared = directionLayer(profile, shared_rect, a);
     const ImageRgba8 truth = directionLayer(profile, member, b);
     ImageRgba8 reprojected, unmoved;
-    reduceSharedOuter(shared, shared_rect, member, reprojected, profile, a, b);
-    reduceSharedOuter(shared, shared_rect, member, unmoved, profile, a, a);
+    reduceSharedLayer(shared, shared_rect, member, reprojected, profile, a, b);
+    reduceSharedLayer(shared, shared_rect, member, unmoved, profile, a, a);
     ASSERT_EQ(reprojected.width(), member.width_px);
     const double err = test::meanAbsDiff(reprojected, truth);
     EXPECT_LT(err, 0.6);
@@ -138,7 +141,7 @@ TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {
     const LayerPlan b = planner.plan({0.0, 0.0}, 25.0);
     ASSERT_NE(a.eyes[0].outer.scale, b.eyes[0].outer.scale);
     const LayerHoles holes{.enabled = true};
-    const SharedOuter s = sharedOuterPlan(profile, {a, b}, Eye::kLeft, holes);
+    const SharedLayer s = sharedLayerPlan(profile, {a, b}, Eye::kLeft, LayerKind::kOuter, holes);
     const LayerRect& u = s.plan.eyes[0].outer;
     EXPECT_DOUBLE_EQ(u.scale, std::min(a.eyes[0].outer.scale, b.eyes[0].outer.scale));
     EXPECT_TRUE(u.rect.contains(a.eyes[0].outer.rect));
@@ -149,7 +152,8 @@ TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {
     EXPECT_LE(hole, layerHoleDeg(profile, b, Eye::kLeft, LayerKind::kOuter, holes) + 1e-9);
     // Different gazes: different hole discs, so none.
     const LayerPlan c = planner.plan({10.0, 0.0}, 10.0);
-    EXPECT_FALSE(sharedOuterPlan(profile, {a, c}, Eye::kLeft, holes).holes.enabled);
+    EXPECT_FALSE(
+        sharedLayerPlan(profile, {a, c}, Eye::kLeft, LayerKind::kOuter, holes).holes.enabled);
 }
 
 TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
@@ -163,42 +167,114 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
     sp.join(1);
     sp.join(2);
     sp.noteRequest(1, yawed(0.0), plan);
-    EXPECT_EQ(sp.decide(1, Eye::kLeft, yawed(0.0), plan, profile, holes).action, A::kOwn);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), plan, profile, holes).action,
+              A::kOwn);
     sp.noteRequest(2, yawed(1.0), plan);
-    auto d = sp.decide(1, Eye::kLeft, yawed(0.0), plan, profile, holes);
+    auto d = sp.decide(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), plan, profile, holes);
     ASSERT_EQ(d.action, A::kRenderShared);
-    const LayerRect rect = d.shared.plan.eyes[0].outer;
+    const SharedLayer shared = d.shared;
+    const LayerRect rect = shared.plan.eyes[0].outer;
     const ImageRgba8 layer = testPattern(rect.width_px, rect.height_px);
-    sp.store(1, Eye::kLeft, yawed(0.0), rect, layer);
+    sp.store(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), shared, layer);
     // Headset 2 measures before it shares; a passing measurement lets it reuse the next one.
-    d = sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes);
+    d = sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes);
     ASSERT_EQ(d.action, A::kMeasure);
     EXPECT_EQ(d.image.width(), plan.eyes[0].outer.width_px);
-    sp.measured(2, Eye::kLeft, {{50.0, 60.0, 0.95, 100}});
-    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action,
+    sp.measured(2, Eye::kLeft, LayerKind::kOuter, {{50.0, 60.0, 0.95, 100}});
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
               A::kRenderShared);  // that render was given to it already
-    sp.store(1, Eye::kLeft, yawed(0.0), rect, layer);
-    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kReuse);
+    sp.store(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), shared, layer);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
+              A::kReuse);
     // A failing band stops the reuse until the next measurement.
-    sp.measured(2, Eye::kLeft, {{50.0, 60.0, 0.95, 100}, {60.0, 70.0, 0.5, 100}});
-    sp.store(1, Eye::kLeft, yawed(0.0), rect, layer);
-    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kRenderShared);
+    sp.measured(2, Eye::kLeft, LayerKind::kOuter,
+                {{50.0, 60.0, 0.95, 100}, {60.0, 70.0, 0.5, 100}});
+    sp.store(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), shared, layer);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
+              A::kRenderShared);
     // Far apart: each its own.
     sp.noteRequest(2, yawed(30.0), plan);
-    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(30.0), plan, profile, holes).action, A::kOwn);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(30.0), plan, profile, holes).action,
+              A::kOwn);
     // A session that left is not brought back by a late request.
     sp.forget(1);
     sp.noteRequest(1, yawed(1.0), plan);
     sp.noteRequest(2, yawed(1.0), plan);
-    EXPECT_EQ(sp.decide(2, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kOwn);
-    EXPECT_EQ(sp.decide(1, Eye::kLeft, yawed(1.0), plan, profile, holes).action, A::kOwn);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
+              A::kOwn);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
+              A::kOwn);
     const SharePeripheryStats s = sp.stats();
     EXPECT_EQ(s.measurements, 2u);
     EXPECT_EQ(s.measurements_failed, 1u);
-    EXPECT_EQ(s.outer_layers_reused, 1u);
+    EXPECT_EQ(s.outer.reused, 1u);
+    EXPECT_EQ(s.middle.reused + s.middle.shared + s.middle.own, 0u);
     ASSERT_EQ(s.ssim_by_band.size(), 2u);
     EXPECT_DOUBLE_EQ(s.ssim_by_band[0].ssim_mean, 0.95);
     EXPECT_DOUBLE_EQ(s.ssim_by_band[1].ssim_min, 0.5);
+}
+
+// The middle layer is centred on the gaze: shared between close poses only when the gazes are
+// close too, over the union of the members' middle rects with no hole when the gazes differ.
+TEST(SharedPeriphery, SharesTheMiddleLayerOnlyBetweenCloseGazes) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlanner planner(profile);
+    const LayerPlan a = planner.plan({0.0, 0.0}, 10.0);
+    const LayerPlan near = planner.plan({0.5, 0.0}, 10.0);
+    const LayerPlan far = planner.plan({6.0, 0.0}, 10.0);
+    const LayerHoles holes{.enabled = true};
+    SharePeripheryConfig c;
+    c.mode = SharePeripheryMode::kOn;
+    SharedPeriphery sp(c);
+    using A = SharedPeriphery::Action;
+    sp.join(1);
+    sp.join(2);
+    sp.noteRequest(1, Pose{}, a);
+    sp.noteRequest(2, Pose{}, far);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kMiddle, Pose{}, a, profile, holes).action,
+              A::kOwn);
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kOuter, Pose{}, a, profile, holes).action,
+              A::kRenderShared);
+    sp.noteRequest(2, Pose{}, near);
+    const auto d = sp.decide(1, Eye::kLeft, LayerKind::kMiddle, Pose{}, a, profile, holes);
+    ASSERT_EQ(d.action, A::kRenderShared);
+    const LayerRect& u = d.shared.plan.eyes[0].middle;
+    EXPECT_TRUE(u.rect.contains(a.eyes[0].middle.rect));
+    EXPECT_TRUE(u.rect.contains(near.eyes[0].middle.rect));
+    EXPECT_DOUBLE_EQ(d.shared.plan.s1, u.scale);
+    EXPECT_FALSE(d.shared.holes.enabled);  // two gazes, two fovea discs
+    sp.store(1, Eye::kLeft, LayerKind::kMiddle, Pose{}, d.shared,
+             testPattern(u.width_px, u.height_px));
+    const auto reused = sp.decide(2, Eye::kLeft, LayerKind::kMiddle, Pose{}, near, profile, holes);
+    ASSERT_EQ(reused.action, A::kReuse);
+    EXPECT_EQ(reused.image.width(), near.eyes[0].middle.width_px);
+    EXPECT_EQ(reused.image.height(), near.eyes[0].middle.height_px);
+    const SharePeripheryStats s = sp.stats();
+    EXPECT_EQ(s.middle.shared, 1u);
+    EXPECT_EQ(s.middle.reused, 1u);
+    EXPECT_EQ(s.outer.shared, 1u);
+}
+
+// A render with a hole is no use to a headset whose own layer has none there.
+TEST(SharedPeriphery, NeverHandsOnARenderWithALargerHole) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    SharePeripheryConfig c;
+    c.mode = SharePeripheryMode::kOn;
+    SharedPeriphery sp(c);
+    sp.join(1);
+    sp.join(2);
+    sp.noteRequest(1, Pose{}, plan);
+    sp.noteRequest(2, Pose{}, plan);
+    const LayerRect& r = plan.eyes[0].middle;
+    const ImageRgba8 img = testPattern(r.width_px, r.height_px);
+    ASSERT_GT(layerHoleDeg(profile, plan, Eye::kLeft, LayerKind::kMiddle, {.enabled = true}), 0.0);
+    sp.store(1, Eye::kLeft, LayerKind::kMiddle, Pose{}, SharedLayer{plan, {.enabled = true}}, img);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kMiddle, Pose{}, plan, profile, {}).action,
+              SharedPeriphery::Action::kRenderShared);
+    sp.store(1, Eye::kLeft, LayerKind::kMiddle, Pose{}, SharedLayer{plan, {}}, img);
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kMiddle, Pose{}, plan, profile, {}).action,
+              SharedPeriphery::Action::kReuse);
 }
 
 TEST(SharedPeriphery, OffNeverShares) {
@@ -209,7 +285,7 @@ TEST(SharedPeriphery, OffNeverShares) {
     sp.join(2);
     sp.noteRequest(1, Pose{}, plan);
     sp.noteRequest(2, Pose{}, plan);
-    EXPECT_EQ(sp.decide(2, Eye::kLeft, Pose{}, plan, profile, {}).action,
+    EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, Pose{}, plan, profile, {}).action,
               SharedPeriphery::Action::kOwn);
     RenderServerStats stats;
     stats.share_periphery = sp.stats();
@@ -217,7 +293,8 @@ TEST(SharedPeriphery, OffNeverShares) {
     EXPECT_EQ(j["mode"], "off");
     for (const char* key :
          {"min_ssim", "band_deg", "outer_layers_own", "outer_layers_shared", "outer_layers_reused",
-          "measurements", "measurements_failed", "service_ms_per_headset_frame", "ssim_by_band"})
+          "middle_layers_own", "middle_layers_shared", "middle_layers_reused", "measurements",
+          "measurements_failed", "service_ms_per_headset_frame", "ssim_by_band"})
         EXPECT_TRUE(j.contains(key)) << key;
     EXPECT_FALSE(parseSharePeripheryMode("sometimes").ok());
     EXPECT_EQ(*parseSharePeripheryMode("auto"), SharePeripheryMode::kAuto);

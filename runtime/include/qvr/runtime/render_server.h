@@ -102,8 +102,9 @@ struct RenderServerConfig {
     // Leave out of each periphery layer the clusters the compositor takes from a finer layer
     // only (render/renderer.h LayerHoles): a larger fovea then costs the server less.
     LayerHoles holes{.enabled = true};
-    // One outer layer for headsets whose poses are close (docs/RUNTIME.md §Shared periphery);
-    // off by default. Eyes rendered in one pass (one_pass_periphery) are not shared.
+    // One outer layer for headsets whose poses are close, one middle layer for those whose gazes
+    // are close too (docs/RUNTIME.md §Shared periphery); off by default. Eyes rendered in one
+    // pass (one_pass_periphery) are not shared.
     SharePeripheryConfig share_periphery;
 };
 

@@ -1,8 +1,9 @@
 // Shared periphery (docs/RUNTIME.md §Shared periphery): headsets of one scene whose head poses are
 // close get one outer layer per eye rendered for all of them — at the finest of their outer
-// sampling rates, over the union of their outer rectangles — each reduced to its own layer rect.
-// Sharing is kept for a headset only while the SSIM of the shared layer against its own outer
-// layer stays above a threshold in every eccentricity band.
+// sampling rates, over the union of their outer rectangles — each reduced to its own layer rect;
+// those whose gazes are close too share the middle layer the same way. Sharing a layer is kept
+// for a headset only while the SSIM of the shared layer against its own stays above a threshold
+// in every eccentricity band.
 #pragma once
 
 #include <array>
@@ -40,6 +41,9 @@ struct SharePeripheryConfig {
     // own pose, so the difference shows as misregistration (the SSIM measures what it costs).
     double max_angle_deg = 3.0;
     double max_position_m = 0.10;
+    // The middle layer is centred on the gaze: it is shared only among headsets whose gazes are
+    // this close, so the group's layer (the union of the members') stays about one member's.
+    double max_gaze_deg = 1.0;
     // Every eccentricity band's SSIM (luma, 7×7 windows) of the shared layer against the
     // headset's own must be at least this (docs/RUNTIME.md says why 0.9).
     double min_ssim = 0.90;
@@ -49,13 +53,16 @@ struct SharePeripheryConfig {
 };
 
 bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c);
+bool gazesClose(const Gaze& a, const Gaze& b, const SharePeripheryConfig& c);
+// The layers a server may share: the middle and the outer one.
+bool isShareable(LayerKind kind);
 
 // Groups by pose: each pose joins the first group whose first member (its leader) is close,
 // else starts a group. Indices into `poses`, groups in order of their leaders.
 std::vector<std::vector<size_t>> groupByPose(const std::vector<Pose>& poses,
                                              const SharePeripheryConfig& c);
 
-// One eccentricity band [lo_deg, hi_deg) of an outer layer.
+// One eccentricity band [lo_deg, hi_deg) of a middle or outer layer.
 struct BandSsim {
     double lo_deg = 0.0;
     double hi_deg = 0.0;
@@ -63,44 +70,52 @@ struct BandSsim {
     int64_t texels = 0;
 };
 
-// SSIM of `shared` (the shared layer as the headset gets it: reduced to its own outer layer)
-// against `own` (its own outer layer) by eccentricity band of band_deg from the plan's gaze.
-// Texels nearer the gaze than hide_below_deg (what the compositor takes from the middle layer
-// only) are left out; bands without a whole 7×7 window are left out.
-std::vector<BandSsim> outerSsimByBand(const HmdProfile& profile, const LayerPlan& plan, Eye eye,
-                                      const ImageRgba8& shared, const ImageRgba8& own,
-                                      double band_deg, double hide_below_deg);
+// SSIM of `shared` (the shared layer as the headset gets it: reduced to its own layer `kind`)
+// against `own` (its own layer) by eccentricity band of band_deg from the plan's gaze. Texels
+// nearer the gaze than hide_below_deg (what the compositor takes from a finer layer only) are
+// left out; bands without a whole 7×7 window are left out.
+std::vector<BandSsim> layerSsimByBand(const HmdProfile& profile, const LayerPlan& plan, Eye eye,
+                                      LayerKind kind, const ImageRgba8& shared,
+                                      const ImageRgba8& own, double band_deg,
+                                      double hide_below_deg);
 bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim);
 
-// The layer the group renders for one eye: the union of its members' outer rectangles, widened
+// The layer `kind` the group renders for one eye: the union of its members' rectangles, widened
 // by margin_deg beyond each edge (what a member's rotation may bring into view), at the finest
-// of their sampling scales, with the plan (gaze, e2) whose hole every member can take (holes off
-// when the members' gazes differ).
-struct SharedOuter {
-    LayerPlan plan;  // a member's plan with eyes[eye].outer the shared rect
+// of their sampling scales, with the plan (gaze, e1 or e2) whose hole every member can take
+// (holes off when the members' gazes differ).
+struct SharedLayer {
+    LayerPlan plan;  // a member's plan with layerOf(eyes[eye], kind) the shared rect
     LayerHoles holes;
 };
-SharedOuter sharedOuterPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
-                            Eye eye, const LayerHoles& holes, double margin_deg = 0.0);
+SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
+                            Eye eye, LayerKind kind, const LayerHoles& holes,
+                            double margin_deg = 0.0);
 
-// A shared layer as one member gets it: its outer layer's texels, rotated from the shared
-// render's orientation to the member's (bilinear), or box-filtered when the two are the same.
-// The member's UCA then takes it as rendered at its own pose; position is not corrected.
-void reduceSharedOuter(const ImageRgba8& shared, const LayerRect& shared_rect,
-                       const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
+// A shared layer as one member gets it: its layer's texels, rotated from the shared render's
+// orientation to the member's (bilinear), or box-filtered when the two are the same. The
+// member's UCA then takes it as rendered at its own pose; position is not corrected.
+void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
+                       const LayerRect& member_rect, ImageRgba8& out, const HmdProfile& profile,
                        const glm::quat& shared_orientation, const glm::quat& member_orientation);
 
 struct SharePeripheryStats {
     std::string mode = "off";
     double min_ssim = 0.0;
     double band_deg = 0.0;
-    uint64_t outer_layers_own = 0;     // rendered for one headset
-    uint64_t outer_layers_shared = 0;  // rendered for a group (and reduced for the renderer)
-    uint64_t outer_layers_reused = 0;  // taken from another headset's shared render
+    // Per shareable layer (middle, outer), each eye's layers counted.
+    struct Layers {
+        uint64_t own = 0;     // rendered for one headset
+        uint64_t shared = 0;  // rendered for a group (and reduced for the renderer)
+        uint64_t reused = 0;  // taken from another headset's shared render
+    };
+    Layers middle, outer;
+    Layers& of(LayerKind kind) { return kind == LayerKind::kMiddle ? middle : outer; }
     uint64_t measurements = 0;
     uint64_t measurements_failed = 0;  // some band below min_ssim
-    // By band over every measurement: the mean and the lowest SSIM.
+    // By layer and band over every measurement: the mean and the lowest SSIM.
     struct Band {
+        std::string layer;  // "middle" or "outer"
         double lo_deg = 0.0, hi_deg = 0.0;
         double ssim_mean = 0.0, ssim_min = 1.0;
         uint64_t measurements = 0;
@@ -110,7 +125,7 @@ struct SharePeripheryStats {
 nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame);
 
 // The server's sharing state, thread-safe: the sessions' latest poses and plans, the newest
-// shared layer each session rendered per eye, each session's SSIM verdict.
+// shared layer each session rendered per layer and eye, each session's SSIM verdicts.
 class SharedPeriphery {
 public:
     using Id = uint64_t;
@@ -122,27 +137,29 @@ public:
     void forget(Id id);
 
     enum class Action {
-        kOwn,           // render its own outer layer
+        kOwn,           // render its own layer
         kRenderShared,  // render `shared` for the group, then store() it
         kReuse,         // `image` holds the layer, reduced from another's shared render
         kMeasure,       // `image` holds a candidate; render its own, measured(), send its own
     };
     struct Decision {
         Action action = Action::kOwn;
-        SharedOuter shared;
+        SharedLayer shared;
         ImageRgba8 image;
     };
-    Decision decide(Id id, Eye eye, const Pose& pose, const LayerPlan& plan,
+    // For a shareable layer `kind` of this headset's frame (holes: the server's).
+    Decision decide(Id id, Eye eye, LayerKind kind, const Pose& pose, const LayerPlan& plan,
                     const HmdProfile& profile, const LayerHoles& holes);
-    void store(Id renderer, Eye eye, const Pose& pose, const LayerRect& rect, ImageRgba8 image);
-    void measured(Id id, Eye eye, const std::vector<BandSsim>& bands);
-    void countOwn();
+    void store(Id renderer, Eye eye, LayerKind kind, const Pose& pose, const SharedLayer& shared,
+               ImageRgba8 image);
+    void measured(Id id, Eye eye, LayerKind kind, const std::vector<BandSsim>& bands);
+    void countOwn(LayerKind kind);
     SharePeripheryStats stats() const;
 
 private:
     struct Entry {
         Pose pose;
-        LayerRect rect;
+        SharedLayer shared;  // the plan it was rendered with
         std::shared_ptr<const ImageRgba8> image;
         std::set<Id> consumed;  // the members it was given to
         uint64_t serial = 0;    // newer renders have larger serials
@@ -151,15 +168,23 @@ private:
         Pose pose;
         LayerPlan plan;
         bool posed = false;  // a request noted
-        // Per eye: its newest shared render, whether the last measurement passed, and the
-        // frames since.
-        std::array<std::optional<Entry>, 2> entries;
-        std::array<std::optional<bool>, 2> verdict;
-        std::array<int, 2> frames_since_measure{};
+        // Per slot (layer and eye, slotOf): its newest shared render, whether the last
+        // measurement passed, and the frames since.
+        std::array<std::optional<Entry>, 4> entries;
+        std::array<std::optional<bool>, 4> verdict;
+        std::array<int, 4> frames_since_measure{};
     };
-    std::vector<Id> groupOfLocked(Id id) const;
-    bool dueLocked(const Session& s, size_t eye) const;  // a measurement is due
-    bool anyDueLocked(const std::vector<Id>& group, size_t eye) const;
+    static size_t slotOf(LayerKind kind, Eye eye);
+    // The members `id` shares layer `kind` with: its pose group, for the middle layer only those
+    // whose gaze is close to its own.
+    std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
+    bool dueLocked(const Session& s, size_t slot) const;  // a measurement is due
+    bool anyDueLocked(const std::vector<Id>& group, size_t slot) const;
+    // Another member's render this headset can take: close pose, covering its layer at least as
+    // finely, a hole no larger than its own (and about the same gaze), not given to it yet.
+    bool usableLocked(const Entry& entry, Id id, Eye eye, LayerKind kind, const Pose& pose,
+                      const LayerPlan& plan, const HmdProfile& profile,
+                      const LayerHoles& holes) const;
 
     SharePeripheryConfig m_config;
     mutable std::mutex m_mutex;
