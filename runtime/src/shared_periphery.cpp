@@ -153,43 +153,65 @@ SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPl
 
 namespace {
 
-// Bilinear sample of an RGBA8 image at texel coordinates (texel centres at i + 0.5), clamped to
-// the edge.
-void sampleBilinear(const ImageRgba8& img, double u, double v, uint8_t* dst) {
-    const double x = std::clamp(u - 0.5, 0.0, double(img.width() - 1));
-    const double y = std::clamp(v - 0.5, 0.0, double(img.height() - 1));
-    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-    const int x1 = std::min(x0 + 1, img.width() - 1), y1 = std::min(y0 + 1, img.height() - 1);
-    const double fx = x - x0, fy = y - y0;
-    for (int c = 0; c < 3; ++c) {
-        const double top = img.at(x0, y0, c) * (1.0 - fx) + img.at(x1, y0, c) * fx;
-        const double bottom = img.at(x0, y1, c) * (1.0 - fx) + img.at(x1, y1, c) * fx;
-        dst[c] = static_cast<uint8_t>(std::clamp(top * (1.0 - fy) + bottom * fy + 0.5, 0.0, 255.0));
+// The member's texel centres through the rotation to the shared render (UCA's map without the
+// lens, which the layers do not have): a flat pinhole rotation is a homography, so along a row
+// the rotated ray moves by a constant step and each texel costs one division and a bilinear tap.
+void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
+                     const LayerRect& member, ImageRgba8& out, const HmdProfile& profile,
+                     const glm::quat& shared_orientation, const glm::quat& member_orientation) {
+    HmdProfile flat = profile;
+    flat.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
+    const EyeWarp warp(flat, shared_orientation, member_orientation);
+    const glm::dmat3& rot = warp.rotation();
+    out.resize(member.width_px, member.height_px);
+    // A member texel (i, j) is the eye-space ray d = (xt, yt, -1), affine in (i, j).
+    const double s = member.scale;
+    const glm::dvec3 d0((member.rect.x0 + 0.5 * s - warp.cx()) / warp.fx(),
+                        -(member.rect.y0 + 0.5 * s - warp.cy()) / warp.fy(), -1.0);
+    const glm::dvec3 r0 = rot * d0;
+    const glm::dvec3 di = rot * glm::dvec3(s / warp.fx(), 0.0, 0.0);
+    const glm::dvec3 dj = rot * glm::dvec3(0.0, -s / warp.fy(), 0.0);
+    // Shared texel coordinates (centres at k + 0.5) of a rendered-eye point.
+    const double ax = warp.fx() / shared_rect.scale,
+                 bx = (warp.cx() - shared_rect.rect.x0) / shared_rect.scale - 0.5;
+    const double ay = warp.fy() / shared_rect.scale,
+                 by = (warp.cy() - shared_rect.rect.y0) / shared_rect.scale - 0.5;
+    const int w = shared.width(), h = shared.height();
+    const size_t stride = static_cast<size_t>(w) * 4;
+    const uint8_t* src = shared.data();
+    for (int j = 0; j < member.height_px; ++j) {
+        glm::dvec3 r = r0 + double(j) * dj;
+        uint8_t* dst = out.data() + static_cast<size_t>(j) * member.width_px * 4;
+        for (int i = 0; i < member.width_px; ++i, r += di, dst += 4) {
+            const double depth = std::max(-r.z, 1e-9);
+            const double x = std::clamp(bx + ax * r.x / depth, 0.0, double(w - 1));
+            const double y = std::clamp(by - ay * r.y / depth, 0.0, double(h - 1));
+            const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+            const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+            const float fx = float(x - x0), fy = float(y - y0);
+            const uint8_t* p00 = src + size_t(y0) * stride + size_t(x0) * 4;
+            const uint8_t* p10 = src + size_t(y0) * stride + size_t(x1) * 4;
+            const uint8_t* p01 = src + size_t(y1) * stride + size_t(x0) * 4;
+            const uint8_t* p11 = src + size_t(y1) * stride + size_t(x1) * 4;
+            for (int c = 0; c < 3; ++c) {
+                const float top = p00[c] + (p10[c] - p00[c]) * fx;
+                const float bottom = p01[c] + (p11[c] - p01[c]) * fx;
+                dst[c] =
+                    static_cast<uint8_t>(std::clamp(top + (bottom - top) * fy + 0.5f, 0.f, 255.f));
+            }
+            dst[3] = 255;
+        }
     }
-    dst[3] = 255;
 }
 
 }  // namespace
 
 void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
-                       const LayerRect& member_outer, ImageRgba8& out, const HmdProfile& profile,
+                       const LayerRect& member_rect, ImageRgba8& out, const HmdProfile& profile,
                        const glm::quat& shared_orientation, const glm::quat& member_orientation) {
     if (angleBetweenDeg(shared_orientation, member_orientation) > 1e-6 && !shared.empty()) {
-        // The member's texel centres through the rotation to the shared render (UCA's map
-        // without the lens, which the layers do not have).
-        HmdProfile flat = profile;
-        flat.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
-        const EyeWarp warp(flat, shared_orientation, member_orientation);
-        out.resize(member_outer.width_px, member_outer.height_px);
-        for (int j = 0; j < member_outer.height_px; ++j) {
-            for (int i = 0; i < member_outer.width_px; ++i) {
-                const WarpSample s =
-                    warp.map(member_outer.rect.x0 + (i + 0.5) * member_outer.scale,
-                             member_outer.rect.y0 + (j + 0.5) * member_outer.scale);
-                sampleBilinear(shared, (s.px - shared_rect.rect.x0) / shared_rect.scale,
-                               (s.py - shared_rect.rect.y0) / shared_rect.scale, &out.at(i, j, 0));
-            }
-        }
+        warpSharedLayer(shared, shared_rect, member_rect, out, profile, shared_orientation,
+                        member_orientation);
         return;
     }
     PeripheryGrid g;
@@ -198,7 +220,7 @@ void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
     g.scale = shared_rect.scale;
     g.width_px = shared.width();
     g.height_px = shared.height();
-    reduceToOuter(shared, g, member_outer, out);
+    reduceToOuter(shared, g, member_rect, out);
 }
 
 nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame) {
