@@ -304,9 +304,11 @@ bool SharedPeriphery::dueLocked(const Session& s, size_t slot) const {
     return !s.verdict[slot] || s.frames_since_measure[slot] > m_config.remeasure_frames;
 }
 
-bool SharedPeriphery::anyDueLocked(const std::vector<Id>& group, size_t slot) const {
-    return std::any_of(group.begin(), group.end(),
-                       [&](Id x) { return dueLocked(m_sessions.at(x), slot); });
+bool SharedPeriphery::anyTakerLocked(const std::vector<Id>& group, Id id, size_t slot) const {
+    return std::any_of(group.begin(), group.end(), [&](Id x) {
+        const Session& s = m_sessions.at(x);
+        return x != id && (dueLocked(s, slot) || s.verdict[slot].value_or(false));
+    });
 }
 
 bool SharedPeriphery::usableLocked(const Entry& entry, Id id, Eye eye, LayerKind kind,
@@ -363,9 +365,8 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
         } else if (best && (m_config.mode == SharePeripheryMode::kOn || *me.verdict[slot])) {
             d.action = Action::kReuse;
             ++m_stats.of(kind).reused;
-        } else if (m_config.mode == SharePeripheryMode::kAuto && me.verdict[slot] == false &&
-                   !anyDueLocked(group, slot)) {
-            return d;  // it does not share, and nobody needs its render to measure against
+        } else if (m_config.mode == SharePeripheryMode::kAuto && !anyTakerLocked(group, id, slot)) {
+            return d;  // no other member would take a group render (its gate failed, not due)
         } else {
             std::vector<LayerPlan> plans = {plan};
             for (Id other : group)

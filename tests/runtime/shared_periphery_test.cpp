@@ -191,7 +191,12 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
                 {{50.0, 60.0, 0.95, 100}, {60.0, 70.0, 0.5, 100}});
     sp.store(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), shared, layer);
     EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
-              A::kRenderShared);
+              A::kRenderShared);  // for headset 1, whose measurement is due
+    // Headset 1 passes, headset 2 failed: nobody would take 1's group render, so it renders its
+    // own layer, not the larger group one.
+    sp.measured(1, Eye::kLeft, LayerKind::kOuter, {{50.0, 60.0, 0.95, 100}});
+    EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), plan, profile, holes).action,
+              A::kOwn);
     // Far apart: each its own.
     sp.noteRequest(2, yawed(30.0), plan);
     EXPECT_EQ(sp.decide(2, Eye::kLeft, LayerKind::kOuter, yawed(30.0), plan, profile, holes).action,
@@ -205,7 +210,7 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
     EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kOuter, yawed(1.0), plan, profile, holes).action,
               A::kOwn);
     const SharePeripheryStats s = sp.stats();
-    EXPECT_EQ(s.measurements, 2u);
+    EXPECT_EQ(s.measurements, 3u);
     EXPECT_EQ(s.measurements_failed, 1u);
     EXPECT_EQ(s.outer.reused, 1u);
     EXPECT_EQ(s.middle.reused + s.middle.shared + s.middle.own, 0u);

@@ -179,7 +179,8 @@ private:
     // whose gaze is close to its own.
     std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
     bool dueLocked(const Session& s, size_t slot) const;  // a measurement is due
-    bool anyDueLocked(const std::vector<Id>& group, size_t slot) const;
+    // Another member of the group would take a group render: its gate passed or is due.
+    bool anyTakerLocked(const std::vector<Id>& group, Id id, size_t slot) const;
     // Another member's render this headset can take: close pose, covering its layer at least as
     // finely, a hole no larger than its own (and about the same gaze), not given to it yet.
     bool usableLocked(const Entry& entry, Id id, Eye eye, LayerKind kind, const Pose& pose,
