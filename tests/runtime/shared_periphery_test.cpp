@@ -2,6 +2,7 @@
 #include "qvr/runtime/shared_periphery.h"
 
 #include <cmath>
+#include <memory>
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -34,6 +35,16 @@ Pose yawed(double yaw_deg, float x_m = 0.0f) {
     p.orientation = quatFromEulerDeg({yaw_deg, 0.0, 0.0});
     p.position_m.x = x_m;
     return p;
+}
+
+// A sharing state in `mode` with headsets 1 and 2 connected.
+std::unique_ptr<SharedPeriphery> twoHeadsets(SharePeripheryMode mode) {
+    SharePeripheryConfig c;
+    c.mode = mode;
+    auto sp = std::make_unique<SharedPeriphery>(c);
+    sp->join(1);
+    sp->join(2);
+    return sp;
 }
 
 TEST(SharedPeriphery, GroupsPosesCloseToTheirLeader) {
@@ -160,12 +171,9 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
     const HmdProfile profile = smallProfile();
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
     const LayerHoles holes{.enabled = true};
-    SharePeripheryConfig c;
-    c.mode = SharePeripheryMode::kAuto;
-    SharedPeriphery sp(c);
+    auto shared_periphery = twoHeadsets(SharePeripheryMode::kAuto);
+    SharedPeriphery& sp = *shared_periphery;
     using A = SharedPeriphery::Action;
-    sp.join(1);
-    sp.join(2);
     sp.noteRequest(1, yawed(0.0), plan);
     EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kOuter, yawed(0.0), plan, profile, holes).action,
               A::kOwn);
@@ -228,12 +236,9 @@ TEST(SharedPeriphery, SharesTheMiddleLayerOnlyBetweenCloseGazes) {
     const LayerPlan near = planner.plan({0.5, 0.0}, 10.0);
     const LayerPlan far = planner.plan({6.0, 0.0}, 10.0);
     const LayerHoles holes{.enabled = true};
-    SharePeripheryConfig c;
-    c.mode = SharePeripheryMode::kOn;
-    SharedPeriphery sp(c);
+    auto shared_periphery = twoHeadsets(SharePeripheryMode::kOn);
+    SharedPeriphery& sp = *shared_periphery;
     using A = SharedPeriphery::Action;
-    sp.join(1);
-    sp.join(2);
     sp.noteRequest(1, Pose{}, a);
     sp.noteRequest(2, Pose{}, far);
     EXPECT_EQ(sp.decide(1, Eye::kLeft, LayerKind::kMiddle, Pose{}, a, profile, holes).action,
@@ -264,11 +269,8 @@ TEST(SharedPeriphery, SharesTheMiddleLayerOnlyBetweenCloseGazes) {
 TEST(SharedPeriphery, NeverHandsOnARenderWithALargerHole) {
     const HmdProfile profile = smallProfile();
     const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
-    SharePeripheryConfig c;
-    c.mode = SharePeripheryMode::kOn;
-    SharedPeriphery sp(c);
-    sp.join(1);
-    sp.join(2);
+    auto shared_periphery = twoHeadsets(SharePeripheryMode::kOn);
+    SharedPeriphery& sp = *shared_periphery;
     sp.noteRequest(1, Pose{}, plan);
     sp.noteRequest(2, Pose{}, plan);
     const LayerRect& r = plan.eyes[0].middle;
