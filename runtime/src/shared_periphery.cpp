@@ -73,15 +73,15 @@ std::vector<BandSsim> layerSsimByBand(const HmdProfile& profile, const LayerPlan
                                       double hide_below_deg) {
     QVR_CHECK(band_deg >= 1.0);
     QVR_CHECK(shared.width() == own.width() && shared.height() == own.height());
-    const LayerRect& outer = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
+    const LayerRect& layer = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
     const EyeGeometry geometry(profile);
     const int bands = static_cast<int>(std::ceil(180.0 / band_deg));
     std::vector<uint8_t> labels(static_cast<size_t>(own.width()) * size_t(own.height()), 0);
     for (int j = 0; j < own.height(); ++j) {
         for (int i = 0; i < own.width(); ++i) {
             const double e_deg =
-                geometry.eccentricityDeg(plan.gaze, outer.rect.x0 + (i + 0.5) * outer.scale,
-                                         outer.rect.y0 + (j + 0.5) * outer.scale);
+                geometry.eccentricityDeg(plan.gaze, layer.rect.x0 + (i + 0.5) * layer.scale,
+                                         layer.rect.y0 + (j + 0.5) * layer.scale);
             if (e_deg < hide_below_deg)
                 continue;
             labels[size_t(j) * size_t(own.width()) + size_t(i)] =
