@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <tuple>
 
 #include <glm/geometric.hpp>
@@ -109,7 +110,47 @@ LayerRect& mutableLayerOf(EyeLayers& layers, LayerKind kind) {
     return kind == LayerKind::kMiddle ? layers.middle : layers.outer;
 }
 
+// The rotation between two orientations of the eye without the lens, which the layers do not have.
+EyeWarp flatWarp(const HmdProfile& profile, const glm::quat& render, const glm::quat& member) {
+    HmdProfile flat = profile;
+    flat.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
+    return EyeWarp(flat, render, member);
+}
+
+PixelRect unite(const PixelRect& a, const PixelRect& b) {
+    return {std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)};
+}
+
 }  // namespace
+
+PixelRect rotatedRect(const HmdProfile& profile, const PixelRect& rect, const glm::quat& render,
+                      const glm::quat& member) {
+    if (rect.empty() || angleBetweenDeg(render, member) <= 1e-6)
+        return rect;
+    const EyeWarp warp = flatWarp(profile, render, member);
+    // A rotation bends straight edges: their images are bounded by enough points along them.
+    constexpr int kSteps = 16;
+    double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+    auto take = [&](double x, double y) {
+        const glm::dvec3 r = warp.rotation() * glm::dvec3((x - warp.cx()) / warp.fx(),
+                                                          -(y - warp.cy()) / warp.fy(), -1.0);
+        const double depth = std::max(-r.z, 1e-6);  // behind the eye: unbounded
+        const double u = warp.cx() + warp.fx() * r.x / depth;
+        const double v = warp.cy() - warp.fy() * r.y / depth;
+        x0 = std::min(x0, u), x1 = std::max(x1, u), y0 = std::min(y0, v), y1 = std::max(y1, v);
+    };
+    for (int k = 0; k <= kSteps; ++k) {
+        const double t = double(k) / kSteps;
+        const double x = rect.x0 + t * rect.width(), y = rect.y0 + t * rect.height();
+        take(x, rect.y0), take(x, rect.y1), take(rect.x0, y), take(rect.x1, y);
+    }
+    constexpr double kLimit = 1e7;  // pixels: far beyond any image
+    auto px = [&](double v, bool up) {
+        v = std::clamp(v, -kLimit, kLimit);
+        return static_cast<int>(up ? std::ceil(v - 1e-6) : std::floor(v + 1e-6));
+    };
+    return {px(x0, false), px(y0, false), px(x1, true), px(y1, true)};
+}
 
 SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
                             Eye eye, LayerKind kind, const LayerHoles& holes, double margin_deg) {
@@ -135,10 +176,18 @@ SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPl
         if (!same_gaze)
             s.holes.enabled = false;  // their holes are different discs
     }
-    // Beyond the image by the rotation a member may be off, so its reprojection stays inside.
-    const int margin_px = static_cast<int>(std::ceil(margin_deg / profile.pixelAngleDeg()));
-    u.rect = {u.rect.x0 - margin_px, u.rect.y0 - margin_px, u.rect.x1 + margin_px,
-              u.rect.y1 + margin_px};
+    // What a member rotated by up to margin_deg either way sees, so its reprojection stays inside
+    // (eight directions; one rotated further is refused by usableLocked's exact check).
+    if (margin_deg > 0.0 && !u.empty()) {
+        const PixelRect r = u.rect;
+        const glm::quat identity(1.0f, 0.0f, 0.0f, 0.0f);
+        for (int k = 0; k < 8; ++k) {
+            const double a = k * std::numbers::pi / 4.0;
+            const glm::quat q =
+                quatFromEulerDeg({margin_deg * std::cos(a), margin_deg * std::sin(a), 0.0});
+            u.rect = unite(u.rect, rotatedRect(profile, r, identity, q));
+        }
+    }
     u.width_px = static_cast<int>(std::ceil(u.rect.width() / u.scale - 1e-9));
     u.height_px = static_cast<int>(std::ceil(u.rect.height() / u.scale - 1e-9));
     (kind == LayerKind::kMiddle ? s.plan.s1 : s.plan.s2) = u.scale;
@@ -159,9 +208,7 @@ namespace {
 void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                      const LayerRect& member, ImageRgba8& out, const HmdProfile& profile,
                      const glm::quat& shared_orientation, const glm::quat& member_orientation) {
-    HmdProfile flat = profile;
-    flat.lens = LensProfile{0.0, 0.0, 1.0, 1.0};
-    const EyeWarp warp(flat, shared_orientation, member_orientation);
+    const EyeWarp warp = flatWarp(profile, shared_orientation, member_orientation);
     const glm::dmat3& rot = warp.rotation();
     out.resize(member.width_px, member.height_px);
     // A member texel (i, j) is the eye-space ray d = (xt, yt, -1), affine in (i, j).
@@ -317,7 +364,9 @@ bool SharedPeriphery::usableLocked(const Entry& entry, Id id, Eye eye, LayerKind
     const LayerRect& mine = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
     const LayerRect& theirs = layerOf(entry.shared.plan.eyes[static_cast<size_t>(eye)], kind);
     if (entry.consumed.contains(id) || !posesClose(entry.pose, pose, m_config) ||
-        !theirs.rect.contains(mine.rect) || theirs.scale > mine.scale + 1e-9)
+        theirs.scale > mine.scale + 1e-9 ||
+        !theirs.rect.contains(
+            rotatedRect(profile, mine.rect, entry.pose.orientation, pose.orientation)))
         return false;
     if (kind == LayerKind::kMiddle && !gazesClose(entry.shared.plan.gaze, plan.gaze, m_config))
         return false;
@@ -350,14 +399,20 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
             return d;
         Session& me = self->second;
         ++me.frames_since_measure[slot];
-        // The newest usable shared render of another member.
+        // The usable shared render of another member nearest in orientation (of equals, the
+        // newest): members that play one motion a few frames apart find the one of their pose.
         Entry* best = nullptr;
+        double best_deg = 0.0;
         for (Id other : group) {
-            auto& entry = m_sessions[other].entries[slot];
-            if (other != id && entry &&
-                usableLocked(*entry, id, eye, kind, pose, plan, profile, holes) &&
-                (!best || entry->serial > best->serial))
-                best = &*entry;
+            if (other == id)
+                continue;
+            for (Entry& entry : m_sessions[other].entries[slot]) {
+                if (!usableLocked(entry, id, eye, kind, pose, plan, profile, holes))
+                    continue;
+                const double deg = angleBetweenDeg(entry.pose.orientation, pose.orientation);
+                if (!best || deg < best_deg || (deg == best_deg && entry.serial > best->serial))
+                    best = &entry, best_deg = deg;
+            }
         }
         const bool due = dueLocked(me, slot);
         if (best && m_config.mode == SharePeripheryMode::kAuto && due) {
@@ -393,8 +448,11 @@ void SharedPeriphery::store(Id renderer, Eye eye, LayerKind kind, const Pose& po
     auto it = m_sessions.find(renderer);
     if (it == m_sessions.end())
         return;
-    it->second.entries[slotOf(kind, eye)] =
-        Entry{pose, shared, std::make_shared<const ImageRgba8>(std::move(image)), {}, ++m_serial};
+    std::deque<Entry>& kept = it->second.entries[slotOf(kind, eye)];
+    kept.push_back(
+        Entry{pose, shared, std::make_shared<const ImageRgba8>(std::move(image)), {}, ++m_serial});
+    while (kept.size() > kRendersKept)
+        kept.pop_front();
 }
 
 void SharedPeriphery::measured(Id id, Eye eye, LayerKind kind, const std::vector<BandSsim>& bands) {

@@ -1,6 +1,7 @@
 // Shared periphery: grouping by pose and gaze, the group's layer and the SSIM gate by band.
 #include "qvr/runtime/shared_periphery.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -143,6 +144,61 @@ TEST(SharedPeriphery, ReprojectsTheSharedRenderToTheMembersOrientation) {
     const double err = test::meanAbsDiff(reprojected, truth);
     EXPECT_LT(err, 0.6);
     EXPECT_GT(test::meanAbsDiff(unmoved, truth), 3.0 * err);
+}
+
+TEST(SharedPeriphery, RotatedRectIsWhatTheOtherOrientationSees) {
+    const HmdProfile profile = smallProfile();
+    const PixelRect r{100, 120, 200, 220};
+    const glm::quat a = quatFromEulerDeg({0.0, 0.0, 0.0});
+    EXPECT_EQ(rotatedRect(profile, r, a, a), r);
+    // A member turned 2° left of the render: its rect lies ~2° left in the render's image (more
+    // pixels than 2° of the mean pixel angle: a pinhole's pixels are finest at the centre),
+    // about as large, at the same height.
+    const PixelRect m = rotatedRect(profile, r, a, quatFromEulerDeg({2.0, 0.0, 0.0}));
+    const double shift_px = (r.x0 + r.x1) / 2.0 - (m.x0 + m.x1) / 2.0;
+    EXPECT_GT(shift_px, 0.9 * 2.0 / profile.pixelAngleDeg());
+    EXPECT_LT(shift_px, 1.5 * 2.0 / profile.pixelAngleDeg());
+    EXPECT_NEAR((m.y0 + m.y1) / 2.0, (r.y0 + r.y1) / 2.0, 2.0);
+    EXPECT_NEAR(m.width(), r.width(), 0.1 * r.width());
+}
+
+ImageRgba8 flatImage(const LayerRect& r, uint8_t value) {
+    ImageRgba8 img;
+    img.resize(r.width_px, r.height_px);
+    std::fill(img.data(), img.data() + size_t(r.width_px) * size_t(r.height_px) * 4, value);
+    return img;
+}
+
+// Members that play one motion a few frames apart: each takes the kept render nearest its own
+// orientation, and never one that does not cover its layer as rotated to the render's.
+TEST(SharedPeriphery, TakesTheNearestKeptRenderThatCoversIt) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    auto shared_periphery = twoHeadsets(SharePeripheryMode::kOn);
+    SharedPeriphery& sp = *shared_periphery;
+    const Eye l = Eye::kLeft;
+    const LayerKind mid = LayerKind::kMiddle;
+    sp.noteRequest(1, yawed(0.0), plan);
+    sp.noteRequest(2, yawed(0.0), plan);
+    const SharedLayer wide = sharedLayerPlan(profile, {plan}, l, mid, {}, 3.0);
+    for (int k = 0; k <= 4; ++k)  // five renders at 0.5° steps: the first is not kept
+        sp.store(1, l, mid, yawed(0.5 * k), wide, flatImage(wide.plan.eyes[0].middle, 10 * k));
+    for (double yaw : {1.1, 0.0}) {
+        const auto d = sp.decide(2, l, mid, yawed(yaw), plan, profile, {});
+        ASSERT_EQ(d.action, SharedPeriphery::Action::kReuse) << yaw;
+        const int nearest = std::max(1, static_cast<int>(std::lround(yaw / 0.5)));
+        EXPECT_EQ(d.image.at(3, 3, 0), 10 * nearest) << yaw;
+    }
+    // A render without a margin does not cover a member turned 2° from it.
+    const SharedLayer tight = sharedLayerPlan(profile, {plan}, l, mid, {}, 0.0);
+    sp.forget(1);
+    sp.join(1);
+    sp.noteRequest(1, yawed(0.0), plan);
+    sp.store(1, l, mid, yawed(0.0), tight, flatImage(tight.plan.eyes[0].middle, 7));
+    EXPECT_EQ(sp.decide(2, l, mid, yawed(2.0), plan, profile, {}).action,
+              SharedPeriphery::Action::kRenderShared);
+    EXPECT_EQ(sp.decide(2, l, mid, yawed(0.0), plan, profile, {}).action,
+              SharedPeriphery::Action::kReuse);
 }
 
 TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -39,6 +40,7 @@ struct SharePeripheryConfig {
     SharePeripheryMode mode = SharePeripheryMode::kOff;
     // Poses this close are candidates: the member's UCA takes a shared layer as rendered at its
     // own pose, so the difference shows as misregistration (the SSIM measures what it costs).
+    // Also the group layer's margin: what a member this far off brings into view.
     double max_angle_deg = 3.0;
     double max_position_m = 0.10;
     // The middle layer is centred on the gaze: it is shared only among headsets whose gazes are
@@ -80,8 +82,14 @@ std::vector<BandSsim> layerSsimByBand(const HmdProfile& profile, const LayerPlan
                                       double hide_below_deg);
 bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim);
 
+// The bounds, in an eye image seen from orientation `render`, of `rect` in the eye image seen from
+// `member` (a flat pinhole rotation of its edges): what a render at `render` must cover for the
+// member to take it. `rect` itself when the two are the same.
+PixelRect rotatedRect(const HmdProfile& profile, const PixelRect& rect, const glm::quat& render,
+                      const glm::quat& member);
+
 // The layer `kind` the group renders for one eye: the union of its members' rectangles, widened
-// by margin_deg beyond each edge (what a member's rotation may bring into view), at the finest
+// to what a rotation of margin_deg either way brings into view (rotatedRect), at the finest
 // of their sampling scales, with the plan (gaze, e1 or e2) whose hole every member can take
 // (holes off when the members' gazes differ).
 struct SharedLayer {
@@ -125,7 +133,7 @@ struct SharePeripheryStats {
 nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame);
 
 // The server's sharing state, thread-safe: the sessions' latest poses and plans, the newest
-// shared layer each session rendered per layer and eye, each session's SSIM verdicts.
+// shared layers each session rendered per layer and eye, each session's SSIM verdicts.
 class SharedPeriphery {
 public:
     using Id = uint64_t;
@@ -168,13 +176,16 @@ private:
         Pose pose;
         LayerPlan plan;
         bool posed = false;  // a request noted
-        // Per slot (layer and eye, slotOf): its newest shared render, whether the last
-        // measurement passed, and the frames since.
-        std::array<std::optional<Entry>, 4> entries;
+        // Per slot (layer and eye, slotOf): its newest kRendersKept shared renders, whether the
+        // last measurement passed, and the frames since.
+        std::array<std::deque<Entry>, 4> entries;
         std::array<std::optional<bool>, 4> verdict;
         std::array<int, 4> frames_since_measure{};
     };
     static size_t slotOf(LayerKind kind, Eye eye);
+    // Renders kept per session and slot: a member a few frames behind another takes the one of
+    // its own pose (bounded: at most 4 × 4 layers per session in memory).
+    static constexpr size_t kRendersKept = 4;
     // The members `id` shares layer `kind` with: its pose group, for the middle layer only those
     // whose gaze is close to its own.
     std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
