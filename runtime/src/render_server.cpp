@@ -11,6 +11,8 @@
 #include <mutex>
 #include <thread>
 
+#include <sys/resource.h>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -19,6 +21,20 @@
 #include "qvr/runtime/affinity.h"
 
 namespace qvr::runtime {
+
+namespace {
+
+// The process's CPU time so far, every thread, user and system.
+double processCpuMs() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    const auto ms = [](const timeval& t) {
+        return double(t.tv_sec) * 1e3 + double(t.tv_usec) * 1e-3;
+    };
+    return ms(u.ru_utime) + ms(u.ru_stime);
+}
+
+}  // namespace
 
 RendererFactory glRendererFactory(GlRendererOptions options) {
     return [options]() -> Expected<std::unique_ptr<Renderer>> {
@@ -91,6 +107,7 @@ nlohmann::json serverPoolJson(const RenderServerStats& s) {
         frames += double(x.frames_rendered);
     }
     return {{"workers", s.workers},
+            {"cpu_ms_per_frame", s.cpu_ms_per_frame},
             {"admission",
              {{"min_fps", s.min_fps},
               {"frame_cost_ms", s.frame_cost_ms},
@@ -163,7 +180,8 @@ struct RenderServer::Impl final : net::ServerHandler {
     net::ClientId last_served = 0;
     bool stopping = false;
     RenderServerStats stats;
-    std::deque<ServerFrameRecord> records;  // guarded by mutex
+    double cpu_ms_first_frame = 0.0, cpu_ms_last_frame = 0.0;  // processCpuMs() at their ends
+    std::deque<ServerFrameRecord> records;                     // guarded by mutex
     // The measured service time per headset-frame: the mean of the first measure_frames, then
     // a moving average over about as many.
     uint64_t cost_frames = 0;
@@ -556,6 +574,8 @@ struct RenderServer::Impl final : net::ServerHandler {
         while (records.size() > config.max_frame_records)
             records.pop_front();
         ++stats.frames_rendered;
+        // CPU time from the end of the first frame (lazy start-up) to the end of the last.
+        (stats.frames_rendered == 1 ? cpu_ms_first_frame : cpu_ms_last_frame) = processCpuMs();
         stats.layers_rendered += delta.layers_rendered;
         stats.periphery_passes += delta.periphery_passes;
         stats.streams_sent += delta.streams_sent;
@@ -657,6 +677,9 @@ RenderServerStats RenderServer::stats() const {
         s.frame_cost_ms = cost_ms;
         s.frame_cost_source = source;
         s.min_fps = m.config.admission.min_fps;
+        if (s.frames_rendered > 1)
+            s.cpu_ms_per_frame =
+                (m.cpu_ms_last_frame - m.cpu_ms_first_frame) / double(s.frames_rendered - 1);
         const int64_t now_ns = m.clock->nowNs();
         for (const auto& x : m.sessions) {
             SessionStats st = x->stats;

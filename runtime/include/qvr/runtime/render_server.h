@@ -161,6 +161,10 @@ struct RenderServerStats {
     double encode_ms_total = 0.0;
     double send_ms_total = 0.0;
     int workers = 0;
+    // The process's CPU time (user + system, every thread: workers, the renderer's, the
+    // transport's) per frame served, from the end of the first frame to the end of the last: the
+    // cost that wall-clock service times overstate when workers contend for cores.
+    double cpu_ms_per_frame = 0.0;
     // What admission knew when asked: the cost per headset-frame and where it came from
     // ("calibration", "measured" or "none").
     double frame_cost_ms = 0.0;
@@ -175,7 +179,7 @@ struct RenderServerStats {
 inline constexpr size_t kMaxEndedSessions = 256;
 
 // The pool, admission and per-session counters as the server's stats JSON carries them:
-// {"workers", "admission": {"min_fps", "frame_cost_ms", "frame_cost_source",
+// {"workers", "cpu_ms_per_frame", "admission": {"min_fps", "frame_cost_ms", "frame_cost_source",
 // "refused_capacity"}, "sessions": [{"client", "connected", "connected_s", "frames_requested",
 // "frames_dropped", "frames_rendered", "frames_encoded", "frames_sent", "fps_sent",
 // "streams_sent", "stream_send_failures", "render_ms_mean", "encode_ms_mean",
