@@ -162,8 +162,8 @@ struct RenderServerStats {
     double send_ms_total = 0.0;
     int workers = 0;
     // The process's CPU time (user + system, every thread: workers, the renderer's, the
-    // transport's) per frame served, from the end of the first frame to the end of the last: the
-    // cost that wall-clock service times overstate when workers contend for cores.
+    // transport's) per frame served, from the end of the first frame to the end of the last:
+    // beside the wall-clock service times, which would overstate it were workers kept waiting.
     double cpu_ms_per_frame = 0.0;
     // What admission knew when asked: the cost per headset-frame and where it came from
     // ("calibration", "measured" or "none").
