@@ -198,7 +198,9 @@ TEST(RenderServerPool, SessionsShareASaturatedWorkerFairly) {
     std::vector<double> rendered;
     for (const SessionStats& x : s.sessions) {
         EXPECT_GE(x.frames_rendered, kRatesMeasurable ? 3u : 1u);
-        EXPECT_GT(x.frames_dropped, 0u);  // saturated: its queue overflowed
+        if (kRatesMeasurable) {
+            EXPECT_GT(x.frames_dropped, 0u);  // saturated: its queue overflowed
+        }
         EXPECT_LE(x.frames_sent, x.frames_encoded);
         EXPECT_LE(x.frames_encoded, x.frames_rendered);
         EXPECT_LE(x.frames_rendered + x.frames_dropped, x.frames_requested);
