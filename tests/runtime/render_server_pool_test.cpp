@@ -237,12 +237,16 @@ TEST(RenderServerPool, WorkersServeSessionsAtOnce) {
                 records[i].start_ns < records[j].done_ns)
                 ++overlaps;
     EXPECT_GE(overlaps, int(s.frames_rendered / 4)) << s.frames_rendered << " frames";
-    // The renders sleep: the process's CPU time per frame is some encoding, not their 20 ms.
+    // The renders sleep: the process's CPU time per frame (the fake headsets' threads here too)
+    // is some encoding and sealing, not their 20 ms — a rate, so not under TSan, where that
+    // CPU part alone takes longer.
     double service_ms = 0.0;
     for (const SessionStats& x : s.sessions)
         service_ms += x.service_ms_total;
     EXPECT_GT(s.cpu_ms_per_frame, 0.0);
-    EXPECT_LT(s.cpu_ms_per_frame, service_ms / double(s.frames_rendered));
+    if (kRatesMeasurable) {
+        EXPECT_LT(s.cpu_ms_per_frame, service_ms / double(s.frames_rendered));
+    }
     EXPECT_DOUBLE_EQ(serverPoolJson(s)["cpu_ms_per_frame"].get<double>(), s.cpu_ms_per_frame);
 }
 
