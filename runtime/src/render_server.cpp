@@ -568,6 +568,7 @@ struct RenderServer::Impl final : net::ServerHandler {
     // Keeps the frame's record and adds its counts to the server's and its session's.
     void record(const Work& w) {
         const RenderServerStats& delta = w.delta;
+        const double cpu_ms = processCpuMs();  // a system call: outside the server's lock
         std::lock_guard lock(mutex);
         if (config.max_frame_records > 0)
             records.push_back(w.rec);
@@ -575,7 +576,7 @@ struct RenderServer::Impl final : net::ServerHandler {
             records.pop_front();
         ++stats.frames_rendered;
         // CPU time from the end of the first frame (lazy start-up) to the end of the last.
-        (stats.frames_rendered == 1 ? cpu_ms_first_frame : cpu_ms_last_frame) = processCpuMs();
+        (stats.frames_rendered == 1 ? cpu_ms_first_frame : cpu_ms_last_frame) = cpu_ms;
         stats.layers_rendered += delta.layers_rendered;
         stats.periphery_passes += delta.periphery_passes;
         stats.streams_sent += delta.streams_sent;

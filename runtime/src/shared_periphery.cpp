@@ -166,8 +166,7 @@ SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPl
         if (u.empty()) {
             u = o;
         } else {
-            u.rect = {std::min(u.rect.x0, o.rect.x0), std::min(u.rect.y0, o.rect.y0),
-                      std::max(u.rect.x1, o.rect.x1), std::max(u.rect.y1, o.rect.y1)};
+            u.rect = unite(u.rect, o.rect);
             u.scale = std::min(u.scale, o.scale);
         }
         min_hole_deg = std::min(min_hole_deg, layerHoleDeg(profile, m, eye, kind, holes));
