@@ -739,6 +739,8 @@ private:
             t->shown_frame = static_cast<int64_t>(report->frame_index);
             t->warp_deg = report->warp_deg;
             m_last_shown = t->shown_frame;
+            if (m_first_composed_frame < 0)
+                m_first_composed_frame = prep.frame;
         }
         t->throughput_bps = m_client ? m_client->throughputBps() : 0.0;
         const int64_t vsync_wait_start_ns = m_clock.nowNs();
@@ -773,11 +775,8 @@ private:
         // fovea render (LIWC's GPU fit takes the fixed part as its intercept).
         m.t_local_ms = m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
         m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
-        if (i < static_cast<int64_t>(m_depth)) {
-            // The frames requested before any completed are the session's start-up (the
-            // server's first renders and key frames, first use of every code path), not what
-            // the next frames will cost: no timing from them reaches the policy's fits (one
-            // 80–140 ms start-up frame biased LIWC's 32-frame window by ~15 ms).
+        if (isStartUpFrame(i, static_cast<int64_t>(m_depth), t->remote_requested,
+                           m_first_composed_frame)) {
             m.t_local_ms = 0.0;
             m.t_remote_ms = 0.0;
         }
@@ -838,6 +837,7 @@ private:
     int64_t m_origin_ns = 0;
     int64_t m_last_connect_try_ns = 0;
     int64_t m_last_shown = -1;
+    int64_t m_first_composed_frame = -1;  // the first frame UCA composed from layers
     int64_t m_last_complete_rx_ns = 0;
     SilenceDetector m_silence;  // the newest streams from the server, or the session's start
     int64_t m_idle_ns = 0;      // waiting for the network or vsync since the last frame finished

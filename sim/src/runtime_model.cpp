@@ -314,6 +314,7 @@ private:
     // Server and link.
     std::deque<Request> m_queue;
     double m_server_free = 0.0, m_link_free = 0.0, m_server_busy_total = 0.0;
+    int64_t m_first_composed = -1;  // the first frame composed from the server's layers
     int m_served_frames = 0;
     size_t m_next_undecoded = 0;
 };
@@ -678,6 +679,10 @@ void PassReplay::learn(int64_t i) {
     m.e1_deg = fs.plan.e1_deg;
     m.t_local_ms = m_depth > 1 && rf.headset_busy_ms > 0.0 ? rf.headset_busy_ms : rf.t_local_ms;
     m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
+    if (isStartUpFrame(i, static_cast<int64_t>(m_depth), rf.requested, m_first_composed)) {
+        m.t_local_ms = 0.0;
+        m.t_remote_ms = 0.0;
+    }
     m.triangles_local = sumWithinDeg(wf.triangles_per_ring, m_header.ring_deg, fs.plan.e1_deg);
     m.pixels_local = sumWithinDeg(wf.pixels_per_ring, m_header.ring_deg, fs.plan.e1_deg);
     m.middle_bytes = fs.middle_bytes > 0 && fs.received_bytes > 0 ? fs.middle_bytes : 0;
@@ -701,6 +706,8 @@ void PassReplay::finish(int64_t i) {
     renderFovea(i);
     const bool have_current = m_state[static_cast<size_t>(i)].expected == 0 || waitForStreams(i);
     composeAndScanOut(i, have_current);
+    if (m_first_composed < 0 && m_state[static_cast<size_t>(i)].expected > 0 && have_current)
+        m_first_composed = i;
     if (m_policy && !m_local_only && !m_whole_frame)
         learn(i);
 }

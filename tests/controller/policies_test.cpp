@@ -49,6 +49,18 @@ FrameMeasurement remoteBound(int64_t index, double e1_deg) {
     return m;
 }
 
+// The start-up no policy learns from: the frames before any completed, and for frames that ask
+// the server for layers, every one up to the first composed from them — however late that is.
+TEST(StartUpFrame, LastsUntilTheFirstCompositionFromTheServersLayers) {
+    EXPECT_TRUE(isStartUpFrame(0, 2, false, -1));
+    EXPECT_TRUE(isStartUpFrame(1, 2, false, -1));
+    EXPECT_FALSE(isStartUpFrame(2, 2, false, -1));  // all local: only the pipeline's fill
+    EXPECT_TRUE(isStartUpFrame(5, 2, true, -1));    // no layers composed yet
+    EXPECT_TRUE(isStartUpFrame(3, 2, true, 3));     // the first composition itself
+    EXPECT_FALSE(isStartUpFrame(4, 2, true, 3));
+    EXPECT_TRUE(isStartUpFrame(1, 2, true, 0));  // composed early: the pipeline's fill still is
+}
+
 TEST(FixedPolicy, KeepsE1WhenFramesChange) {
     FixedPolicy fixed;
     EXPECT_EQ(fixed.name(), "fixed");
