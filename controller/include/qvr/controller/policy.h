@@ -45,13 +45,13 @@ struct FrameMeasurement {
 };
 
 // Whether a frame is the session's start-up, whose timing reaches no policy's fits (the runtime's
-// headset and its model alike; RunStats::warmup_frames counts the same start-up): the frames
-// requested before any completed (frame < depth) and, for a frame that asked the server for
-// layers, every frame up to the first UCA composed from them (first_composed < 0: none yet) —
-// the server's first renders and key frames, the first use of every code path. One 80–140 ms
-// start-up frame biased LIWC's 32-frame window by ~15 ms; the first composition alone took 450–580
-// ms at a quarter core (EPYC), and its frame taught LIWC's headset fit a slope that held e1 at 1°
-// for 60 frames (docs/LIWC.md "Fits").
+// headset and its model alike; RunStats::warmup_frames also leaves these frames out, and its
+// first --warmup-frames besides): the frames requested before any completed (frame < depth) and,
+// for a frame that asked the server for layers, every frame up to the first UCA composed from
+// them (first_composed < 0: none yet) — the server's first renders and key frames, the first use
+// of every code path. One 80–140 ms start-up frame biased LIWC's 32-frame window by ~15 ms; the
+// first composition alone took 450–580 ms at a quarter core (EPYC), and its frame taught LIWC's
+// headset fit a slope that held e1 at 1° for 60 frames (docs/LIWC.md "Fits").
 constexpr bool isStartUpFrame(int64_t frame, int64_t depth, bool remote_requested,
                               int64_t first_composed) {
     return frame < depth || (remote_requested && (first_composed < 0 || frame <= first_composed));
