@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <tuple>
 
@@ -153,21 +154,26 @@ PixelRect rotatedRect(const HmdProfile& profile, const PixelRect& rect, const gl
 }
 
 SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
-                            Eye eye, LayerKind kind, const LayerHoles& holes, double margin_deg) {
+                            Eye eye, LayerKind kind, const LayerHoles& holes, double margin_deg,
+                            const MemberViews& views) {
     QVR_CHECK(!members.empty() && isShareable(kind));
     const size_t e = static_cast<size_t>(eye);
     SharedLayer s{members.front(), holes};
     LayerRect& u = mutableLayerOf(s.plan.eyes[e], kind);
+    u.rect = PixelRect{};
     double min_hole_deg = 1e9;
-    for (const LayerPlan& m : members) {
+    for (size_t i = 0; i < members.size(); ++i) {
+        const LayerPlan& m = members[i];
         const LayerRect& o = layerOf(m.eyes[e], kind);
         if (o.empty())
             continue;
-        if (u.empty()) {
-            u = o;
-        } else {
-            u.rect = unite(u.rect, o.rect);
-            u.scale = std::min(u.scale, o.scale);
+        u.scale = u.rect.empty() ? o.scale : std::min(u.scale, o.scale);
+        const bool viewed = i < views.of.size() && !views.of[i].empty();
+        if (!viewed)
+            u.rect = u.rect.empty() ? o.rect : unite(u.rect, o.rect);
+        for (size_t k = 0; viewed && k < views.of[i].size(); ++k) {
+            const PixelRect seen = rotatedRect(profile, o.rect, views.render, views.of[i][k]);
+            u.rect = u.rect.empty() ? seen : unite(u.rect, seen);
         }
         min_hole_deg = std::min(min_hole_deg, layerHoleDeg(profile, m, eye, kind, holes));
         const bool same_gaze = std::fabs(m.gaze.x_deg - s.plan.gaze.x_deg) < 1e-6 &&
@@ -202,8 +208,10 @@ SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPl
 namespace {
 
 // The member's texel centres through the rotation to the shared render (UCA's map without the
-// lens, which the layers do not have): a flat pinhole rotation is a homography, so along a row
-// the rotated ray moves by a constant step and each texel costs one division and a bilinear tap.
+// lens, which the layers do not have). A flat pinhole rotation is a homography: its exact image is
+// taken every kSpan texels along a row and stepped linearly between (for rotations within the
+// grouping angle, the curve departs from its chord by far less than a hundredth of a texel over
+// a span), each texel a fixed-point bilinear tap.
 void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                      const LayerRect& member, ImageRgba8& out, const HmdProfile& profile,
                      const glm::quat& shared_orientation, const glm::quat& member_orientation) {
@@ -222,32 +230,70 @@ void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                  bx = (warp.cx() - shared_rect.rect.x0) / shared_rect.scale - 0.5;
     const double ay = warp.fy() / shared_rect.scale,
                  by = (warp.cy() - shared_rect.rect.y0) / shared_rect.scale - 0.5;
+    auto texel = [&](const glm::dvec3& r) {
+        const double depth = std::max(-r.z, 1e-9);
+        return glm::dvec2(bx + ax * r.x / depth, by - ay * r.y / depth);
+    };
     const int w = shared.width(), h = shared.height();
     const size_t stride = static_cast<size_t>(w) * 4;
     const uint8_t* src = shared.data();
+    constexpr int kSpan = 16;
+    constexpr double kOne = 65536.0;  // 16.16 fixed point
+    const int64_t max_x = int64_t(w - 1) << 16, max_y = int64_t(h - 1) << 16;
     for (int j = 0; j < member.height_px; ++j) {
-        glm::dvec3 r = r0 + double(j) * dj;
+        const glm::dvec3 row = r0 + double(j) * dj;
         uint8_t* dst = out.data() + static_cast<size_t>(j) * member.width_px * 4;
-        for (int i = 0; i < member.width_px; ++i, r += di, dst += 4) {
-            const double depth = std::max(-r.z, 1e-9);
-            const double x = std::clamp(bx + ax * r.x / depth, 0.0, double(w - 1));
-            const double y = std::clamp(by - ay * r.y / depth, 0.0, double(h - 1));
-            const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-            const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-            const float fx = float(x - x0), fy = float(y - y0);
-            const uint8_t* p00 = src + size_t(y0) * stride + size_t(x0) * 4;
-            const uint8_t* p10 = src + size_t(y0) * stride + size_t(x1) * 4;
-            const uint8_t* p01 = src + size_t(y1) * stride + size_t(x0) * 4;
-            const uint8_t* p11 = src + size_t(y1) * stride + size_t(x1) * 4;
-            for (int c = 0; c < 3; ++c) {
-                const float top = p00[c] + (p10[c] - p00[c]) * fx;
-                const float bottom = p01[c] + (p11[c] - p01[c]) * fx;
-                dst[c] =
-                    static_cast<uint8_t>(std::clamp(top + (bottom - top) * fy + 0.5f, 0.f, 255.f));
+        glm::dvec2 a = texel(row);
+        for (int i0 = 0; i0 < member.width_px; i0 += kSpan) {
+            const int n = std::min(kSpan, member.width_px - i0);
+            const glm::dvec2 b = texel(row + double(i0 + n) * di);
+            int64_t x = std::llround(a.x * kOne), y = std::llround(a.y * kOne);
+            const int64_t sx = std::llround((b.x - a.x) / n * kOne);
+            const int64_t sy = std::llround((b.y - a.y) / n * kOne);
+            for (int k = 0; k < n; ++k, x += sx, y += sy, dst += 4) {
+                const int64_t cx = std::clamp<int64_t>(x, 0, max_x);
+                const int64_t cy = std::clamp<int64_t>(y, 0, max_y);
+                const int x0 = int(cx >> 16), y0 = int(cy >> 16);
+                const uint32_t fx = uint32_t(cx >> 8) & 255u, fy = uint32_t(cy >> 8) & 255u;
+                const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+                const uint8_t* p00 = src + size_t(y0) * stride + size_t(x0) * 4;
+                const uint8_t* p10 = src + size_t(y0) * stride + size_t(x1) * 4;
+                const uint8_t* p01 = src + size_t(y1) * stride + size_t(x0) * 4;
+                const uint8_t* p11 = src + size_t(y1) * stride + size_t(x1) * 4;
+                for (int c = 0; c < 3; ++c) {
+                    const uint32_t top = p00[c] * (256u - fx) + p10[c] * fx;
+                    const uint32_t bottom = p01[c] * (256u - fx) + p11[c] * fx;
+                    dst[c] = uint8_t((top * (256u - fy) + bottom * fy + 32768u) >> 16);
+                }
+                dst[3] = 255;
             }
-            dst[3] = 255;
+            a = b;
         }
     }
+}
+
+// The member's layer cut out of the shared render: the same orientation and scale, and its
+// texels on the render's grid (a box filter of one texel is a copy).
+bool cropSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
+                     const LayerRect& member, ImageRgba8& out) {
+    if (std::fabs(shared_rect.scale - member.scale) > 1e-9)
+        return false;
+    const double ox = (member.rect.x0 - shared_rect.rect.x0) / shared_rect.scale;
+    const double oy = (member.rect.y0 - shared_rect.rect.y0) / shared_rect.scale;
+    const int x = static_cast<int>(std::lround(ox)), y = static_cast<int>(std::lround(oy));
+    if (std::fabs(ox - x) > 1e-9 || std::fabs(oy - y) > 1e-9 || x < 0 || y < 0 ||
+        x + member.width_px > shared.width() || y + member.height_px > shared.height())
+        return false;
+    out.resize(member.width_px, member.height_px);
+    const size_t row = static_cast<size_t>(member.width_px) * 4;
+    for (int j = 0; j < member.height_px; ++j) {
+        uint8_t* dst = out.data() + static_cast<size_t>(j) * row;
+        std::memcpy(dst, shared.data() + (static_cast<size_t>(y + j) * shared.width() + x) * 4,
+                    row);
+        for (size_t k = 3; k < row; k += 4)
+            dst[k] = 255;
+    }
+    return true;
 }
 
 }  // namespace
@@ -255,7 +301,11 @@ void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
 void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                        const LayerRect& member_rect, ImageRgba8& out, const HmdProfile& profile,
                        const glm::quat& shared_orientation, const glm::quat& member_orientation) {
-    if (angleBetweenDeg(shared_orientation, member_orientation) > 1e-6 && !shared.empty()) {
+    const bool turned = angleBetweenDeg(shared_orientation, member_orientation) > 1e-6;
+    if (!turned && cropSharedLayer(shared, shared_rect, member_rect, out))
+        return;
+    // At one scale, a box of one texel is the bilinear tap the warp takes.
+    if ((turned || std::fabs(shared_rect.scale - member_rect.scale) <= 1e-9) && !shared.empty()) {
         warpSharedLayer(shared, shared_rect, member_rect, out, profile, shared_orientation,
                         member_orientation);
         return;
@@ -270,6 +320,7 @@ void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
 }
 
 nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_ms_per_frame) {
+    const uint64_t shared = s.middle.shared + s.outer.shared;
     nlohmann::json bands = nlohmann::json::array();
     for (const SharePeripheryStats::Band& b : s.ssim_by_band)
         bands.push_back({{"layer", b.layer},
@@ -289,6 +340,9 @@ nlohmann::json sharePeripheryJson(const SharePeripheryStats& s, double service_m
             {"middle_layers_reused", s.middle.reused},
             {"measurements", s.measurements},
             {"measurements_failed", s.measurements_failed},
+            {"margin_deg_mean", shared ? s.margin_deg_sum / double(shared) : 0.0},
+            {"group_texels_per_own",
+             s.own_texels ? double(s.group_texels) / double(s.own_texels) : 0.0},
             {"service_ms_per_headset_frame", service_ms_per_frame},
             {"ssim_by_band", std::move(bands)}};
 }
@@ -309,9 +363,33 @@ void SharedPeriphery::noteRequest(Id id, const Pose& pose, const LayerPlan& plan
     auto it = m_sessions.find(id);
     if (it == m_sessions.end())
         return;  // gone while its frame was served
-    it->second.pose = pose;
-    it->second.plan = plan;
-    it->second.posed = true;
+    Session& s = it->second;
+    if (s.posed && s.previous) {
+        const std::vector<glm::quat> expected = expectedViews(s);
+        s.misses_deg.push_back(angleBetweenDeg(expected.back(), pose.orientation));
+        if (s.misses_deg.size() > kMissesKept)
+            s.misses_deg.pop_front();
+    }
+    if (s.posed)
+        s.previous = s.pose.orientation;
+    s.pose = pose;
+    s.plan = plan;
+    s.posed = true;
+}
+
+std::vector<glm::quat> SharedPeriphery::expectedViews(const Session& s) {
+    if (!s.previous)
+        return {s.pose.orientation};
+    // The turn between the two newest requests, once more (a constant angular velocity).
+    const glm::quat step = s.pose.orientation * glm::inverse(*s.previous);
+    return {s.pose.orientation, glm::normalize(step * s.pose.orientation)};
+}
+
+double SharedPeriphery::expectedMissDeg(const Session& s) const {
+    if (s.misses_deg.empty())
+        return m_config.max_angle_deg;
+    return std::min(m_config.max_angle_deg,
+                    *std::max_element(s.misses_deg.begin(), s.misses_deg.end()));
 }
 
 void SharedPeriphery::forget(Id id) {
@@ -422,13 +500,26 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
         } else if (m_config.mode == SharePeripheryMode::kAuto && !anyTakerLocked(group, id, slot)) {
             return d;  // no other member would take a group render (its gate failed, not due)
         } else {
+            // Rendered for where the others will look from when they take it, with the largest
+            // miss of that expectation as the margin.
             std::vector<LayerPlan> plans = {plan};
-            for (Id other : group)
-                if (other != id)
-                    plans.push_back(m_sessions[other].plan);
+            MemberViews views{pose.orientation, {{}}};
+            double margin_deg = 0.0;
+            for (Id other : group) {
+                if (other == id)
+                    continue;
+                const Session& s = m_sessions.at(other);
+                plans.push_back(s.plan);
+                views.of.push_back(expectedViews(s));
+                margin_deg = std::max(margin_deg, expectedMissDeg(s));
+            }
             d.action = Action::kRenderShared;
-            d.shared = sharedLayerPlan(profile, plans, eye, kind, holes, m_config.max_angle_deg);
+            d.shared = sharedLayerPlan(profile, plans, eye, kind, holes, margin_deg, views);
             ++m_stats.of(kind).shared;
+            m_stats.margin_deg_sum += margin_deg;
+            m_stats.group_texels +=
+                uint64_t(layerOf(d.shared.plan.eyes[size_t(eye)], kind).pixels());
+            m_stats.own_texels += uint64_t(layerOf(plan.eyes[size_t(eye)], kind).pixels());
             return d;
         }
         best->consumed.insert(id);

@@ -13,6 +13,7 @@
 #include "../render/render_test_util.h"
 #include "qvr/compose/test_pattern.h"
 #include "qvr/foveation/eye_geometry.h"
+#include "qvr/render/periphery_pass.h"
 #include "qvr/runtime/render_server.h"
 #include "qvr/runtime/session.h"
 
@@ -199,6 +200,73 @@ TEST(SharedPeriphery, TakesTheNearestKeptRenderThatCoversIt) {
               SharedPeriphery::Action::kRenderShared);
     EXPECT_EQ(sp.decide(2, l, mid, yawed(0.0), plan, profile, {}).action,
               SharedPeriphery::Action::kReuse);
+}
+
+// The group's render reaches where the others will look from, not a fixed angle every way: a
+// member turned 2° to one side widens it on that side only, and a member turning at a steady rate
+// is covered at its next request with no margin (its extrapolation never missed).
+TEST(SharedPeriphery, GroupRenderReachesWhereTheMembersWillLookFrom) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const Eye l = Eye::kLeft;
+    const LayerKind mid = LayerKind::kMiddle;
+    const PixelRect own = plan.eyes[0].middle.rect;
+    const glm::quat at0 = yawed(0.0).orientation, at2 = yawed(2.0).orientation;
+    const SharedLayer s =
+        sharedLayerPlan(profile, {plan, plan}, l, mid, {}, 0.0, MemberViews{at0, {{}, {at2}}});
+    const PixelRect u = s.plan.eyes[0].middle.rect;
+    EXPECT_TRUE(u.contains(own));
+    EXPECT_TRUE(u.contains(rotatedRect(profile, own, at0, at2)));
+    EXPECT_TRUE((u.x0 == own.x0) != (u.x1 == own.x1)) << "widened on one side only";
+    const SharedLayer every_way = sharedLayerPlan(profile, {plan}, l, mid, {}, 3.0);
+    EXPECT_LT(u.area(), every_way.plan.eyes[0].middle.rect.area());
+
+    auto sp = twoHeadsets(SharePeripheryMode::kOn);
+    for (int k = 0; k < 6; ++k)  // headset 2 turns 1° a request
+        sp->noteRequest(2, yawed(1.0 * k), plan);
+    sp->noteRequest(1, yawed(5.0), plan);
+    const auto d = sp->decide(1, l, mid, yawed(5.0), plan, profile, {});
+    ASSERT_EQ(d.action, SharedPeriphery::Action::kRenderShared);
+    EXPECT_LT(d.shared.plan.eyes[0].middle.rect.area(), every_way.plan.eyes[0].middle.rect.area());
+    EXPECT_NEAR(sp->stats().margin_deg_sum, 0.0, 1e-3);
+    sp->store(1, l, mid, yawed(5.0), d.shared, flatImage(d.shared.plan.eyes[0].middle, 9));
+    // 1.5° past the extrapolated 6°: not covered, so it renders anew (a 3° margin took it).
+    sp->noteRequest(2, yawed(7.5), plan);
+    EXPECT_EQ(sp->decide(2, l, mid, yawed(7.5), plan, profile, {}).action,
+              SharedPeriphery::Action::kRenderShared);
+    EXPECT_EQ(sp->decide(2, l, mid, yawed(6.0), plan, profile, {}).action,
+              SharedPeriphery::Action::kReuse);
+}
+
+// Handing the renderer its own layer out of the group's: at one orientation and scale a copy (on
+// the grid) or the one-texel box, which is the bilinear tap (off the grid).
+TEST(SharedPeriphery, ReducesAtOneScaleAsTheBoxFilterDoes) {
+    const HmdProfile profile = smallProfile();
+    const glm::quat q = yawed(0.0).orientation;
+    LayerRect shared;
+    shared.rect = {92, 76, 92 + 2 * 70, 76 + 2 * 50};
+    shared.scale = 2.0;
+    shared.width_px = 70;
+    shared.height_px = 50;
+    const ImageRgba8 image = testPattern(shared.width_px, shared.height_px);
+    PeripheryGrid g;
+    g.x0 = shared.rect.x0;
+    g.y0 = shared.rect.y0;
+    g.scale = shared.scale;
+    g.width_px = shared.width_px;
+    g.height_px = shared.height_px;
+    for (const int shift_px : {0, 1, 3}) {  // 0: on the group's grid; 1, 3: half a texel off
+        LayerRect member = shared;
+        member.rect = {100 + shift_px, 80, 100 + shift_px + 2 * 60, 80 + 2 * 40};
+        member.width_px = 60;
+        member.height_px = 40;
+        ImageRgba8 fast, box;
+        reduceSharedLayer(image, shared, member, fast, profile, q, q);
+        reduceToOuter(image, g, member, box);
+        ASSERT_EQ(fast.width(), box.width());
+        ASSERT_EQ(fast.height(), box.height());
+        EXPECT_LT(test::meanAbsDiff(fast, box), shift_px == 0 ? 1e-9 : 0.6) << shift_px;
+    }
 }
 
 TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {

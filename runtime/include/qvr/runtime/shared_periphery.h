@@ -88,17 +88,25 @@ bool bandsPass(const std::vector<BandSsim>& bands, double min_ssim);
 PixelRect rotatedRect(const HmdProfile& profile, const PixelRect& rect, const glm::quat& render,
                       const glm::quat& member);
 
-// The layer `kind` the group renders for one eye: the union of its members' rectangles, widened
-// to what a rotation of margin_deg either way brings into view (rotatedRect), at the finest
-// of their sampling scales, with the plan (gaze, e1 or e2) whose hole every member can take
-// (holes off when the members' gazes differ).
+// Where the group's members are expected to look from when they take its render: of[i] holds
+// member i's orientations (none: the render's own), `render` the render's orientation.
+struct MemberViews {
+    glm::quat render{1.0f, 0.0f, 0.0f, 0.0f};
+    std::vector<std::vector<glm::quat>> of;
+};
+
+// The layer `kind` the group renders for one eye: the union of its members' rectangles, each
+// as seen from the render's orientation when the member looks from each of its views
+// (rotatedRect), widened to what a rotation of margin_deg either way brings into view, at the
+// finest of their sampling scales, with the plan (gaze, e1 or e2) whose hole every member can
+// take (holes off when the members' gazes differ).
 struct SharedLayer {
     LayerPlan plan;  // a member's plan with layerOf(eyes[eye], kind) the shared rect
     LayerHoles holes;
 };
 SharedLayer sharedLayerPlan(const HmdProfile& profile, const std::vector<LayerPlan>& members,
                             Eye eye, LayerKind kind, const LayerHoles& holes,
-                            double margin_deg = 0.0);
+                            double margin_deg = 0.0, const MemberViews& views = {});
 
 // A shared layer as one member gets it: its layer's texels, rotated from the shared render's
 // orientation to the member's (bilinear), or box-filtered when the two are the same. The
@@ -121,6 +129,9 @@ struct SharePeripheryStats {
     Layers& of(LayerKind kind) { return kind == LayerKind::kMiddle ? middle : outer; }
     uint64_t measurements = 0;
     uint64_t measurements_failed = 0;  // some band below min_ssim
+    // Over the group renders: their margin_deg, their texels and their renderer's own layer's.
+    double margin_deg_sum = 0.0;
+    uint64_t group_texels = 0, own_texels = 0;
     // By layer and band over every measurement: the mean and the lowest SSIM.
     struct Band {
         std::string layer;  // "middle" or "outer"
@@ -176,6 +187,10 @@ private:
         Pose pose;
         LayerPlan plan;
         bool posed = false;  // a request noted
+        // The orientation of the request before `pose`'s, and how far each of the last
+        // kMissesKept requests landed from the orientation extrapolated from the two before it.
+        std::optional<glm::quat> previous;
+        std::deque<double> misses_deg;
         // Per slot (layer and eye, slotOf): its newest kRendersKept shared renders, whether the
         // last measurement passed, and the frames since.
         std::array<std::deque<Entry>, 4> entries;
@@ -186,6 +201,13 @@ private:
     // Renders kept per session and slot: a member a few frames behind another takes the one of
     // its own pose (bounded: at most 4 × 4 layers per session in memory).
     static constexpr size_t kRendersKept = 4;
+    // Requests over which a session's extrapolation miss is taken (its largest): about a second.
+    static constexpr size_t kMissesKept = 16;
+    // Where a member is expected to look from when it takes a render: its newest request's
+    // orientation and the next one extrapolated from the two newest; and the largest miss of that
+    // extrapolation over its last requests (max_angle_deg until there is one).
+    static std::vector<glm::quat> expectedViews(const Session& s);
+    double expectedMissDeg(const Session& s) const;
     // The members `id` shares layer `kind` with: its pose group, for the middle layer only those
     // whose gaze is close to its own.
     std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
