@@ -472,18 +472,16 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
         if (self == m_sessions.end() || !self->second.posed)
             return d;  // gone while its frame was served, or not noted
         const std::vector<Id> group = groupOfLocked(id, kind);
-        if (group.size() < 2)
-            return d;
         Session& me = self->second;
-        ++me.frames_since_measure[slot];
-        // The usable shared render of another member nearest in orientation (of equals, the
-        // newest): members that play one motion a few frames apart find the one of their pose.
+        // The usable shared render of another headset nearest in orientation (of equals, the
+        // newest): headsets that play one motion a few frames apart find the one of their pose,
+        // also when the other's newest pose has moved on beyond the group's reach.
         Entry* best = nullptr;
         double best_deg = 0.0;
-        for (Id other : group) {
+        for (auto& [other, session] : m_sessions) {
             if (other == id)
                 continue;
-            for (Entry& entry : m_sessions[other].entries[slot]) {
+            for (Entry& entry : session.entries[slot]) {
                 if (!usableLocked(entry, id, eye, kind, pose, plan, profile, holes))
                     continue;
                 const double deg = angleBetweenDeg(entry.pose.orientation, pose.orientation);
@@ -491,6 +489,9 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
                     best = &entry, best_deg = deg;
             }
         }
+        if (!best && group.size() < 2)
+            return d;
+        ++me.frames_since_measure[slot];
         const bool due = dueLocked(me, slot);
         if (best && m_config.mode == SharePeripheryMode::kAuto && due) {
             d.action = Action::kMeasure;
