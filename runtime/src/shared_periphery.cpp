@@ -1,5 +1,5 @@
-// Shared periphery: grouping by pose (and gaze), the group's layer, and the SSIM gate by
-// eccentricity band (shared_periphery.h).
+// Shared periphery: grouping by pose (the middle layer while its union pays), the group's layer,
+// and the SSIM gate by eccentricity band (shared_periphery.h).
 #include "qvr/runtime/shared_periphery.h"
 
 #include <algorithm>
@@ -46,8 +46,19 @@ bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c) {
            double(glm::length(a.position_m - b.position_m)) <= c.max_position_m;
 }
 
-bool gazesClose(const Gaze& a, const Gaze& b, const SharePeripheryConfig& c) {
-    return std::hypot(a.x_deg - b.x_deg, a.y_deg - b.y_deg) <= c.max_gaze_deg;
+bool middleUnionPays(const LayerPlan& a, const LayerPlan& b) {
+    for (size_t e = 0; e < a.eyes.size(); ++e) {
+        const LayerRect& x = a.eyes[e].middle;
+        const LayerRect& y = b.eyes[e].middle;
+        if (x.empty() || y.empty())
+            return false;
+        const PixelRect u{std::min(x.rect.x0, y.rect.x0), std::min(x.rect.y0, y.rect.y0),
+                          std::max(x.rect.x1, y.rect.x1), std::max(x.rect.y1, y.rect.y1)};
+        const double scale = std::min(x.scale, y.scale);
+        if (double(u.area()) / (scale * scale) >= double(x.pixels() + y.pixels()))
+            return false;
+    }
+    return true;
 }
 
 bool isShareable(LayerKind kind) {
@@ -411,12 +422,12 @@ std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id, LayerKind
         ids.push_back(k);
         poses.push_back(s.pose);
     }
-    const Gaze& gaze = m_sessions.at(id).plan.gaze;
+    const LayerPlan& mine = m_sessions.at(id).plan;
     for (const std::vector<size_t>& g : groupByPose(poses, m_config)) {
         std::vector<Id> out;
         for (size_t i : g)
-            if (kind == LayerKind::kOuter ||
-                gazesClose(m_sessions.at(ids[i]).plan.gaze, gaze, m_config))
+            if (kind == LayerKind::kOuter || ids[i] == id ||
+                middleUnionPays(m_sessions.at(ids[i]).plan, mine))
                 out.push_back(ids[i]);
         if (std::find(out.begin(), out.end(), id) != out.end())
             return out;
@@ -444,8 +455,6 @@ bool SharedPeriphery::usableLocked(const Entry& entry, Id id, Eye eye, LayerKind
         theirs.scale > mine.scale + 1e-9 ||
         !theirs.rect.contains(
             rotatedRect(profile, mine.rect, entry.pose.orientation, pose.orientation)))
-        return false;
-    if (kind == LayerKind::kMiddle && !gazesClose(entry.shared.plan.gaze, plan.gaze, m_config))
         return false;
     if (!entry.shared.holes.enabled)
         return true;

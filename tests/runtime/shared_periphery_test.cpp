@@ -353,12 +353,17 @@ TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
 
 // The middle layer is centred on the gaze: shared between close poses only when the gazes are
 // close too, over the union of the members' middle rects with no hole when the gazes differ.
-TEST(SharedPeriphery, SharesTheMiddleLayerOnlyBetweenCloseGazes) {
+// The middle layer is centred on the gaze: two gazes 6° apart share one render of the union of
+// their layers (a little larger than either); two 45° apart render their own (the union would
+// cost more than both).
+TEST(SharedPeriphery, SharesTheMiddleLayerWhileOneRenderOfTheUnionCostsLess) {
     const HmdProfile profile = smallProfile();
     const LayerPlanner planner(profile);
-    const LayerPlan a = planner.plan({0.0, 0.0}, 10.0);
-    const LayerPlan near = planner.plan({0.5, 0.0}, 10.0);
-    const LayerPlan far = planner.plan({6.0, 0.0}, 10.0);
+    const LayerPlan a = planner.plan({-20.0, -10.0}, 10.0);
+    const LayerPlan near = planner.plan({-14.0, -10.0}, 10.0);
+    const LayerPlan far = planner.plan({20.0, 10.0}, 10.0);
+    EXPECT_TRUE(middleUnionPays(a, near));
+    EXPECT_FALSE(middleUnionPays(a, far));
     const LayerHoles holes{.enabled = true};
     auto shared_periphery = twoHeadsets(SharePeripheryMode::kOn);
     SharedPeriphery& sp = *shared_periphery;

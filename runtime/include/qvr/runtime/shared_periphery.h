@@ -1,7 +1,8 @@
 // Shared periphery (docs/RUNTIME.md §Shared periphery): headsets of one scene whose head poses are
 // close get one outer layer per eye rendered for all of them — at the finest of their outer
 // sampling rates, over the union of their outer rectangles — each reduced to its own layer rect;
-// those whose gazes are close too share the middle layer the same way. Sharing a layer is kept
+// those for whom one render of the union of their middle layers costs fewer texels than theirs
+// share the middle layer the same way. Sharing a layer is kept
 // for a headset only while the SSIM of the shared layer against its own stays above a threshold
 // in every eccentricity band.
 #pragma once
@@ -43,9 +44,6 @@ struct SharePeripheryConfig {
     // Also the group layer's margin: what a member this far off brings into view.
     double max_angle_deg = 3.0;
     double max_position_m = 0.10;
-    // The middle layer is centred on the gaze: it is shared only among headsets whose gazes are
-    // this close, so the group's layer (the union of the members') stays about one member's.
-    double max_gaze_deg = 1.0;
     // Every eccentricity band's SSIM (luma, 7×7 windows) of the shared layer against the
     // headset's own must be at least this (docs/RUNTIME.md says why 0.9).
     double min_ssim = 0.90;
@@ -55,7 +53,9 @@ struct SharePeripheryConfig {
 };
 
 bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c);
-bool gazesClose(const Gaze& a, const Gaze& b, const SharePeripheryConfig& c);
+// The middle layer is centred on the gaze: two headsets share it while one render of the union
+// of their middle layers (at the finer scale, each eye) costs fewer texels than their two.
+bool middleUnionPays(const LayerPlan& a, const LayerPlan& b);
 // The layers a server may share: the middle and the outer one.
 bool isShareable(LayerKind kind);
 
@@ -209,13 +209,13 @@ private:
     static std::vector<glm::quat> expectedViews(const Session& s);
     double expectedMissDeg(const Session& s) const;
     // The members `id` shares layer `kind` with: its pose group, for the middle layer only those
-    // whose gaze is close to its own.
+    // with whom one render of the union pays (middleUnionPays).
     std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
     bool dueLocked(const Session& s, size_t slot) const;  // a measurement is due
     // Another member of the group would take a group render: its gate passed or is due.
     bool anyTakerLocked(const std::vector<Id>& group, Id id, size_t slot) const;
     // Another member's render this headset can take: close pose, covering its layer at least as
-    // finely, a hole no larger than its own (and about the same gaze), not given to it yet.
+    // finely, a hole no larger than its own, not given to it yet.
     bool usableLocked(const Entry& entry, Id id, Eye eye, LayerKind kind, const Pose& pose,
                       const LayerPlan& plan, const HmdProfile& profile,
                       const LayerHoles& holes) const;
