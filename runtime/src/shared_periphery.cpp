@@ -46,21 +46,6 @@ bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c) {
            double(glm::length(a.position_m - b.position_m)) <= c.max_position_m;
 }
 
-bool middleUnionPays(const LayerPlan& a, const LayerPlan& b) {
-    for (size_t e = 0; e < a.eyes.size(); ++e) {
-        const LayerRect& x = a.eyes[e].middle;
-        const LayerRect& y = b.eyes[e].middle;
-        if (x.empty() || y.empty())
-            return false;
-        const PixelRect u{std::min(x.rect.x0, y.rect.x0), std::min(x.rect.y0, y.rect.y0),
-                          std::max(x.rect.x1, y.rect.x1), std::max(x.rect.y1, y.rect.y1)};
-        const double scale = std::min(x.scale, y.scale);
-        if (double(u.area()) / (scale * scale) >= double(x.pixels() + y.pixels()))
-            return false;
-    }
-    return true;
-}
-
 bool isShareable(LayerKind kind) {
     return kind == LayerKind::kMiddle || kind == LayerKind::kOuter;
 }
@@ -134,6 +119,20 @@ PixelRect unite(const PixelRect& a, const PixelRect& b) {
 }
 
 }  // namespace
+
+bool middleUnionPays(const LayerPlan& a, const LayerPlan& b) {
+    for (size_t e = 0; e < a.eyes.size(); ++e) {
+        const LayerRect& x = a.eyes[e].middle;
+        const LayerRect& y = b.eyes[e].middle;
+        if (x.empty() || y.empty())
+            return false;
+        const PixelRect u = unite(x.rect, y.rect);
+        const double scale = std::min(x.scale, y.scale);
+        if (double(u.area()) / (scale * scale) >= double(x.pixels() + y.pixels()))
+            return false;
+    }
+    return true;
+}
 
 PixelRect rotatedRect(const HmdProfile& profile, const PixelRect& rect, const glm::quat& render,
                       const glm::quat& member) {
