@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 #include <tuple>
 
@@ -283,7 +282,7 @@ void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
 }
 
 // The member's layer cut out of the shared render: the same orientation and scale, and its
-// texels on the render's grid (a box filter of one texel is a copy).
+// texels on the render's grid (a box filter of one texel is a copy: cropMiddle's).
 bool cropSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                      const LayerRect& member, ImageRgba8& out) {
     if (std::fabs(shared_rect.scale - member.scale) > 1e-9)
@@ -294,15 +293,12 @@ bool cropSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
     if (std::fabs(ox - x) > 1e-9 || std::fabs(oy - y) > 1e-9 || x < 0 || y < 0 ||
         x + member.width_px > shared.width() || y + member.height_px > shared.height())
         return false;
-    out.resize(member.width_px, member.height_px);
-    const size_t row = static_cast<size_t>(member.width_px) * 4;
-    for (int j = 0; j < member.height_px; ++j) {
-        uint8_t* dst = out.data() + static_cast<size_t>(j) * row;
-        std::memcpy(dst, shared.data() + (static_cast<size_t>(y + j) * shared.width() + x) * 4,
-                    row);
-        for (size_t k = 3; k < row; k += 4)
-            dst[k] = 255;
-    }
+    PeripheryGrid grid;
+    grid.width_px = shared.width();
+    grid.height_px = shared.height();
+    grid.middle_col = x;
+    grid.middle_row = y;
+    cropMiddle(shared, grid, member, out);
     return true;
 }
 
@@ -374,7 +370,7 @@ void SharedPeriphery::noteRequest(Id id, const Pose& pose, const LayerPlan& plan
     if (it == m_sessions.end())
         return;  // gone while its frame was served
     Session& s = it->second;
-    if (s.posed && s.previous) {
+    if (s.previous) {
         const std::vector<glm::quat> expected = expectedViews(s);
         s.misses_deg.push_back(angleBetweenDeg(expected.back(), pose.orientation));
         if (s.misses_deg.size() > kMissesKept)
