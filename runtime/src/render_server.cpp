@@ -457,7 +457,8 @@ struct RenderServer::Impl final : net::ServerHandler {
 
     // A middle or outer layer into images.image with sharing on: another member's shared render
     // reduced to this headset's layer; or its own beside such a candidate when a measurement is
-    // due; or the group's layer, rendered, kept for the others and reduced; or its own alone.
+    // due; or the group's layer, rendered, kept for the others and reduced; or its own alone,
+    // kept when another headset may come by its pose.
     Expected<RenderStats> renderShareable(Renderer& r, Images& images, const LayerPlan& plan,
                                           Eye eye, LayerKind kind, const Work& w) {
         const Pose& pose = w.req->pose;
@@ -488,6 +489,8 @@ struct RenderServer::Impl final : net::ServerHandler {
         if (!rs)
             return rs;
         sharing->countOwn(kind);
+        if (d.keep)
+            sharing->store(w.id, eye, kind, pose, SharedLayer{plan, config.holes}, images.image);
         if (d.action == SharedPeriphery::Action::kMeasure)
             sharing->measured(
                 w.id, eye, kind,

@@ -45,6 +45,11 @@ bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c) {
            double(glm::length(a.position_m - b.position_m)) <= c.max_position_m;
 }
 
+bool samePose(const Pose& a, const Pose& b) {
+    return angleBetweenDeg(a.orientation, b.orientation) <= kSamePoseDeg &&
+           double(glm::length(a.position_m - b.position_m)) <= kSamePoseM;
+}
+
 bool isShareable(LayerKind kind) {
     return kind == LayerKind::kMiddle || kind == LayerKind::kOuter;
 }
@@ -409,14 +414,10 @@ size_t SharedPeriphery::slotOf(LayerKind kind, Eye eye) {
 }
 
 std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id, LayerKind kind) const {
-    std::vector<Id> ids;
+    const std::vector<Id> ids = posedIdsLocked();
     std::vector<Pose> poses;
-    for (const auto& [k, s] : m_sessions) {
-        if (!s.posed)
-            continue;  // no request yet
-        ids.push_back(k);
-        poses.push_back(s.pose);
-    }
+    for (Id k : ids)
+        poses.push_back(m_sessions.at(k).pose);
     const LayerPlan& mine = m_sessions.at(id).plan;
     for (const std::vector<size_t>& g : groupByPose(poses, m_config)) {
         std::vector<Id> out;
@@ -428,6 +429,14 @@ std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id, LayerKind
             return out;
     }
     return {id};
+}
+
+std::vector<SharedPeriphery::Id> SharedPeriphery::posedIdsLocked() const {
+    std::vector<Id> ids;
+    for (const auto& [k, s] : m_sessions)
+        if (s.posed)
+            ids.push_back(k);
+    return ids;
 }
 
 bool SharedPeriphery::dueLocked(const Session& s, size_t slot) const {
@@ -446,8 +455,9 @@ bool SharedPeriphery::usableLocked(const Entry& entry, Id id, Eye eye, LayerKind
                                    const HmdProfile& profile, const LayerHoles& holes) const {
     const LayerRect& mine = layerOf(plan.eyes[static_cast<size_t>(eye)], kind);
     const LayerRect& theirs = layerOf(entry.shared.plan.eyes[static_cast<size_t>(eye)], kind);
-    if (entry.consumed.contains(id) || !posesClose(entry.pose, pose, m_config) ||
-        theirs.scale > mine.scale + 1e-9 ||
+    // A render of its very pose may be taken again (the scene is still: the same texels).
+    if ((entry.consumed.contains(id) && !samePose(entry.pose, pose)) ||
+        !posesClose(entry.pose, pose, m_config) || theirs.scale > mine.scale + 1e-9 ||
         !theirs.rect.contains(
             rotatedRect(profile, mine.rect, entry.pose.orientation, pose.orientation)))
         return false;
@@ -493,27 +503,40 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
                     best = &entry, best_deg = deg;
             }
         }
-        if (!best && group.size() < 2)
+        me.follows[slot] = best && samePose(best->pose, pose);
+        if (!best && group.size() < 2) {
+            d.keep = posedIdsLocked().size() > 1;  // another may come by this pose
             return d;
+        }
         ++me.frames_since_measure[slot];
         const bool due = dueLocked(me, slot);
-        if (best && m_config.mode == SharePeripheryMode::kAuto && due) {
+        // A render of its very pose (samePose) at its own scale holds the texels its own render
+        // would: nothing for the gate to measure, whatever it measured on other renders.
+        const bool copy =
+            me.follows[slot] && std::fabs(layerOf(best->shared.plan.eyes[size_t(eye)], kind).scale -
+                                          layerOf(plan.eyes[size_t(eye)], kind).scale) < 1e-9;
+        if (best && m_config.mode == SharePeripheryMode::kAuto && due && !copy) {
             d.action = Action::kMeasure;
-        } else if (best && (m_config.mode == SharePeripheryMode::kOn || *me.verdict[slot])) {
+        } else if (best &&
+                   (m_config.mode == SharePeripheryMode::kOn || copy || *me.verdict[slot])) {
             d.action = Action::kReuse;
             ++m_stats.of(kind).reused;
         } else if (m_config.mode == SharePeripheryMode::kAuto && !anyTakerLocked(group, id, slot)) {
-            return d;  // no other member would take a group render (its gate failed, not due)
+            // No other member would take a group render (its gate failed, not due); one that
+            // comes by this pose would take this render.
+            d.keep = true;
+            return d;
         } else {
             // Rendered for where the others will look from when they take it, with the largest
-            // miss of that expectation as the margin.
+            // miss of that expectation as the margin; a member that follows this one's path takes
+            // the render of its own pose when it gets there, which this one's view covers.
             std::vector<LayerPlan> plans = {plan};
             MemberViews views{pose.orientation, {{}}};
             double margin_deg = 0.0;
             for (Id other : group) {
-                if (other == id)
-                    continue;
                 const Session& s = m_sessions.at(other);
+                if (other == id || s.follows[slot])
+                    continue;
                 plans.push_back(s.plan);
                 views.of.push_back(expectedViews(s));
                 margin_deg = std::max(margin_deg, expectedMissDeg(s));

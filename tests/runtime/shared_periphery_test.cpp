@@ -182,7 +182,7 @@ TEST(SharedPeriphery, TakesTheNearestKeptRenderThatCoversIt) {
     sp.noteRequest(1, yawed(0.0), plan);
     sp.noteRequest(2, yawed(0.0), plan);
     const SharedLayer wide = sharedLayerPlan(profile, {plan}, l, mid, {}, 3.0);
-    for (int k = 0; k <= 4; ++k)  // five renders at 0.5° steps: the first is not kept
+    for (int k = 0; k <= 16; ++k)  // 17 renders at 0.5° steps: the first is not kept
         sp.store(1, l, mid, yawed(0.5 * k), wide, flatImage(wide.plan.eyes[0].middle, 10 * k));
     for (double yaw : {1.1, 0.0}) {
         const auto d = sp.decide(2, l, mid, yawed(yaw), plan, profile, {});
@@ -200,6 +200,53 @@ TEST(SharedPeriphery, TakesTheNearestKeptRenderThatCoversIt) {
               SharedPeriphery::Action::kRenderShared);
     EXPECT_EQ(sp.decide(2, l, mid, yawed(0.0), plan, profile, {}).action,
               SharedPeriphery::Action::kReuse);
+}
+
+// A headset that follows another's path a few frames behind, more than the group's reach apart,
+// takes the other's own render of each pose it comes to; and while it does, the other's group
+// render does not widen toward where the follower looks from now. Once the follower leaves the
+// path (it finds no render of its pose), the group render covers it again.
+TEST(SharedPeriphery, AFollowerTakesTheRenderOfItsPoseAndCostsNoWidening) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const Eye l = Eye::kLeft;
+    const LayerKind mid = LayerKind::kMiddle;
+    auto shared_periphery = twoHeadsets(SharePeripheryMode::kOn);
+    SharedPeriphery& sp = *shared_periphery;
+    const LayerRect& own = plan.eyes[0].middle;
+    // 1.5° a frame, three frames apart: 4.5° apart, beyond the 3° of a group.
+    sp.noteRequest(2, yawed(-4.5), plan);
+    for (int k = 0; k < 8; ++k) {
+        sp.noteRequest(1, yawed(1.5 * k), plan);
+        const auto lead = sp.decide(1, l, mid, yawed(1.5 * k), plan, profile, {});
+        ASSERT_EQ(lead.action, SharedPeriphery::Action::kOwn) << k;
+        ASSERT_TRUE(lead.keep) << k;
+        sp.store(1, l, mid, yawed(1.5 * k), SharedLayer{plan, {}}, flatImage(own, uint8_t(k)));
+        if (k < 3)
+            continue;
+        sp.noteRequest(2, yawed(1.5 * (k - 3)), plan);
+        const auto follow = sp.decide(2, l, mid, yawed(1.5 * (k - 3)), plan, profile, {});
+        ASSERT_EQ(follow.action, SharedPeriphery::Action::kReuse) << k;
+        EXPECT_EQ(follow.image.at(3, 3, 0), k - 3) << k;
+    }
+    // A still head: the render of its very pose is taken again (a still scene: the same texels).
+    const auto again = sp.decide(2, l, mid, yawed(6.0), plan, profile, {});
+    ASSERT_EQ(again.action, SharedPeriphery::Action::kReuse);
+    EXPECT_EQ(again.image.at(3, 3, 0), 4);
+    // Now 1° apart, a group, the follower off the path: its last decision took the render of its
+    // pose, so the leader's group render is its own layer; the follower then finds no render
+    // of its pose and none reaching it, and the leader's next group render widens toward it.
+    sp.noteRequest(1, yawed(11.0), plan);
+    sp.noteRequest(2, yawed(10.0), plan);
+    const auto tight = sp.decide(1, l, mid, yawed(11.0), plan, profile, {});
+    ASSERT_EQ(tight.action, SharedPeriphery::Action::kRenderShared);
+    EXPECT_EQ(tight.shared.plan.eyes[0].middle.rect.area(), own.rect.area());
+    sp.store(1, l, mid, yawed(11.0), tight.shared, flatImage(tight.shared.plan.eyes[0].middle, 50));
+    EXPECT_EQ(sp.decide(2, l, mid, yawed(10.0), plan, profile, {}).action,
+              SharedPeriphery::Action::kRenderShared);
+    const auto wide = sp.decide(1, l, mid, yawed(11.0), plan, profile, {});
+    ASSERT_EQ(wide.action, SharedPeriphery::Action::kRenderShared);
+    EXPECT_GT(wide.shared.plan.eyes[0].middle.rect.area(), own.rect.area());
 }
 
 // The group's render reaches where the others will look from, not a fixed angle every way: a
@@ -289,6 +336,35 @@ TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {
     const LayerPlan c = planner.plan({10.0, 0.0}, 10.0);
     EXPECT_FALSE(
         sharedLayerPlan(profile, {a, c}, Eye::kLeft, LayerKind::kOuter, holes).holes.enabled);
+}
+
+// A render made at a headset's very pose and at its scale holds the texels its own would: it
+// takes it whatever the gate measured on other renders, and the renderer keeps its own layer
+// for it even when no member would take a group render.
+TEST(SharedPeriphery, TakesARenderOfItsVeryPoseWhateverTheGateMeasured) {
+    const HmdProfile profile = smallProfile();
+    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
+    const LayerHoles holes{.enabled = true};
+    auto shared_periphery = twoHeadsets(SharePeripheryMode::kAuto);
+    SharedPeriphery& sp = *shared_periphery;
+    using A = SharedPeriphery::Action;
+    const Eye l = Eye::kLeft;
+    const LayerKind outer = LayerKind::kOuter;
+    sp.noteRequest(1, yawed(0.0), plan);
+    sp.noteRequest(2, yawed(1.0), plan);
+    auto d = sp.decide(1, l, outer, yawed(0.0), plan, profile, holes);
+    ASSERT_EQ(d.action, A::kRenderShared);
+    sp.store(1, l, outer, yawed(0.0), d.shared, flatImage(d.shared.plan.eyes[0].outer, 5));
+    ASSERT_EQ(sp.decide(2, l, outer, yawed(1.0), plan, profile, holes).action, A::kMeasure);
+    sp.measured(2, l, outer, {{60.0, 70.0, 0.5, 100}});
+    d = sp.decide(1, l, outer, yawed(0.0), plan, profile, holes);
+    ASSERT_EQ(d.action, A::kOwn);
+    EXPECT_TRUE(d.keep);
+    sp.store(1, l, outer, yawed(0.0), SharedLayer{plan, holes}, flatImage(plan.eyes[0].outer, 9));
+    sp.noteRequest(2, yawed(0.0), plan);
+    d = sp.decide(2, l, outer, yawed(0.0), plan, profile, holes);
+    ASSERT_EQ(d.action, A::kReuse);
+    EXPECT_EQ(d.image.at(3, 3, 0), 9);
 }
 
 TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {

@@ -53,6 +53,12 @@ struct SharePeripheryConfig {
 };
 
 bool posesClose(const Pose& a, const Pose& b, const SharePeripheryConfig& c);
+// Poses this close see the same texels: 0.01° is a fifth of the finest layer's texel (a
+// full-resolution pixel of the default profile spans ~0.05°); 0.1 mm moves a point 0.6 m away
+// by 0.01°.
+constexpr double kSamePoseDeg = 0.01;
+constexpr double kSamePoseM = 1e-4;
+bool samePose(const Pose& a, const Pose& b);
 // The middle layer is centred on the gaze: two headsets share it while one render of the union
 // of their middle layers (at the finer scale, each eye) costs fewer texels than their two.
 bool middleUnionPays(const LayerPlan& a, const LayerPlan& b);
@@ -165,6 +171,9 @@ public:
         Action action = Action::kOwn;
         SharedLayer shared;
         ImageRgba8 image;
+        // kOwn: another headset may take this render later (it follows this one's path a few
+        // frames behind), so store() it with the headset's own plan once rendered.
+        bool keep = false;
     };
     // For a shareable layer `kind` of this headset's frame (holes: the server's).
     Decision decide(Id id, Eye eye, LayerKind kind, const Pose& pose, const LayerPlan& plan,
@@ -196,11 +205,17 @@ private:
         std::array<std::deque<Entry>, 4> entries;
         std::array<std::optional<bool>, 4> verdict;
         std::array<int, 4> frames_since_measure{};
+        // Per slot: its last decision took a render made at its own pose (samePose): it
+        // follows another's path a few frames behind and will find that one's renders of the
+        // poses it comes to, so a group render need not reach where it looks from now.
+        std::array<bool, 4> follows{};
     };
     static size_t slotOf(LayerKind kind, Eye eye);
-    // Renders kept per session and slot: a member a few frames behind another takes the one of
-    // its own pose (bounded: at most 4 × 4 layers per session in memory).
-    static constexpr size_t kRendersKept = 4;
+    // Renders kept per session and slot, group renders and kept own ones: a headset up to
+    // kRendersKept - 1 frames behind another on its path takes the one of its own pose (two
+    // headsets started together run 2-8 frames apart) (bounded: at most 16 × 4 layers per
+    // session in memory, 32 MB of the default profile's).
+    static constexpr size_t kRendersKept = 16;
     // Requests over which a session's extrapolation miss is taken (its largest): about a second.
     static constexpr size_t kMissesKept = 16;
     // Where a member is expected to look from when it takes a render: its newest request's
@@ -211,11 +226,12 @@ private:
     // The members `id` shares layer `kind` with: its pose group, for the middle layer only those
     // with whom one render of the union pays (middleUnionPays).
     std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
+    std::vector<Id> posedIdsLocked() const;               // the sessions with a request noted
     bool dueLocked(const Session& s, size_t slot) const;  // a measurement is due
     // Another member of the group would take a group render: its gate passed or is due.
     bool anyTakerLocked(const std::vector<Id>& group, Id id, size_t slot) const;
     // Another member's render this headset can take: close pose, covering its layer at least as
-    // finely, a hole no larger than its own, not given to it yet.
+    // finely, a hole no larger than its own, not given to it yet unless made at its very pose.
     bool usableLocked(const Entry& entry, Id id, Eye eye, LayerKind kind, const Pose& pose,
                       const LayerPlan& plan, const HmdProfile& profile,
                       const LayerHoles& holes) const;
