@@ -286,11 +286,15 @@ void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
     }
 }
 
+bool sameScale(const LayerRect& a, const LayerRect& b) {
+    return std::fabs(a.scale - b.scale) <= 1e-9;
+}
+
 // The member's layer cut out of the shared render: the same orientation and scale, and its
 // texels on the render's grid (a box filter of one texel is a copy: cropMiddle's).
 bool cropSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                      const LayerRect& member, ImageRgba8& out) {
-    if (std::fabs(shared_rect.scale - member.scale) > 1e-9)
+    if (!sameScale(shared_rect, member))
         return false;
     const double ox = (member.rect.x0 - shared_rect.rect.x0) / shared_rect.scale;
     const double oy = (member.rect.y0 - shared_rect.rect.y0) / shared_rect.scale;
@@ -316,7 +320,7 @@ void reduceSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
     if (!turned && cropSharedLayer(shared, shared_rect, member_rect, out))
         return;
     // At one scale, a box of one texel is the bilinear tap the warp takes.
-    if ((turned || std::fabs(shared_rect.scale - member_rect.scale) <= 1e-9) && !shared.empty()) {
+    if ((turned || sameScale(shared_rect, member_rect)) && !shared.empty()) {
         warpSharedLayer(shared, shared_rect, member_rect, out, profile, shared_orientation,
                         member_orientation);
         return;
@@ -414,10 +418,14 @@ size_t SharedPeriphery::slotOf(LayerKind kind, Eye eye) {
 }
 
 std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id, LayerKind kind) const {
-    const std::vector<Id> ids = posedIdsLocked();
+    std::vector<Id> ids;
     std::vector<Pose> poses;
-    for (Id k : ids)
-        poses.push_back(m_sessions.at(k).pose);
+    for (const auto& [k, s] : m_sessions) {
+        if (!s.posed)
+            continue;  // no request yet
+        ids.push_back(k);
+        poses.push_back(s.pose);
+    }
     const LayerPlan& mine = m_sessions.at(id).plan;
     for (const std::vector<size_t>& g : groupByPose(poses, m_config)) {
         std::vector<Id> out;
@@ -429,14 +437,6 @@ std::vector<SharedPeriphery::Id> SharedPeriphery::groupOfLocked(Id id, LayerKind
             return out;
     }
     return {id};
-}
-
-std::vector<SharedPeriphery::Id> SharedPeriphery::posedIdsLocked() const {
-    std::vector<Id> ids;
-    for (const auto& [k, s] : m_sessions)
-        if (s.posed)
-            ids.push_back(k);
-    return ids;
 }
 
 bool SharedPeriphery::dueLocked(const Session& s, size_t slot) const {
@@ -505,7 +505,9 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
         }
         me.follows[slot] = best && samePose(best->pose, pose);
         if (!best && group.size() < 2) {
-            d.keep = posedIdsLocked().size() > 1;  // another may come by this pose
+            // Another may come by this pose.
+            d.keep = std::any_of(m_sessions.begin(), m_sessions.end(),
+                                 [id](const auto& x) { return x.first != id && x.second.posed; });
             return d;
         }
         ++me.frames_since_measure[slot];
@@ -513,8 +515,8 @@ SharedPeriphery::Decision SharedPeriphery::decide(Id id, Eye eye, LayerKind kind
         // A render of its very pose (samePose) at its own scale holds the texels its own render
         // would: nothing for the gate to measure, whatever it measured on other renders.
         const bool copy =
-            me.follows[slot] && std::fabs(layerOf(best->shared.plan.eyes[size_t(eye)], kind).scale -
-                                          layerOf(plan.eyes[size_t(eye)], kind).scale) < 1e-9;
+            me.follows[slot] && sameScale(layerOf(best->shared.plan.eyes[size_t(eye)], kind),
+                                          layerOf(plan.eyes[size_t(eye)], kind));
         if (best && m_config.mode == SharePeripheryMode::kAuto && due && !copy) {
             d.action = Action::kMeasure;
         } else if (best &&

@@ -338,14 +338,25 @@ TEST(SharedPeriphery, GroupLayerCoversEveryMemberAtTheFinestScale) {
         sharedLayerPlan(profile, {a, c}, Eye::kLeft, LayerKind::kOuter, holes).holes.enabled);
 }
 
+// Headsets 1 and 2 sharing on auto, the small display's plan for a centred gaze, the server's
+// holes.
+struct AutoPair {
+    HmdProfile profile;
+    LayerPlan plan;
+    LayerHoles holes;
+    std::unique_ptr<SharedPeriphery> sp;
+};
+AutoPair autoPair() {
+    const HmdProfile profile = smallProfile();
+    return {profile, LayerPlanner(profile).plan({0.0, 0.0}, 10.0), LayerHoles{.enabled = true},
+            twoHeadsets(SharePeripheryMode::kAuto)};
+}
+
 // A render made at a headset's very pose and at its scale holds the texels its own would: it
 // takes it whatever the gate measured on other renders, and the renderer keeps its own layer
 // for it even when no member would take a group render.
 TEST(SharedPeriphery, TakesARenderOfItsVeryPoseWhateverTheGateMeasured) {
-    const HmdProfile profile = smallProfile();
-    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
-    const LayerHoles holes{.enabled = true};
-    auto shared_periphery = twoHeadsets(SharePeripheryMode::kAuto);
+    auto [profile, plan, holes, shared_periphery] = autoPair();
     SharedPeriphery& sp = *shared_periphery;
     using A = SharedPeriphery::Action;
     const Eye l = Eye::kLeft;
@@ -368,10 +379,7 @@ TEST(SharedPeriphery, TakesARenderOfItsVeryPoseWhateverTheGateMeasured) {
 }
 
 TEST(SharedPeriphery, ReusesAnotherMembersRenderOnlyWhileTheMeasurementPasses) {
-    const HmdProfile profile = smallProfile();
-    const LayerPlan plan = LayerPlanner(profile).plan({0.0, 0.0}, 10.0);
-    const LayerHoles holes{.enabled = true};
-    auto shared_periphery = twoHeadsets(SharePeripheryMode::kAuto);
+    auto [profile, plan, holes, shared_periphery] = autoPair();
     SharedPeriphery& sp = *shared_periphery;
     using A = SharedPeriphery::Action;
     sp.noteRequest(1, yawed(0.0), plan);

@@ -226,7 +226,6 @@ private:
     // The members `id` shares layer `kind` with: its pose group, for the middle layer only those
     // with whom one render of the union pays (middleUnionPays).
     std::vector<Id> groupOfLocked(Id id, LayerKind kind) const;
-    std::vector<Id> posedIdsLocked() const;               // the sessions with a request noted
     bool dueLocked(const Session& s, size_t slot) const;  // a measurement is due
     // Another member of the group would take a group render: its gate passed or is due.
     bool anyTakerLocked(const std::vector<Id>& group, Id id, size_t slot) const;
