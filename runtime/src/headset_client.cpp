@@ -555,8 +555,6 @@ private:
         const bool fallback = choice.fallback;
         const double t_local_pred_ms = choice.t_local_pred_ms;
         const double t_remote_pred_ms = choice.t_remote_pred_ms;
-        if (m_config.workload && wf)
-            m_config.workload->writeFrame(*wf);
         FrameTelemetry* t = &tel(ti);
         t->decision_ns = rel(m_clock.nowNs());
         t->fallback_local = fallback;
@@ -629,24 +627,39 @@ private:
         const LayerPlan& plan = prep.plan;
         const int64_t local_start_ns = m_clock.nowNs();
         tel(prep.telemetry).local_start_ns = rel(local_start_ns);
-        double fragments = 0.0;
+        double fragments = 0.0, pixels = 0.0;
+        bool counted = true;
         for (int eye = 0; eye < 2; ++eye) {
-            if (plan.eyes[static_cast<size_t>(eye)].fovea.empty())
+            const LayerRect& fovea = plan.eyes[static_cast<size_t>(eye)].fovea;
+            if (fovea.empty())
                 continue;
             auto rs =
                 renderLayer(*m_renderer, m_config.profile, plan, prep.head, static_cast<Eye>(eye),
                             LayerKind::kFovea, prep.layers->eyes[static_cast<size_t>(eye)].fovea);
-            if (!rs)
+            if (!rs) {
                 ++m_stats.render_failures;
-            else
+                counted = false;
+            } else {
                 fragments += double(rs->fragment_invocations);
+                pixels += double(fovea.pixels());
+            }
         }
         const int64_t local_end_ns = m_clock.nowNs();
         FrameTelemetry* t = &tel(prep.telemetry);
         t->local_end_ns = rel(local_end_ns);
         t->fovea_fragments = fragments;
         t->t_local_ms = double(local_end_ns - local_start_ns) * 1e-6;
+        recordWorkload(prep, counted && pixels > 0.0 ? fragments / pixels : -1.0);
         return local_end_ns;
+    }
+
+    // The frame's workload as LIWC counted it, with the fragments its fovea pass shaded per
+    // fovea pixel (written after the pass, in frame order; docs/WORKLOAD_FORMAT.md frag_px).
+    void recordWorkload(Prepared& prep, double fragments_per_px) {
+        if (!m_config.workload || !prep.wf)
+            return;
+        prep.wf->fovea_fragments_per_px = std::min(fragments_per_px, 1e3);
+        m_config.workload->writeFrame(*prep.wf);
     }
 
     // When to stop waiting for a frame's remote layers. The wait limit runs from when the server

@@ -26,6 +26,14 @@ namespace qvr {
 
 namespace {
 
+// One eye's fovea fragments from the trace's recorded fragments per fovea pixel; −1 (the law's
+// mean) where none is recorded, and for a whole-frame pass, whose depth complexity the fovea's
+// does not tell.
+double recordedFragments(const WorkloadFrame& wf, double pixels, bool whole_frame) {
+    return wf.fovea_fragments_per_px >= 0.0 && !whole_frame ? wf.fovea_fragments_per_px * pixels
+                                                            : -1.0;
+}
+
 struct Stream {
     int64_t frame = 0;
     double rx_ms = 0.0;  // last packet arrived
@@ -596,8 +604,9 @@ void PassReplay::renderFovea(int64_t i) {
                 continue;
             const double px = double(e.fovea.pixels());
             const double drawn_tris = drawn(i, fs.plan, eye, 0, tris, 1.0);
-            const double frags =
-                m_config.fovea_fragments ? m_config.fovea_fragments(i, fs.plan, eye) : -1.0;
+            const double frags = m_config.fovea_fragments
+                                     ? m_config.fovea_fragments(i, fs.plan, eye)
+                                     : recordedFragments(wf, px, m_local_only);
             work(m_local_only ? m_costs.fovea.atFullFrame(px, drawn_tris, frags)
                               : m_costs.fovea.at(px, drawn_tris, frags));
         }

@@ -38,6 +38,10 @@ assert "<source src='qvr_display.mp4' type='video/mp4'>" in html, "no video elem
 assert "<img src='qvr_display_still.png'" in html, "no still"
 for key in ["fps_mean", "mtp_ms_mean", "frames_displayed"]:
     assert key in d["designs"]["local"], key
+# The qvr design's workload: every frame with the fragments its fovea pass shaded per pixel
+# (what qvr capacity charges the fovea), more than one a pixel (depth complexity, 2x2 quads).
+frames = [json.loads(l) for l in open(os.path.join(out, "workload.jsonl"))][1:]
+assert len(frames) == 24 and all(f["frag_px"] >= 1.0 for f in frames), frames[:2]
 # The transport's and the handshake's counters, in summary.json and in the report.
 for key in ["nacks_sent", "media_forged", "media_replayed", "fec_recoveries", "streams_lost"]:
     assert key in d["designs"]["qvr"], key

@@ -691,6 +691,41 @@ TEST(RuntimeModel, TheFoveaCostsTheFragmentsTheCallerSaysItShades) {
     EXPECT_NEAR(simulateRuntime(trace, cfg, link2).frames[7].t_local_ms, 2.5 * px * 1e-6, 1e-9);
 }
 
+TEST(RuntimeModel, WithoutTheCallersCountsTheFoveaCostsTheTracesRecordedFragments) {
+    // The same law, no fovea_fragments: frames that recorded their fovea's fragments per pixel
+    // (a qvr run's workload.jsonl, frag_px) are charged that many per fovea pixel, the others
+    // the calibration's 2.5; a whole-frame pass (local) is never charged the fovea's overdraw.
+    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
+    c.fovea = {};
+    c.fovea.ms_per_mfrag = 1.0;
+    c.fovea.frag_per_px = 2.5;
+    WorkloadTrace trace = flatTrace(10);
+    for (int k : {2, 6})
+        trace.frames[size_t(k)].fovea_fragments_per_px = 10.0;
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Ffr;
+    cfg.costs = c;
+    cfg.frames = 10;
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[2].gaze, 5.0);
+    const double px = double(plan.eyes[0].fovea.pixels() + plan.eyes[1].fovea.pixels());
+    EXPECT_NEAR(r.frames[2].t_local_ms, 10.0 * px * 1e-6, 1e-9);
+    EXPECT_NEAR(r.frames[6].t_local_ms, 10.0 * px * 1e-6, 1e-9);
+    EXPECT_NEAR(r.frames[5].t_local_ms, 2.5 * px * 1e-6, 1e-9);
+    // The caller's counts, where given, win over the trace's.
+    cfg.fovea_fragments = [](int64_t, const LayerPlan&, int) { return 1e6; };
+    NoisyLink link2 = fastLink();
+    EXPECT_NEAR(simulateRuntime(trace, cfg, link2).frames[2].t_local_ms, 2.0, 1e-9);
+    // Local renders the whole frame: the same at frames 2 and 5.
+    cfg.fovea_fragments = nullptr;
+    cfg.design = Design::Local;
+    NoisyLink link3 = fastLink();
+    const RuntimeRunResult local = simulateRuntime(trace, cfg, link3);
+    EXPECT_GT(local.frames[2].t_local_ms, 0.0);
+    EXPECT_NEAR(local.frames[2].t_local_ms, local.frames[5].t_local_ms, 1e-9);
+}
+
 TEST(RuntimeModel, SwAndQvrPayTheRingCountsEveryFrame) {
     // The runtime counts the rings for qvr and sw (LIWC's model, fed reactively for sw), the
     // draw clusters at a constant cost: with only that and a 1 ms UCA, both are charged it in

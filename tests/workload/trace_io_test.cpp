@@ -60,6 +60,8 @@ WorkloadTrace handMadeTrace(int frames = 3) {
         for (size_t s = 0; s < h.scales.size(); ++s)
             f.bits_per_pixel.push_back(0.3 * std::pow(h.scales[s], 0.7) + u(rng));
         f.static_split = {12345.5 * u(rng), 0.25 + 0.5 * u(rng), 1e5 * u(rng), 7e4};
+        if (n == 1)
+            f.fovea_fragments_per_px = 3.0 + u(rng);  // recorded by a run; the others not
         t.frames.push_back(f);
     }
     return t;
@@ -138,6 +140,7 @@ void expectSameTrace(const WorkloadTrace& a, const WorkloadTrace& b) {
         EXPECT_EQ(fa.static_split.bg_bytes, fb.static_split.bg_bytes);
         EXPECT_EQ(fa.static_split.depth_bytes, fb.static_split.depth_bytes);
         EXPECT_EQ(fa.bits_per_pixel_lossless, fb.bits_per_pixel_lossless);
+        EXPECT_EQ(fa.fovea_fragments_per_px, fb.fovea_fragments_per_px);
         EXPECT_EQ(fa.static_split.bg_bytes_lossless, fb.static_split.bg_bytes_lossless);
     }
 }
@@ -423,6 +426,12 @@ TEST(ReadWorkloadTrace, NamesLineWhenFrameValueIsOutOfRange) {
     l = lines;
     l[1] = replaced(l[1], "\"i\":0", "\"i\":-1");
     expectErrorAtLine(joinLines(l), 2, "'i'");
+    // The optional fragments per fovea pixel: a number in [0, 1000].
+    for (const char* bad : {"-0.5", "1e4", "\"many\"", "null"}) {
+        l = lines;
+        l[2] = replaced(l[2], "\"static\":", std::string("\"frag_px\":") + bad + ",\"static\":");
+        expectErrorAtLine(joinLines(l), 3, "frag_px");
+    }
 }
 
 TEST(ReadWorkloadTrace, NamesLineWhenQuaternionIsNotUnit) {

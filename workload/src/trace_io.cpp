@@ -224,6 +224,8 @@ bool parseFrame(const json& j, const WorkloadHeader& h, WorkloadFrame& f, FieldR
     if (j.contains("bpp_lossless") &&
         !r.array(j, "bpp_lossless", f.bits_per_pixel_lossless, h.scales.size(), h.scales.size()))
         return false;
+    if (!r.number(j, "frag_px", f.fovea_fragments_per_px, 0, 1e3, false))
+        return false;
     const json* st = nullptr;
     if (!r.object(j, "static", st))
         return false;
@@ -348,6 +350,8 @@ void WorkloadTraceWriter::writeFrame(const WorkloadFrame& f) {
                 {"depth_bytes", f.static_split.depth_bytes}}}};
     if (!f.bits_per_pixel_lossless.empty())
         j["bpp_lossless"] = vec(f.bits_per_pixel_lossless);
+    if (f.fovea_fragments_per_px >= 0.0)
+        j["frag_px"] = f.fovea_fragments_per_px;
     if (f.static_split.bg_bytes_lossless >= 0.0)
         j["static"]["bg_bytes_lossless"] = f.static_split.bg_bytes_lossless;
     m_out << j.dump() << '\n';

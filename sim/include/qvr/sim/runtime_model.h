@@ -63,8 +63,10 @@ struct RuntimeSimConfig {
     std::function<double(int64_t frame, const LayerPlan& plan, int eye, int kind)> layer_triangles;
     // The fragments one eye's fovea (or whole-frame) pass shades for frame `frame` under `plan`
     // (RenderStats::fragment_invocations), < 0 where not known: the fovea law then charges its
-    // pixels at the calibration's fragments per pixel. Empty: none known. `qvr run` gives the
-    // counts its headset's own passes made (docs/MODEL.md §9).
+    // pixels at the calibration's fragments per pixel. Empty: the trace's recorded fragments per
+    // fovea pixel (WorkloadFrame::fovea_fragments_per_px, a qvr run's workload.jsonl) times the
+    // pass's pixels where the frame has them. `qvr run` gives the counts its headset's own passes
+    // made (docs/MODEL.md §9).
     std::function<double(int64_t frame, const LayerPlan& plan, int eye)> fovea_fragments;
 };
 

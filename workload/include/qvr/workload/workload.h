@@ -48,6 +48,10 @@ struct WorkloadFrame {
     // H.264"); empty when the trace did not record it (docs/RECORDING.md).
     std::vector<double> bits_per_pixel_lossless;
     StaticSplit static_split;
+    // The fragments the headset's fovea pass shaded per fovea pixel, both eyes (its overdraw,
+    // RenderStats::fragment_invocations); < 0 where not recorded (a qvr run's workload.jsonl
+    // records it; docs/WORKLOAD_FORMAT.md).
+    double fovea_fragments_per_px = -1.0;
 };
 
 struct WorkloadHeader {
