@@ -2,14 +2,16 @@
 # Shared periphery's cost (docs/RUNTIME.md §Shared periphery): two headsets of one motion and gaze
 # on one server, without sharing and with it, alternated per round so the host's drift falls on
 # both. Prints each round's server time per headset-frame, their ratio, and the gate's SSIM by
-# band.
+# band. OFFSET_MS > 0: the second headset plays the motion that far ahead (qvr run
+# --headset-offset-ms), so the two never share a pose and nothing is copied.
 #   bash scripts/shared_periphery_ab.sh QVR OUT [ROUNDS=3] [MODE=on|auto] [DESIGN=fixed:5]
+#        [OFFSET_MS=0]
 set -euo pipefail
 if [ $# -lt 2 ]; then
-    echo "usage: $0 QVR OUT [ROUNDS] [MODE] [DESIGN]" >&2
+    echo "usage: $0 QVR OUT [ROUNDS] [MODE] [DESIGN] [OFFSET_MS]" >&2
     exit 2
 fi
-qvr=$1 out=$2 rounds=${3:-3} mode=${4:-on} design=${5:-fixed:5}
+qvr=$1 out=$2 rounds=${3:-3} mode=${4:-on} design=${5:-fixed:5} offset=${6:-0}
 case $mode in on | auto) ;; *) echo "$0: MODE '$mode': expected on or auto" >&2; exit 2 ;; esac
 [[ $rounds =~ ^[1-9][0-9]*$ ]] || { echo "$0: ROUNDS '$rounds': expected a count" >&2; exit 2; }
 mkdir -p "$out"
@@ -19,7 +21,8 @@ for r in $(seq 1 "$rounds"); do
     for m in $order; do
         "$qvr" run --scene builtin:room --designs "$design" --profile small --frames 90 \
             --headset-share 0.25 --headsets 2 --identical-workloads --no-video --quality-every 0 \
-            --share-periphery "$m" --quiet --out "$out/r$r/$m" >"$out/r$r.$m.log" 2>&1
+            --headset-offset-ms "$offset" --share-periphery "$m" --quiet --out "$out/r$r/$m" \
+            >"$out/r$r.$m.log" 2>&1
     done
 done
 python3 - "$out" "$rounds" "$mode" <<'PY'

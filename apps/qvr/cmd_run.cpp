@@ -112,6 +112,11 @@ static Registered registerRun(CLI::App& app) {
            kMinHeadsets, kMaxHeadsets);
     cmd->add_flag("--identical-workloads", o->identical_workloads,
                   "Every headset the same motion and gaze (--motion, --gaze, --seed)");
+    addFinite(cmd, "--headset-offset-ms", o->headset_offset_ms,
+              "Headset k plays its motion and gaze k times this far ahead: with "
+              "--identical-workloads, headsets on one path a fraction of a frame apart, whose "
+              "poses are close and never the same",
+              0.0, 1000.0);
     addInt(cmd, "--quality-every", o->quality_every,
            "Measure every Nth displayed frame against a full-resolution render after each "
            "design's run (0: off)",
@@ -130,8 +135,11 @@ static Registered registerRun(CLI::App& app) {
                 o->no_holes ? " --no-holes" : "",
                 o->share_periphery != "off" ? " --share-periphery " + o->share_periphery : "",
                 o->headsets > 1
-                    ? fmt::format(" --headsets {}{}", o->headsets,
-                                  o->identical_workloads ? " --identical-workloads" : "")
+                    ? fmt::format(" --headsets {}{}{}", o->headsets,
+                                  o->identical_workloads ? " --identical-workloads" : "",
+                                  o->headset_offset_ms > 0.0
+                                      ? fmt::format(" --headset-offset-ms {}", o->headset_offset_ms)
+                                      : "")
                     : "");
             return runRun(*o);
         }};

@@ -346,8 +346,9 @@ std::optional<RunError> DesignRunner::startOtherHeadsets() {
     for (const std::string& r : defaultMotionRecordings())
         if (fs::exists(r))
             recordings.push_back(r);
-    m_workloads = headsetWorkloads(m_plan.headsets, m_plan.motion, m_plan.gaze, m_plan.seed,
-                                   m_plan.identical_workloads, recordings);
+    m_workloads =
+        headsetWorkloads(m_plan.headsets, m_plan.motion, m_plan.gaze, m_plan.seed,
+                         m_plan.identical_workloads, recordings, m_plan.headset_offset_ms);
     if (m_plan.headsets <= 1)
         return std::nullopt;
     auto others = OtherHeadsets::make(m_plan, m_workloads, m_m.client_core);
@@ -387,9 +388,11 @@ void printHeadsets(const std::vector<HeadsetOutcome>& headsets, const std::strin
         if (h.error.empty())
             fmt::print(
                 "    headset {:2} fps {:6.1f}  mtp {:6.1f} ms (p99 {:6.1f})  {:8.0f} B/frame  e1 "
-                "{:5.1f} deg  ({}, seed {})\n",
+                "{:5.1f} deg  ({}, seed {}{})\n",
                 h.index, s.fps_mean, s.mtp_ms_mean, s.mtp_ms_p99, s.bytes_per_frame_mean,
-                s.e1_deg_mean, fs::path(h.workload.motion).stem().string(), h.workload.seed);
+                s.e1_deg_mean, fs::path(h.workload.motion).stem().string(), h.workload.seed,
+                h.workload.ahead_ms > 0.0 ? fmt::format(", {:g} ms ahead", h.workload.ahead_ms)
+                                          : std::string());
         else
             fmt::print("    headset {:2} failed: {}\n", h.index, h.error);
     }

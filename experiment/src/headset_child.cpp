@@ -227,6 +227,7 @@ nlohmann::json OtherHeadsets::settings(size_t k, const std::string& design, uint
             {"motion", w.motion},
             {"gaze", w.gaze},
             {"seed", w.seed},
+            {"ahead_ms", w.ahead_ms},
             {"telemetry_csv", (dir / fmt::format("frames_{}.csv", design)).string()},
             {"summary_json", (dir / fmt::format("summary_{}.json", design)).string()}};
 }
@@ -334,6 +335,7 @@ Expected<HeadsetResult> childSession(const nlohmann::json& s) {
                           s.at("seed").get<uint64_t>());
     if (!inputs)
         return makeError(inputs.error());
+    playAhead(inputs->traces, s.at("ahead_ms").get<double>());
     // Ready once the renderer is made and the scene uploaded: the first frame is about to start.
     hc->before_frame = [](int64_t frame) {
         if (frame != 0)

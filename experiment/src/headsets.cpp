@@ -13,10 +13,11 @@ std::vector<std::string> defaultMotionRecordings() {
 std::vector<HeadsetWorkload> headsetWorkloads(int headsets, const std::string& motion,
                                               const std::string& gaze, uint64_t seed,
                                               bool identical,
-                                              const std::vector<std::string>& recordings) {
+                                              const std::vector<std::string>& recordings,
+                                              double offset_ms) {
     std::vector<HeadsetWorkload> out;
     for (int k = 0; k < headsets; ++k) {
-        HeadsetWorkload w{motion, gaze, seed};
+        HeadsetWorkload w{motion, gaze, seed, double(k) * offset_ms};
         if (k > 0 && !identical) {
             w.seed = seed + uint64_t(k);
             if (motion == "default" && !recordings.empty())
@@ -81,7 +82,8 @@ nlohmann::json headsetJson(const HeadsetOutcome& h) {
     nlohmann::json j = {{"headset", h.index},
                         {"motion", h.workload.motion},
                         {"gaze", h.workload.gaze},
-                        {"seed", h.workload.seed}};
+                        {"seed", h.workload.seed},
+                        {"ahead_ms", h.workload.ahead_ms}};
     if (!h.error.empty()) {
         j["error"] = h.error;
         return j;

@@ -129,6 +129,7 @@ RunOutcome runOutcome(const RunOptions& plan, const HmdProfile& profile,
     o.video = std::move(video);
     o.headsets = plan.headsets;
     o.identical_workloads = plan.identical_workloads;
+    o.headset_offset_ms = plan.headset_offset_ms;
     o.headsets_by_design = m.headsets;
     o.never_shown = m.never_shown;
     o.stale_only = m.stale_only;
@@ -408,6 +409,7 @@ void headsetsSummaryJson(const RunOutcome& o, nlohmann::json& j) {
         return;
     j["headsets_requested"] = o.headsets;
     j["identical_workloads"] = o.identical_workloads;
+    j["headset_offset_ms"] = o.headset_offset_ms;
     nlohmann::json by_design = nlohmann::json::object();
     for (const HeadsetsResult& r : o.headsets_by_design)
         by_design[r.design] = headsetsJson(r);

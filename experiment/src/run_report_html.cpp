@@ -322,12 +322,16 @@ void headsetsHtml(report::HtmlReport& page, const RunOutcome& o) {
     page.paragraph(fmt::format(
         "Headset 0 runs in this process as every run's headset does; the others each in a "
         "process of their own, all pinned to the headset core {} and started together at headset "
-        "0's first frame; {}. Jain's fairness index is (ΣFPS)² / (n·ΣFPS²): 1 "
+        "0's first frame; {}{}. Jain's fairness index is (ΣFPS)² / (n·ΣFPS²): 1 "
         "when every headset has the same frame rate. The server time per headset-frame is its "
         "render, readback and encode time per frame it served while the headsets ran.",
         o.client_core,
         o.identical_workloads ? "every headset the same motion and gaze (--identical-workloads)"
-                              : "each its own motion recording and gaze seed"));
+                              : "each its own motion recording and gaze seed",
+        o.headset_offset_ms > 0.0
+            ? fmt::format(", headset k {:g} ms ahead of headset 0 per k (--headset-offset-ms)",
+                          o.headset_offset_ms)
+            : std::string()));
     report::Table t({"design", "headset", "motion", "seed", "FPS", "MTP p99 ms", "KB/frame",
                      "e1 mean °", "Jain's index (FPS)", "server ms per headset-frame"});
     for (const HeadsetsResult& r : o.headsets_by_design)

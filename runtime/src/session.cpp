@@ -87,6 +87,15 @@ Expected<HeadsetTraces> makeTraces(const std::string& motion, const std::string&
     return t;
 }
 
+void playAhead(HeadsetTraces& traces, double ms) {
+    for (PoseSample& s : traces.motion.samples)
+        s.t_ms -= ms;
+    for (GazeSample& s : traces.gaze.samples)
+        s.t_ms -= ms;
+    for (GazeEvent& e : traces.gaze.events)
+        e.start_ms -= ms;
+}
+
 Expected<HeadsetInputs> loadHeadsetInputs(const std::string& scene, const std::string& motion,
                                           const std::string& gaze, double refresh_hz, int frames,
                                           uint64_t seed) {

@@ -281,6 +281,9 @@ for n in 0 17 x; do
         fail "run --headsets $n exits 2" "exit $rc: $(head -c 200 "$tmp/bad_err.txt")"
     fi
 done
+for v in -1 nan 1001; do
+    expect_error "run --headset-offset-ms $v" run --headsets 2 --headset-offset-ms "$v" --frames 2 --out "$tmp/run"
+done
 # qvr capacity: a calibration and a workload are required; bad values exit 2.
 for args in "--trace x --target-fps 30" \
     "--hardware /nonexistent.toml --trace x --target-fps 30" \

@@ -66,6 +66,13 @@ TEST(HeadsetWorkloads, IdenticalAreAllThePlans) {
         EXPECT_EQ(h, (HeadsetWorkload{"default", "model", 3}));
 }
 
+TEST(HeadsetWorkloads, HeadsetKPlaysKOffsetsAhead) {
+    const auto w = headsetWorkloads(3, "default", "model", 3, true, kRecordings, 2.5);
+    ASSERT_EQ(w.size(), 3u);
+    for (size_t k = 0; k < w.size(); ++k)
+        EXPECT_EQ(w[k], (HeadsetWorkload{"default", "model", 3, 2.5 * double(k)}));
+}
+
 runtime::ServerFrameStamps stamp(int64_t start_ns,
                                  std::vector<std::pair<int64_t, int64_t>> layers) {
     runtime::ServerFrameStamps s;

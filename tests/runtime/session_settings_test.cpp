@@ -6,7 +6,10 @@
 
 #include <chrono>
 
+#include <glm/geometric.hpp>
+
 #include "qvr/runtime/serve_loop.h"
+#include "qvr/runtime/session.h"
 
 namespace qvr::runtime {
 namespace {
@@ -53,6 +56,26 @@ TEST(SessionSettings, HeadsetConfigParsesTheDesignAndProfile) {
     auto bad = headsetConfig(s);
     ASSERT_FALSE(bad);
     EXPECT_EQ(bad.error().rfind("--design: ", 0), 0u);
+}
+
+TEST(PlayAhead, GivesAtEachTimeWhatTheTracesGaveThatMuchLater) {
+    auto base = loadHeadsetInputs("builtin:room", "default", "model", 90.0, 60, 4);
+    ASSERT_TRUE(base) << base.error();
+    HeadsetTraces ahead = base->traces;
+    playAhead(ahead, 3.7);
+    for (double t : {0.0, 11.1, 250.0, 600.0}) {
+        const Pose a = poseAt(ahead.motion, t), b = poseAt(base->traces.motion, t + 3.7);
+        EXPECT_NEAR(glm::length(a.position_m - b.position_m), 0.0, 1e-6) << t;
+        EXPECT_NEAR(std::fabs(glm::dot(a.orientation, b.orientation)), 1.0, 1e-6) << t;
+        const Gaze ga = gazeAt(ahead.gaze, t), gb = gazeAt(base->traces.gaze, t + 3.7);
+        EXPECT_NEAR(ga.x_deg, gb.x_deg, 1e-9) << t;
+        EXPECT_NEAR(ga.y_deg, gb.y_deg, 1e-9) << t;
+    }
+    // A fraction of a frame ahead is a different pose while the head moves.
+    const Pose a = poseAt(ahead.motion, 300.0), b = poseAt(base->traces.motion, 300.0);
+    EXPECT_GT(glm::length(a.position_m - b.position_m) +
+                  (1.0 - std::fabs(glm::dot(a.orientation, b.orientation))),
+              1e-7);
 }
 
 TEST(ServeLoop, StopsAtTheDurationOrWhenStopped) {

@@ -26,6 +26,7 @@ struct HeadsetWorkload {
     std::string motion;
     std::string gaze;
     uint64_t seed = 1;
+    double ahead_ms = 0.0;  // plays its motion and gaze this far ahead (playAhead)
     bool operator==(const HeadsetWorkload&) const = default;
 };
 
@@ -36,11 +37,13 @@ std::vector<std::string> defaultMotionRecordings();
 // The workloads of `headsets` headsets. Headset 0 always has the plan's own (motion, gaze,
 // seed), so one headset runs what `qvr run` always ran. Identical: every headset the same. Else,
 // with the default motion, headset k takes recording k of `recordings` (cyclically) and the gaze
-// seed seed + k; with any other motion, every headset that motion and its own gaze seed.
+// seed seed + k; with any other motion, every headset that motion and its own gaze seed. Headset
+// k plays k × offset_ms ahead (qvr run --headset-offset-ms).
 std::vector<HeadsetWorkload> headsetWorkloads(int headsets, const std::string& motion,
                                               const std::string& gaze, uint64_t seed,
                                               bool identical,
-                                              const std::vector<std::string>& recordings);
+                                              const std::vector<std::string>& recordings,
+                                              double offset_ms = 0.0);
 
 // Jain's fairness index (Σx)² / (n·Σx²): 1 when every value is equal, 1/n when one takes all.
 // 1 for no values or all zero; negative values are taken as 0.

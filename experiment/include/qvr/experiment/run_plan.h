@@ -43,6 +43,7 @@ struct RunOptions {
     // each in a process of its own, all started together for every design.
     int headsets = 1;
     bool identical_workloads = false;  // every headset the plan's motion, gaze and seed
+    double headset_offset_ms = 0.0;    // headset k plays k × this ahead (close, distinct paths)
     std::string command_line;
 };
 

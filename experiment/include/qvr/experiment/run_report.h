@@ -80,6 +80,7 @@ struct RunOutcome {
     // Every design's headsets (one each unless qvr run --headsets N), in the order they ran.
     int headsets = 1;
     bool identical_workloads = false;
+    double headset_offset_ms = 0.0;
     std::vector<HeadsetsResult> headsets_by_design;
 };
 

@@ -28,6 +28,11 @@ Expected<HeadsetTraces> makeTraces(const std::string& motion, const std::string&
                                    const Scene& scene, double refresh_hz, int frames,
                                    uint64_t seed);
 
+// The traces played `ms` ahead: at time t they give what they gave at t + ms (the last sample
+// held past its end). Headsets on one path a fraction of a frame apart never repeat each other's
+// poses (qvr run --headset-offset-ms).
+void playAhead(HeadsetTraces& traces, double ms);
+
 // What a headset runs on: the scene (with its BVH for LIWC's ring counts) and the traces placed
 // in it, loaded from the command line's spellings (makeTraces for motion and gaze).
 struct HeadsetInputs {
