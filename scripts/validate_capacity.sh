@@ -17,6 +17,9 @@
 #
 # Usage: scripts/validate_capacity.sh QVR OUT_DIR [MAX_HEADSETS=4] [SHARE=0.25] [FRAMES=90]
 #        [TARGET_FPS=5] [REPEATS=3] [extra qvr run options, e.g. --profile small]
+# DESIGN=fixed:5 (environment; default qvr) validates another design: a fixed e1 takes LIWC's
+# choices out and leaves the server's and the headsets' costs. The workload is a qvr design's:
+# round 1's N = 1 run, or for another design one more qvr run (OUT/wl).
 set -euo pipefail
 usage="usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [REPEATS] [options]"
 qvr=${1:?$usage}
@@ -27,46 +30,55 @@ frames=${5:-90}
 target=${6:-5}
 repeats=${7:-3}
 shift $(($# < 7 ? $# : 7))
+design=${DESIGN:-qvr}
 mkdir -p "$out"
 for r in $(seq 1 "$repeats"); do
     mkdir -p "$out/r$r"
     for k in $(seq 0 $((max - 1))); do
         n=$(((k + r - 1) % max + 1))
         dir="$out/r$r/h$n"
-        nice -n 5 "$qvr" run --headsets "$n" --identical-workloads --designs qvr \
+        nice -n 5 "$qvr" run --headsets "$n" --identical-workloads --designs "$design" \
             --frames "$frames" --headset-share "$share" --no-video --quality-every 0 --quiet \
             --out "$dir" "$@" >"$dir.log" 2>&1 ||
             { echo "validate_capacity: run N=$n failed (see $dir.log)" >&2; exit 1; }
     done
 done
 first="$out/r1/h1/summary.json"
+workload="$out/r1/h1/workload.jsonl"
+if [ "$design" != qvr ]; then  # only the qvr design records its workload
+    workload="$out/wl/workload.jsonl"
+    nice -n 5 "$qvr" run --designs qvr --frames "$frames" --headset-share "$share" --no-video \
+        --quality-every 0 --quiet --out "$out/wl" "$@" >"$out/wl.log" 2>&1 ||
+        { echo "validate_capacity: the workload run failed (see $out/wl.log)" >&2; exit 1; }
+fi
 field() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))$1)" "$first"; }
 cal=$(field "['calibration']['path']")
 net=$(field "['net']")
 scene=$(field "['scene']")
 lod=$(python3 -c "import json,re,sys; m=re.search(r'--lod-px (\S+)', json.load(open(sys.argv[1]))['command']); print(m.group(1) if m else 1)" "$first")
-nice -n 5 "$qvr" capacity --hardware "$cal" --trace "$out/r1/h1/workload.jsonl" --net "$net" \
+nice -n 5 "$qvr" capacity --hardware "$cal" --trace "$workload" --net "$net" --design "$design" \
     --scene "$scene" --lod-px "$lod" \
     --target-fps "$target" --headset-share "$share" --headsets-share-one-core \
     --max-headsets "$max" --every-count --frames "$frames" --json "$out/capacity.json" \
     >"$out/capacity.log"
-python3 - "$out" "$max" "$target" "$repeats" <<'EOF'
+python3 - "$out" "$max" "$target" "$repeats" "$design" <<'EOF'
 import json, statistics, sys
 out, n_max, target, repeats = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+design = sys.argv[5]
 pred = {p["headsets"]: p for p in json.load(open(f"{out}/capacity.json"))["points"]}
 
 
 def reading(path):
     s = json.load(open(path))
-    if "headsets" not in s:  # one headset's summary keeps its keys: the qvr design's
-        q = s["designs"]["qvr"]
+    if "headsets" not in s:  # one headset's summary keeps its keys: the design's
+        q = s["designs"][design]
         s["headsets"] = [q]
         s["server_ms_per_headset_frame"] = q.get("server_busy_ms_mean")
     fps = [h["fps_mean"] for h in s["headsets"] if "fps_mean" in h]
     return {"fps": sum(fps) / len(fps) if fps else 0.0, "fps_min": min(fps, default=0.0),
             "jain": s.get("jain_fairness_fps", 1.0),
             "server_ms": s.get("server_ms_per_headset_frame") or float("nan"),
-            "own": s["designs"]["qvr"].get("predicted", {}).get("fps_mean", float("nan"))}
+            "own": s["designs"][design].get("predicted", {}).get("fps_mean", float("nan"))}
 
 
 rows, measured_cap, predicted_cap, worst = [], 0, 0, 0.0
