@@ -55,6 +55,25 @@ RuntimeCosts flatCosts(double fovea_pass_ms, double uca_ms, double server_layer_
     return c;
 }
 
+// ffr (a 5° fovea) over `frames` frames with these costs.
+RuntimeSimConfig ffrConfig(const RuntimeCosts& costs, int frames) {
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Ffr;
+    cfg.costs = costs;
+    cfg.frames = frames;
+    return cfg;
+}
+
+// A fovea law of 1 ms per million fragments and nothing else (a 1 ms UCA), charging 2.5
+// fragments a pixel where none are known.
+RuntimeCosts fragmentLaw() {
+    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
+    c.fovea = {};
+    c.fovea.ms_per_mfrag = 1.0;
+    c.fovea.frag_per_px = 2.5;
+    return c;
+}
+
 // A link so fast its transfers take no measurable time.
 NoisyLink fastLink() {
     return NoisyLink("fast", 1e15, 1.0, kInf, {0, 0}, 1);
@@ -488,10 +507,7 @@ TEST(RuntimeModel, CostsScaleWithPixelsAndTriangles) {
     RuntimeCosts c = flatCosts(1.0, 1.0, 1.0);
     c.fovea.ms_per_mpx = 100.0;
     const WorkloadTrace trace = flatTrace(20);
-    RuntimeSimConfig cfg;
-    cfg.design = Design::Ffr;
-    cfg.costs = c;
-    cfg.frames = 20;
+    RuntimeSimConfig cfg = ffrConfig(c, 20);
     NoisyLink link = fastLink();
     cfg.fixed_e1_deg = 5.0;
     const RuntimeRunResult small = simulateRuntime(trace, cfg, link);
@@ -515,10 +531,7 @@ TEST(RuntimeModel, ServerLayersCostTheirTrianglesOverTheirScaleSquared) {
     RuntimeCosts c = flatCosts(1.0, 1.0, 0.0);
     c.server_render = {0.0, 0.0, 1.0};
     const WorkloadTrace trace = flatTrace(10);
-    RuntimeSimConfig cfg;
-    cfg.design = Design::Ffr;
-    cfg.costs = c;
-    cfg.frames = 10;
+    RuntimeSimConfig cfg = ffrConfig(c, 10);
     NoisyLink link = fastLink();
     const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
     const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[0].gaze, 5.0);
@@ -621,10 +634,7 @@ TEST(RuntimeModel, LayersCostTheTrianglesTheCallerSaysTheyDraw) {
     c.fovea = {0.0, 0.0, 1.0};
     c.server_render = {0.0, 0.0, 2.0};
     const WorkloadTrace trace = flatTrace(10);
-    RuntimeSimConfig cfg;
-    cfg.design = Design::Ffr;
-    cfg.costs = c;
-    cfg.frames = 10;
+    RuntimeSimConfig cfg = ffrConfig(c, 10);
     int calls = 0;
     cfg.layer_triangles = [&](int64_t frame, const LayerPlan& plan, int eye, int kind) {
         ++calls;
@@ -665,15 +675,9 @@ TEST(RuntimeModel, TheFoveaCostsTheFragmentsTheCallerSaysItShades) {
     // A fovea law of 1 ms per million fragments and nothing else: with a fovea_fragments count
     // of 1e6·(frame + 1)·(eye + 1) per eye, frame k's fovea takes 3·(k + 1) ms; where the count
     // is not known (< 0, here frame 4) its pixels at the calibration's 2.5 fragments a pixel.
-    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
-    c.fovea = {};
-    c.fovea.ms_per_mfrag = 1.0;
-    c.fovea.frag_per_px = 2.5;
+    const RuntimeCosts c = fragmentLaw();
     const WorkloadTrace trace = flatTrace(10);
-    RuntimeSimConfig cfg;
-    cfg.design = Design::Ffr;
-    cfg.costs = c;
-    cfg.frames = 10;
+    RuntimeSimConfig cfg = ffrConfig(c, 10);
     cfg.fovea_fragments = [](int64_t frame, const LayerPlan& plan, int eye) {
         EXPECT_NEAR(plan.e1_deg, 5.0, 1e-9);
         return frame == 4 ? -1.0 : 1e6 * double(frame + 1) * double(eye + 1);
@@ -695,17 +699,11 @@ TEST(RuntimeModel, WithoutTheCallersCountsTheFoveaCostsTheTracesRecordedFragment
     // The same law, no fovea_fragments: frames that recorded their fovea's fragments per pixel
     // (a qvr run's workload.jsonl, frag_px) are charged that many per fovea pixel, the others
     // the calibration's 2.5; a whole-frame pass (local) is never charged the fovea's overdraw.
-    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
-    c.fovea = {};
-    c.fovea.ms_per_mfrag = 1.0;
-    c.fovea.frag_per_px = 2.5;
+    const RuntimeCosts c = fragmentLaw();
     WorkloadTrace trace = flatTrace(10);
     for (int k : {2, 6})
         trace.frames[size_t(k)].fovea_fragments_per_px = 10.0;
-    RuntimeSimConfig cfg;
-    cfg.design = Design::Ffr;
-    cfg.costs = c;
-    cfg.frames = 10;
+    RuntimeSimConfig cfg = ffrConfig(c, 10);
     NoisyLink link = fastLink();
     const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
     const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[2].gaze, 5.0);
