@@ -271,18 +271,20 @@ expect_error "calibrate --codec bogus" calibrate --codec bogus --out "$tmp/cal.t
 expect_error "run --hardware /nonexistent" run --hardware /nonexistent.toml --frames 2 --out "$tmp/run"
 expect_error "run --quality-every -1" run --quality-every -1 --frames 2 --out "$tmp/run"
 expect_error "run --hardware <bad runtime.pipeline>" run --hardware "$tmp/rt_bad.toml" --frames 2 --out "$tmp/run"
-# --headsets is bounded (1..16): a bad count exits 2 before anything runs.
-for n in 0 17 x; do
-    "$QVR" run --headsets "$n" --frames 2 --out "$tmp/run" >/dev/null 2>"$tmp/bad_err.txt"
+# --headsets (1..16) and --headset-offset-ms ([0, 1000]) are bounded: a bad value exits 2, naming
+# its option, before anything runs.
+for bad in "headsets 0" "headsets 17" "headsets x" "headset-offset-ms -1" "headset-offset-ms nan" \
+    "headset-offset-ms 1001"; do
+    set -- $bad
+    others=()
+    [ "$1" = headsets ] || others=(--headsets 2)
+    "$QVR" run "${others[@]}" "--$1" "$2" --frames 2 --out "$tmp/run" >/dev/null 2>"$tmp/bad_err.txt"
     rc=$?
-    if [ $rc -eq 2 ] && grep -q -- "--headsets" "$tmp/bad_err.txt"; then
-        pass "run --headsets $n exits 2"
+    if [ $rc -eq 2 ] && grep -q -- "--$1" "$tmp/bad_err.txt"; then
+        pass "run --$1 $2 exits 2"
     else
-        fail "run --headsets $n exits 2" "exit $rc: $(head -c 200 "$tmp/bad_err.txt")"
+        fail "run --$1 $2 exits 2" "exit $rc: $(head -c 200 "$tmp/bad_err.txt")"
     fi
-done
-for v in -1 nan 1001; do
-    expect_error "run --headset-offset-ms $v" run --headsets 2 --headset-offset-ms "$v" --frames 2 --out "$tmp/run"
 done
 # qvr capacity: a calibration and a workload are required; bad values exit 2.
 for args in "--trace x --target-fps 30" \
