@@ -371,7 +371,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         // What the server took beyond the transmission, against what it had to draw.
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
-        const double server_ms = std::max(0.0, m.t_remote_ms - sent_bits / bps * 1000.0);
+        const double server_ms = serverMsOf(m, sent_bits / bps * 1000.0);
         if (!opening)
             m_server_fit.add(
                 {1.0, decided->periphery_triangles * 1e-5, decided->periphery_pixels * 1e-5},
@@ -401,10 +401,26 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
     }
     m_bits_law_measured = m_bits_law_measured || have_mid || have_out;
+    if (m.arrival_ms > 0.0)
+        m_last_arrival_ms = m.arrival_ms;
     // The next candidates step from the newest decision; the measured e1 replaces it only when
     // no later decision is already out (a pipelined headset has one in flight).
     if (m_pending.empty())
         m_e1_deg = m.e1_deg;
+}
+
+double LiwcPolicy::serverMsOf(const FrameMeasurement& m, double sent_ms) const {
+    // T_remote runs from when the server could start: the request, or the previous frame's last
+    // packet when the request came before it. In that second case the server worked on this
+    // frame while the link carried the one before, so the link's time does not add to the
+    // server's: when the headset waited (its busy time under T_remote) and so did the link (the
+    // frame's transmission under T_remote), the server set the pace and its frame took
+    // T_remote. Otherwise T_remote is the server and the transmission in turn.
+    const bool overlapped =
+        m.request_ms > 0.0 && m_last_arrival_ms > 0.0 && m.request_ms < m_last_arrival_ms;
+    if (overlapped && m.t_local_ms < m.t_remote_ms && sent_ms < m.t_remote_ms)
+        return m.t_remote_ms;
+    return std::max(0.0, m.t_remote_ms - sent_ms);
 }
 
 bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {

@@ -116,6 +116,8 @@ private:
     // Whether the measured frame is kept apart from the steady-state fits: its e1 moved from the
     // previous one's, or it is the session's first (its encoders' opening key frames).
     bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
+    // What the server took of a frame, from its T_remote and its transmission (sent_ms).
+    double serverMsOf(const FrameMeasurement& m, double sent_ms) const;
     // Both eyes' middle and outer layers' bits at e1 (0 once the fovea covers the frame).
     double peripheryBits(const Gaze& gaze, double e1_deg) const;
     double peripheryTriangles(double e1_deg) const;
@@ -159,6 +161,7 @@ private:
     double m_frames_between_moves = 1.0;
     int m_frames_since_move = 0;
     double m_last_observed_e1_deg = -1.0;
+    double m_last_arrival_ms = 0.0;  // the newest observed frame's last periphery packet
     // reactive: the rings of the newest observed frame, and those of frames not yet observed.
     struct SeenFrame {
         int64_t index = 0;
