@@ -342,9 +342,9 @@ TEST(LiwcPeriodObjective, LearnsTheServersFrameWhenItsRenderHidesTheTransmission
             }
     };
     findBest();
-    // A link that takes three quarters of the server's time where the headset meets the server.
-    truth.throughput_bps = 1.0;
-    truth.throughput_bps = stages(best_e)[2] / (0.75 * stages(best_e)[1]);
+    // A link that takes three quarters of the server's time where the headset meets the server
+    // (the transmission goes as 1 / throughput).
+    truth.throughput_bps *= stages(best_e)[2] / (0.75 * stages(best_e)[1]);
     findBest();
     for (double start : {5.0, 40.0}) {
         LiwcConfig c = periodConfig();
