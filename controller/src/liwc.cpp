@@ -368,7 +368,8 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     if (m.throughput_bps > 0.0)
         m_throughput_bps = (1.0 - b) * m_throughput_bps + b * m.throughput_bps;
     if (m_config.frame_period_objective && decided && m.t_remote_ms > 0.0) {
-        // What the server took beyond the transmission, against what it had to draw.
+        // What the server took of the frame (serverMsOf, which reads the previous arrival
+        // before it is replaced below), against what it had to draw.
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
         const double server_ms = serverMsOf(m, sent_bits / bps * 1000.0);
