@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 #include <glm/gtc/quaternion.hpp>
 
+#include "qvr/compose/bilinear_span.h"
 #include "qvr/core/pose.h"
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/runtime/session.h"
@@ -51,5 +52,28 @@ BENCHMARK(BM_ReduceSharedLayer)
     ->Args({1, 0})
     ->Args({1, 5})
     ->Unit(benchmark::kMicrosecond);
+
+// The warp's taps alone, the vector kernel (arg 1) against its scalar twin (arg 0): the outer
+// layer's texels as 5° of yaw lays them on the render, 16 to a span.
+void BM_BilinearSpans(benchmark::State& state) {
+    const Case c(LayerKind::kOuter);
+    const LayerRect& mine = layerOf(c.plan.eyes[0], LayerKind::kOuter);
+    std::vector<FixedSpan> spans;
+    for (int j = 0; j < mine.height_px; ++j)
+        for (int i = 0; i < mine.width_px; i += 16)
+            spans.push_back({int64_t(i) * 65536 + 40000, int64_t(j) * 65536 + 9000 * (i / 16),
+                             63000, 700, std::min(16, mine.width_px - i)});
+    std::vector<uint8_t> out(size_t(mine.pixels()) * 4);
+    for (auto _ : state) {
+        if (state.range(0) == 1)
+            bilinearSpans(c.image, spans.data(), spans.size(), out.data());
+        else
+            bilinearSpansScalar(c.image, spans.data(), spans.size(), out.data());
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.counters["texels"] = double(mine.pixels());
+    state.SetLabel(state.range(0) == 1 ? bilinearSpanTarget() : "scalar");
+}
+BENCHMARK(BM_BilinearSpans)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "qvr/compose/bilinear_span.h"
 #include "qvr/compose/quality.h"
 #include "qvr/compose/warp.h"
 #include "qvr/core/check.h"
@@ -225,7 +226,7 @@ namespace {
 // lens, which the layers do not have). A flat pinhole rotation is a homography: its exact image is
 // taken every kSpan texels along a row and stepped linearly between (a turn of 3° in yaw and
 // pitch bends it off its chord by at most 0.06 texel over a span, at the corners of a ±50° view),
-// each texel a fixed-point bilinear tap.
+// each texel a fixed-point bilinear tap (bilinearSpans: a vector of taps at a time).
 void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
                      const LayerRect& member, ImageRgba8& out, const HmdProfile& profile,
                      const glm::quat& shared_orientation, const glm::quat& member_orientation) {
@@ -248,41 +249,23 @@ void warpSharedLayer(const ImageRgba8& shared, const LayerRect& shared_rect,
         const double depth = std::max(-r.z, 1e-9);
         return glm::dvec2(bx + ax * r.x / depth, by - ay * r.y / depth);
     };
-    const int w = shared.width(), h = shared.height();
-    const size_t stride = static_cast<size_t>(w) * 4;
-    const uint8_t* src = shared.data();
     constexpr int kSpan = 16;
     constexpr double kOne = 65536.0;  // 16.16 fixed point
-    const int64_t max_x = int64_t(w - 1) << 16, max_y = int64_t(h - 1) << 16;
+    std::vector<FixedSpan> spans(static_cast<size_t>((member.width_px + kSpan - 1) / kSpan));
     for (int j = 0; j < member.height_px; ++j) {
         const glm::dvec3 row = r0 + double(j) * dj;
-        uint8_t* dst = out.data() + static_cast<size_t>(j) * member.width_px * 4;
         glm::dvec2 a = texel(row);
-        for (int i0 = 0; i0 < member.width_px; i0 += kSpan) {
+        for (size_t k = 0; k < spans.size(); ++k) {
+            const int i0 = int(k) * kSpan;
             const int n = std::min(kSpan, member.width_px - i0);
             const glm::dvec2 b = texel(row + double(i0 + n) * di);
-            int64_t x = std::llround(a.x * kOne), y = std::llround(a.y * kOne);
-            const int64_t sx = std::llround((b.x - a.x) / n * kOne);
-            const int64_t sy = std::llround((b.y - a.y) / n * kOne);
-            for (int k = 0; k < n; ++k, x += sx, y += sy, dst += 4) {
-                const int64_t cx = std::clamp<int64_t>(x, 0, max_x);
-                const int64_t cy = std::clamp<int64_t>(y, 0, max_y);
-                const int x0 = int(cx >> 16), y0 = int(cy >> 16);
-                const uint32_t fx = uint32_t(cx >> 8) & 255u, fy = uint32_t(cy >> 8) & 255u;
-                const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-                const uint8_t* p00 = src + size_t(y0) * stride + size_t(x0) * 4;
-                const uint8_t* p10 = src + size_t(y0) * stride + size_t(x1) * 4;
-                const uint8_t* p01 = src + size_t(y1) * stride + size_t(x0) * 4;
-                const uint8_t* p11 = src + size_t(y1) * stride + size_t(x1) * 4;
-                for (int c = 0; c < 3; ++c) {
-                    const uint32_t top = p00[c] * (256u - fx) + p10[c] * fx;
-                    const uint32_t bottom = p01[c] * (256u - fx) + p11[c] * fx;
-                    dst[c] = uint8_t((top * (256u - fy) + bottom * fy + 32768u) >> 16);
-                }
-                dst[3] = 255;
-            }
+            spans[k] = {std::llround(a.x * kOne), std::llround(a.y * kOne),
+                        std::llround((b.x - a.x) / n * kOne), std::llround((b.y - a.y) / n * kOne),
+                        n};
             a = b;
         }
+        bilinearSpans(shared, spans.data(), spans.size(),
+                      out.data() + static_cast<size_t>(j) * member.width_px * 4);
     }
 }
 
