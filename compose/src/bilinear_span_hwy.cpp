@@ -4,6 +4,7 @@
 // leave the 32-bit range (a ray grazing the eye's plane) takes the scalar twin.
 #include <algorithm>
 #include <cstring>
+#include <iterator>
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "bilinear_span_hwy.cpp"
@@ -97,14 +98,17 @@ void spanVector(const ImageRgba8& src, const FixedSpan& s, uint8_t* dst) {
     }
 }
 
+// Whether every lane spanVector computes, those past the span's end in its last vector too,
+// holds its coordinates in int32 (then no lane's arithmetic overflows, on any target).
 bool fitsInt32(const FixedSpan& s) {
     constexpr int64_t kLimit = int64_t(1) << 30;
-    const int64_t last = s.n > 0 ? s.n - 1 : 0;
+    const int64_t lanes = static_cast<int64_t>(hn::Lanes(DI()));
+    const int64_t last = std::max<int64_t>(1, (s.n + lanes - 1) / lanes) * lanes - 1;
+    if (s.sx < -kLimit || s.sx > kLimit || s.sy < -kLimit || s.sy > kLimit)
+        return false;
     const int64_t ends[4] = {s.x, s.y, s.x + last * s.sx, s.y + last * s.sy};
-    for (int64_t v : ends)
-        if (v < -kLimit || v > kLimit)
-            return false;
-    return s.sx >= -kLimit && s.sx <= kLimit && s.sy >= -kLimit && s.sy <= kLimit;
+    return std::all_of(std::begin(ends), std::end(ends),
+                       [](int64_t v) { return v >= -kLimit && v <= kLimit; });
 }
 
 }  // namespace
