@@ -19,7 +19,14 @@
 #        [TARGET_FPS=5] [REPEATS=3] [extra qvr run options, e.g. --profile small]
 # DESIGN=fixed:5 (environment; default qvr) validates another design: a fixed e1 takes LIWC's
 # choices out and leaves the server's and the headsets' costs. The workload is a qvr design's:
-# round 1's N = 1 run, or for another design one more qvr run (OUT/wl).
+# round 1's N = 1 run, or for another design one more qvr run (OUT/wl). REUSE=1 keeps the runs an
+# earlier call left in OUT_DIR and only predicts again.
+#
+# Two predictions per N: at the calibration's speed (the machine as it was calibrated, a cached
+# calibration maybe hours before), and at the speed the runs' own probes measured (qvr capacity
+# --headset-speed/--server-speed: for each N the median over its rounds of summary.json
+# calibration.speed_reference.run_over_reference, the fixed reference frames timed around each
+# run). The second is the model's error; the gap between the two is the machine's drift.
 set -euo pipefail
 usage="usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [REPEATS] [options]"
 qvr=${1:?$usage}
@@ -37,6 +44,7 @@ for r in $(seq 1 "$repeats"); do
     for k in $(seq 0 $((max - 1))); do
         n=$(((k + r - 1) % max + 1))
         dir="$out/r$r/h$n"
+        [ "${REUSE:-0}" = 1 ] && [ -s "$dir/summary.json" ] && continue
         nice -n 5 "$qvr" run --headsets "$n" --identical-workloads --designs "$design" \
             --frames "$frames" --headset-share "$share" --no-video --quality-every 0 --quiet \
             --out "$dir" "$@" >"$dir.log" 2>&1 ||
@@ -56,16 +64,38 @@ cal=$(field "['calibration']['path']")
 net=$(field "['net']")
 scene=$(field "['scene']")
 lod=$(python3 -c "import json,re,sys; m=re.search(r'--lod-px (\S+)', json.load(open(sys.argv[1]))['command']); print(m.group(1) if m else 1)" "$first")
-nice -n 5 "$qvr" capacity --hardware "$cal" --trace "$workload" --net "$net" --design "$design" \
-    --scene "$scene" --lod-px "$lod" \
-    --target-fps "$target" --headset-share "$share" --headsets-share-one-core \
-    --max-headsets "$max" --every-count --frames "$frames" --json "$out/capacity.json" \
-    >"$out/capacity.log"
+capacity() {  # capacity JSON [options]: qvr capacity on the workload, every count
+    local json=$1
+    shift
+    nice -n 5 "$qvr" capacity --hardware "$cal" --trace "$workload" --net "$net" \
+        --design "$design" --scene "$scene" --lod-px "$lod" --target-fps "$target" \
+        --headset-share "$share" --headsets-share-one-core --every-count --frames "$frames" \
+        --json "$json" "$@" >"${json%.json}.log" ||
+        { echo "validate_capacity: qvr capacity failed (see ${json%.json}.log)" >&2; exit 1; }
+}
+capacity "$out/capacity.json" --max-headsets "$max"
+for n in $(seq 1 "$max"); do
+    # The median factors over N's rounds: two words.
+    read -r h_speed s_speed < <(python3 - "$out" "$n" "$repeats" <<'EOF'
+import json, statistics, sys
+out, n, repeats = sys.argv[1], sys.argv[2], int(sys.argv[3])
+f = [json.load(open(f"{out}/r{r}/h{n}/summary.json"))["calibration"]["speed_reference"]
+     .get("run_over_reference", {}) for r in range(1, repeats + 1)]
+print(*(statistics.median(x.get(side, 1.0) for x in f) for side in ("headset", "server")))
+EOF
+)
+    capacity "$out/capacity_at_speed_$n.json" --max-headsets "$n" --headset-speed "$h_speed" \
+        --server-speed "$s_speed"
+done
 python3 - "$out" "$max" "$target" "$repeats" "$design" <<'EOF'
 import json, statistics, sys
 out, n_max, target, repeats = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
 design = sys.argv[5]
 pred = {p["headsets"]: p for p in json.load(open(f"{out}/capacity.json"))["points"]}
+at_speed = {}
+for n in range(1, n_max + 1):
+    c = json.load(open(f"{out}/capacity_at_speed_{n}.json"))
+    at_speed[n] = dict(c["points"][n - 1], speed=c["speed"])
 
 
 def reading(path):
@@ -81,34 +111,58 @@ def reading(path):
             "own": s["designs"][design].get("predicted", {}).get("fps_mean", float("nan"))}
 
 
-rows, measured_cap, predicted_cap, worst = [], 0, 0, 0.0
+def error_pct(p, m):
+    return 100.0 * (p - m) / m if m > 0 else float("nan")
+
+
+def count_at_target(fps_by_n):  # counts from 1 in order, as qvr capacity does
+    count = 0
+    for n in range(1, n_max + 1):
+        if fps_by_n[n] < target:
+            break
+        count = n
+    return count
+
+
+rows = []
 for n in range(1, n_max + 1):
     takes = [reading(f"{out}/r{r}/h{n}/summary.json") for r in range(1, repeats + 1)]
     med = {k: statistics.median(t[k] for t in takes) for k in takes[0]}
-    p, m = pred[n]["fps_mean"], med["fps"]
-    err = 100.0 * (p - m) / m if m > 0 else float("nan")
-    worst = max(worst, abs(err))
-    if med["fps_min"] >= target and measured_cap == n - 1:
-        measured_cap = n
-    if p >= target and predicted_cap == n - 1:
-        predicted_cap = n
+    m, p, q = med["fps"], pred[n]["fps_mean"], at_speed[n]["fps_mean"]
     rows.append({"headsets": n, "measured_fps": m, "measured_fps_takes": [t["fps"] for t in takes],
-                 "measured_fps_min": med["fps_min"], "predicted_fps": p, "error_pct": err,
+                 "measured_fps_min": med["fps_min"], "predicted_fps": p,
+                 "error_pct": error_pct(p, m), "speed": at_speed[n]["speed"],
+                 "predicted_fps_at_probe_speed": q, "error_pct_at_probe_speed": error_pct(q, m),
                  "jain_fairness_fps": med["jain"], "server_ms_measured": med["server_ms"],
                  "server_ms_predicted": pred[n]["server_ms_per_headset_frame"],
+                 "server_ms_predicted_at_probe_speed": at_speed[n]["server_ms_per_headset_frame"],
                  "run_predicted_fps": med["own"]})
-print(f"N  measured FPS/headset: median [each round]   predicted  error   Jain   "
-      "server ms/headset-frame meas/pred   run's own prediction")
+measured_cap = count_at_target({r["headsets"]: r["measured_fps_min"] for r in rows})
+predicted_cap = count_at_target({r["headsets"]: r["predicted_fps"] for r in rows})
+predicted_cap_at_speed = count_at_target(
+    {r["headsets"]: r["predicted_fps_at_probe_speed"] for r in rows})
+worst = max(abs(r["error_pct"]) for r in rows)
+worst_at_speed = max(abs(r["error_pct_at_probe_speed"]) for r in rows)
+print("N  measured FPS/headset: median [each round]  | predicted, error: at the calibration's "
+      "speed | at the probes' (headset, server) | Jain | server ms/headset-frame measured / "
+      "predicted at the probes' | run's own prediction")
 for r in rows:
     m, own = r["measured_fps"], r["run_predicted_fps"]
     takes = ", ".join(f"{x:.2f}" for x in r["measured_fps_takes"])
-    own_text = f"{own:.2f} ({100.0 * (own - m) / m:+.1f}%)" if own == own and m > 0 else "-"
-    print(f"{r['headsets']}  {m:6.2f} [{takes}]   {r['predicted_fps']:6.2f}  "
-          f"{r['error_pct']:+6.1f}%  {r['jain_fairness_fps']:.3f}  "
-          f"{r['server_ms_measured']:.1f} / {r['server_ms_predicted']:.1f}   {own_text}")
-print(f"headsets per server at {target:g} FPS: measured {measured_cap}, predicted {predicted_cap}")
-print(f"largest FPS error {worst:.1f}% (criterion: within 15%)")
+    own_text = f"{own:.2f} ({error_pct(own, m):+.1f}%)" if own == own and m > 0 else "-"
+    sp = r["speed"]
+    print(f"{r['headsets']}  {m:6.2f} [{takes}]  | {r['predicted_fps']:6.2f} "
+          f"{r['error_pct']:+6.1f}% | {r['predicted_fps_at_probe_speed']:6.2f} "
+          f"{r['error_pct_at_probe_speed']:+6.1f}% (x{sp['headset']:.2f}, x{sp['server']:.2f}) | "
+          f"{r['jain_fairness_fps']:.3f} | {r['server_ms_measured']:.1f} / "
+          f"{r['server_ms_predicted_at_probe_speed']:.1f} | {own_text}")
+print(f"headsets per server at {target:g} FPS: measured {measured_cap}, predicted "
+      f"{predicted_cap_at_speed} at the probes' speed ({predicted_cap} at the calibration's)")
+print(f"largest FPS error {worst_at_speed:.1f}% at the probes' speed, {worst:.1f}% at the "
+      "calibration's (criterion: within 15%)")
 json.dump({"rows": rows, "repeats": repeats, "target_fps": target,
            "measured_headsets": measured_cap, "predicted_headsets": predicted_cap,
-           "max_error_pct": worst}, open(f"{out}/validation.json", "w"), indent=2)
+           "predicted_headsets_at_probe_speed": predicted_cap_at_speed,
+           "max_error_pct": worst, "max_error_pct_at_probe_speed": worst_at_speed},
+          open(f"{out}/validation.json", "w"), indent=2)
 EOF

@@ -107,6 +107,12 @@ static Registered registerCapacity(CLI::App& app) {
     cmd->add_option("--max-headsets", o->model.max_headsets)->check(CLI::Range(1, 64));
     cmd->add_flag("--every-count", o->model.every_count, "Every count up to --max-headsets");
     addFramesOption(cmd, o->model.frames, 20, 100000, "Frames each count is modelled over");
+    addFinite(cmd, "--headset-speed", o->model.speed.headset,
+              "The headset's times over the calibration's on this machine now (a qvr run's "
+              "summary.json calibration.speed_reference.run_over_reference.headset)",
+              0.05, 20.0);
+    addFinite(cmd, "--server-speed", o->model.speed.server,
+              "The server's times over the calibration's (run_over_reference.server)", 0.05, 20.0);
     cmd->add_option("--json", o->json, "Write the result as JSON");
     return {cmd, [o] { return runCapacity(*o); }};
 }

@@ -10,6 +10,15 @@
 
 namespace qvr {
 
+namespace {
+
+// One headset's server time per frame: the modelled one is N-fold (each headset waits on all N).
+double perHeadsetServerMs(const CapacityPoint& p) {
+    return p.summary.server_busy_ms_mean / p.factors.server;
+}
+
+}  // namespace
+
 CapacityFactors capacityFactors(int headsets, double headset_share, bool share_one_core) {
     const double n = double(std::max(headsets, 1));
     const double own = 1.0 / std::clamp(headset_share, 1e-3, 1.0);
@@ -44,7 +53,8 @@ Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const Runti
         RuntimeSimConfig cfg;
         cfg.design = o.design;
         cfg.fixed_e1_deg = o.fixed_e1_deg;
-        cfg.costs = costs.atSpeed(p.factors.headset, p.factors.server);
+        cfg.costs =
+            costs.atSpeed(p.factors.headset * o.speed.headset, p.factors.server * o.speed.server);
         cfg.costs.link_delay_ms += delay_ms;
         cfg.pipeline_depth = o.pipeline_depth;
         cfg.wait_limit_ms = o.wait_limit_ms;
@@ -53,8 +63,7 @@ Expected<CapacityResult> predictCapacity(const WorkloadTrace& trace, const Runti
         cfg.layer_triangles = layer_triangles;
         p.summary = simulateRuntime(trace, cfg, **link).summary;
         // The summary's server time is the N-fold one: each headset's own share of it is 1/N.
-        p.server_utilisation =
-            p.summary.server_busy_ms_mean / p.factors.server * n * p.summary.fps_mean / 1000.0;
+        p.server_utilisation = perHeadsetServerMs(p) * n * p.summary.fps_mean / 1000.0;
         below += p.summary.fps_mean < o.target_fps ? 1 : 0;
         result.points.push_back(std::move(p));
     }
@@ -81,12 +90,15 @@ Expected<CapacityInputs> loadCapacityInputs(const std::string& hardware_path,
 std::string capacityText(const CapacityResult& r, const CapacityOptions& o) {
     std::string text = fmt::format("qvr capacity: {} on {}, target {:g} FPS per headset\n",
                                    designLabel(o.design, o.fixed_e1_deg), o.net, o.target_fps);
+    if (o.speed.headset != 1.0 || o.speed.server != 1.0)
+        text += fmt::format("  at x{:.3f} the calibration's headset times, x{:.3f} its server's\n",
+                            o.speed.headset, o.speed.server);
     for (const CapacityPoint& p : r.points)
         text += fmt::format(
             "  {:2} headsets: {:6.1f} FPS  MTP p99 {:7.1f} ms  server {:5.1f} ms per "
             "headset-frame, busy {:3.0f}%\n",
-            p.headsets, p.summary.fps_mean, p.summary.mtp_ms_p99,
-            p.summary.server_busy_ms_mean / p.factors.server, 100.0 * p.server_utilisation);
+            p.headsets, p.summary.fps_mean, p.summary.mtp_ms_p99, perHeadsetServerMs(p),
+            100.0 * p.server_utilisation);
     text += fmt::format("  {} headsets per server at {:g} FPS\n", r.headsets, o.target_fps);
     return text;
 }
@@ -94,22 +106,22 @@ std::string capacityText(const CapacityResult& r, const CapacityOptions& o) {
 std::string capacityJson(const CapacityResult& r, const CapacityOptions& o) {
     nlohmann::json points = nlohmann::json::array();
     for (const CapacityPoint& p : r.points)
-        points.push_back(
-            {{"headsets", p.headsets},
-             {"headset_factor", p.factors.headset},
-             {"server_factor", p.factors.server},
-             {"fps_mean", p.summary.fps_mean},
-             {"mtp_ms_mean", p.summary.mtp_ms_mean},
-             {"mtp_ms_p99", p.summary.mtp_ms_p99},
-             {"bytes_per_frame_mean", p.summary.bytes_per_frame_mean},
-             {"e1_deg_mean", p.summary.e1_deg_mean},
-             {"server_ms_per_headset_frame", p.summary.server_busy_ms_mean / p.factors.server},
-             {"server_utilisation", p.server_utilisation}});
+        points.push_back({{"headsets", p.headsets},
+                          {"headset_factor", p.factors.headset},
+                          {"server_factor", p.factors.server},
+                          {"fps_mean", p.summary.fps_mean},
+                          {"mtp_ms_mean", p.summary.mtp_ms_mean},
+                          {"mtp_ms_p99", p.summary.mtp_ms_p99},
+                          {"bytes_per_frame_mean", p.summary.bytes_per_frame_mean},
+                          {"e1_deg_mean", p.summary.e1_deg_mean},
+                          {"server_ms_per_headset_frame", perHeadsetServerMs(p)},
+                          {"server_utilisation", p.server_utilisation}});
     const nlohmann::json j = {{"design", designLabel(o.design, o.fixed_e1_deg)},
                               {"target_fps", o.target_fps},
                               {"net", o.net},
                               {"headset_share", o.headset_share},
                               {"headsets_share_one_core", o.headsets_share_one_core},
+                              {"speed", {{"headset", o.speed.headset}, {"server", o.speed.server}}},
                               {"headsets_at_target", r.headsets},
                               {"points", points}};
     return j.dump(2) + "\n";

@@ -289,7 +289,9 @@ done
 # qvr capacity: a calibration and a workload are required; bad values exit 2.
 for args in "--trace x --target-fps 30" \
     "--hardware /nonexistent.toml --trace x --target-fps 30" \
-    "--hardware $tmp/rt_bad.toml --trace $tmp/rt_bad.toml --target-fps 0"; do
+    "--hardware $tmp/rt_bad.toml --trace $tmp/rt_bad.toml --target-fps 0" \
+    "--hardware $tmp/rt.toml --trace $tmp/good.jsonl --target-fps 5 --headset-speed 0" \
+    "--hardware $tmp/rt.toml --trace $tmp/good.jsonl --target-fps 5 --server-speed nan"; do
     # shellcheck disable=SC2086
     "$QVR" capacity $args >/dev/null 2>"$tmp/bad_err.txt"
     rc=$?

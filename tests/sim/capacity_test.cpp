@@ -97,6 +97,28 @@ TEST(PredictCapacity, ServerBoundRemoteFollowsOneOverN) {
     EXPECT_EQ(r->headsets, 3);
 }
 
+TEST(PredictCapacity, AMachineAtAnotherSpeedScalesTheCalibratedTimes) {
+    // The server at 1.5x the calibration's times: 21 ms a frame, N headsets each every 21·N ms
+    // (one at 47.6 FPS, two at 23.8, three at 15.9); the headset's speed factor applies on top
+    // of its share.
+    CapacityOptions o = remoteOptions(20.0);
+    o.speed = {1.0, 1.5};
+    const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), o);
+    ASSERT_TRUE(r) << r.error();
+    EXPECT_EQ(r->headsets, 2);
+    ASSERT_GE(r->points.size(), 2u);
+    EXPECT_NEAR(r->points[1].summary.fps_mean, 1000.0 / 42.0, 0.15 * 1000.0 / 42.0);
+    // Per headset-frame the server takes the slower machine's 21 ms, not the calibration's 14.
+    EXPECT_NEAR(r->points[1].summary.server_busy_ms_mean / r->points[1].factors.server, 21.0, 1e-6);
+    // The same as the calibration with every server time 1.5x.
+    const auto scaled = predictCapacity(flatTrace(120), serverBoundCosts(7.0).atSpeed(1.0, 1.5),
+                                        remoteOptions(20.0));
+    ASSERT_TRUE(scaled) << scaled.error();
+    ASSERT_EQ(scaled->points.size(), r->points.size());
+    for (size_t i = 0; i < r->points.size(); ++i)
+        EXPECT_DOUBLE_EQ(scaled->points[i].summary.fps_mean, r->points[i].summary.fps_mean);
+}
+
 TEST(PredictCapacity, ChargesTheTrianglesTheCallerSaysEachLayerDraws) {
     // 1 ms per thousand triangles and nothing else on the server. On the flat trace's rings
     // remote's frame is light enough for several headsets at 20 FPS. Counted as drawn (qvr

@@ -19,6 +19,12 @@
 
 namespace qvr {
 
+// The factors on the headset's and the server's times (1: the calibration's).
+struct CapacityFactors {
+    double headset = 1.0;
+    double server = 1.0;
+};
+
 struct CapacityOptions {
     Design design = Design::Qvr;
     double fixed_e1_deg = 5.0;
@@ -32,13 +38,13 @@ struct CapacityOptions {
     int frames = 300;
     int warmup_frames = 10;
     bool every_count = false;  // predict every count up to max_headsets (else stop below target)
+    // The machine's speed over the calibration's: its times are the calibrated ones times these
+    // (a run's speed probes measure them: summary.json calibration.speed_reference
+    // .run_over_reference). On top of the headset count's factors.
+    CapacityFactors speed;
 };
 
 // The factors on the headset's and the server's times with `headsets` headsets.
-struct CapacityFactors {
-    double headset = 1.0;
-    double server = 1.0;
-};
 CapacityFactors capacityFactors(int headsets, double headset_share, bool share_one_core);
 
 // One headset count's prediction.
