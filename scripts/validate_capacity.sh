@@ -24,9 +24,12 @@
 #
 # Two predictions per N: at the calibration's speed (the machine as it was calibrated, a cached
 # calibration maybe hours before), and at the speed the runs' own probes measured (qvr capacity
-# --headset-speed/--server-speed: for each N the median over its rounds of summary.json
-# calibration.speed_reference.run_over_reference, the fixed reference frames timed around each
-# run). The second is the model's error; the gap between the two is the machine's drift.
+# --headset-speed/--server-speed: the median over every run of summary.json
+# calibration.speed_reference.run_over_reference, the fixed reference frames timed before and
+# after each run). The second is the model's error; the gap between the two is the machine's
+# drift. One speed for all the runs, not one per N: a probe times one second on core 0, and this
+# host's cores each slow to ~0.55x in stretches of 3-9 s, independently (docs/MODEL.md §13), so a
+# run's two probes are a poor estimate of its own speed and the median of all of them the best.
 set -euo pipefail
 usage="usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [REPEATS] [options]"
 qvr=${1:?$usage}
@@ -74,28 +77,24 @@ capacity() {  # capacity JSON [options]: qvr capacity on the workload, every cou
         { echo "validate_capacity: qvr capacity failed (see ${json%.json}.log)" >&2; exit 1; }
 }
 capacity "$out/capacity.json" --max-headsets "$max"
-for n in $(seq 1 "$max"); do
-    # The median factors over N's rounds: two words.
-    read -r h_speed s_speed < <(python3 - "$out" "$n" "$repeats" <<'EOF'
+# The median factors over every run: two words.
+read -r h_speed s_speed < <(python3 - "$out" "$max" "$repeats" <<'EOF'
 import json, statistics, sys
-out, n, repeats = sys.argv[1], sys.argv[2], int(sys.argv[3])
+out, n_max, repeats = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 f = [json.load(open(f"{out}/r{r}/h{n}/summary.json"))["calibration"]["speed_reference"]
-     .get("run_over_reference", {}) for r in range(1, repeats + 1)]
+     .get("run_over_reference", {}) for r in range(1, repeats + 1) for n in range(1, n_max + 1)]
 print(*(statistics.median(x.get(side, 1.0) for x in f) for side in ("headset", "server")))
 EOF
 )
-    capacity "$out/capacity_at_speed_$n.json" --max-headsets "$n" --headset-speed "$h_speed" \
-        --server-speed "$s_speed"
-done
+capacity "$out/capacity_at_probe_speed.json" --max-headsets "$max" --headset-speed "$h_speed" \
+    --server-speed "$s_speed"
 python3 - "$out" "$max" "$target" "$repeats" "$design" <<'EOF'
 import json, statistics, sys
 out, n_max, target, repeats = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
 design = sys.argv[5]
 pred = {p["headsets"]: p for p in json.load(open(f"{out}/capacity.json"))["points"]}
-at_speed = {}
-for n in range(1, n_max + 1):
-    c = json.load(open(f"{out}/capacity_at_speed_{n}.json"))
-    at_speed[n] = dict(c["points"][n - 1], speed=c["speed"])
+c = json.load(open(f"{out}/capacity_at_probe_speed.json"))
+at_speed, speed = {p["headsets"]: p for p in c["points"]}, c["speed"]
 
 
 def reading(path):
@@ -131,7 +130,7 @@ for n in range(1, n_max + 1):
     m, p, q = med["fps"], pred[n]["fps_mean"], at_speed[n]["fps_mean"]
     rows.append({"headsets": n, "measured_fps": m, "measured_fps_takes": [t["fps"] for t in takes],
                  "measured_fps_min": med["fps_min"], "predicted_fps": p,
-                 "error_pct": error_pct(p, m), "speed": at_speed[n]["speed"],
+                 "error_pct": error_pct(p, m),
                  "predicted_fps_at_probe_speed": q, "error_pct_at_probe_speed": error_pct(q, m),
                  "jain_fairness_fps": med["jain"], "server_ms_measured": med["server_ms"],
                  "server_ms_predicted": pred[n]["server_ms_per_headset_frame"],
@@ -143,24 +142,25 @@ predicted_cap_at_speed = count_at_target(
     {r["headsets"]: r["predicted_fps_at_probe_speed"] for r in rows})
 worst = max(abs(r["error_pct"]) for r in rows)
 worst_at_speed = max(abs(r["error_pct_at_probe_speed"]) for r in rows)
+print(f"the runs' probes: x{speed['headset']:.2f} the calibration's headset times, "
+      f"x{speed['server']:.2f} its server's (medians over {n_max * repeats} runs)")
 print("N  measured FPS/headset: median [each round]  | predicted, error: at the calibration's "
-      "speed | at the probes' (headset, server) | Jain | server ms/headset-frame measured / "
-      "predicted at the probes' | run's own prediction")
+      "speed | at the probes' | Jain | server ms/headset-frame measured / predicted at the "
+      "probes' | run's own prediction")
 for r in rows:
     m, own = r["measured_fps"], r["run_predicted_fps"]
     takes = ", ".join(f"{x:.2f}" for x in r["measured_fps_takes"])
     own_text = f"{own:.2f} ({error_pct(own, m):+.1f}%)" if own == own and m > 0 else "-"
-    sp = r["speed"]
     print(f"{r['headsets']}  {m:6.2f} [{takes}]  | {r['predicted_fps']:6.2f} "
           f"{r['error_pct']:+6.1f}% | {r['predicted_fps_at_probe_speed']:6.2f} "
-          f"{r['error_pct_at_probe_speed']:+6.1f}% (x{sp['headset']:.2f}, x{sp['server']:.2f}) | "
+          f"{r['error_pct_at_probe_speed']:+6.1f}% | "
           f"{r['jain_fairness_fps']:.3f} | {r['server_ms_measured']:.1f} / "
           f"{r['server_ms_predicted_at_probe_speed']:.1f} | {own_text}")
 print(f"headsets per server at {target:g} FPS: measured {measured_cap}, predicted "
       f"{predicted_cap_at_speed} at the probes' speed ({predicted_cap} at the calibration's)")
 print(f"largest FPS error {worst_at_speed:.1f}% at the probes' speed, {worst:.1f}% at the "
       "calibration's (criterion: within 15%)")
-json.dump({"rows": rows, "repeats": repeats, "target_fps": target,
+json.dump({"rows": rows, "repeats": repeats, "target_fps": target, "probe_speed": speed,
            "measured_headsets": measured_cap, "predicted_headsets": predicted_cap,
            "predicted_headsets_at_probe_speed": predicted_cap_at_speed,
            "max_error_pct": worst, "max_error_pct_at_probe_speed": worst_at_speed},
