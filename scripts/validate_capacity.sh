@@ -27,8 +27,8 @@
 # --headset-speed/--server-speed: the median over every run of summary.json
 # calibration.speed_reference.run_over_reference, the fixed reference frames timed before and
 # after each run). The second is the model's error; the gap between the two is the machine's
-# drift. One speed for all the runs, not one per N: a probe times one second on core 0, and this
-# host's cores each slow to ~0.55x in stretches of 3-9 s, independently (docs/MODEL.md §13), so a
+# drift. One speed for all the runs, not one per N: a probe times 0.6 s on core 0, and this
+# host's cores each slow to ~0.55x in stretches of 3-9 s, independently (docs/MODEL.md §11), so a
 # run's two probes are a poor estimate of its own speed and the median of all of them the best.
 set -euo pipefail
 usage="usage: validate_capacity.sh QVR OUT_DIR [MAX] [SHARE] [FRAMES] [TARGET] [REPEATS] [options]"
