@@ -99,8 +99,7 @@ TEST(PredictCapacity, ServerBoundRemoteFollowsOneOverN) {
 
 TEST(PredictCapacity, AMachineAtAnotherSpeedScalesTheCalibratedTimes) {
     // The server at 1.5x the calibration's times: 21 ms a frame, N headsets each every 21·N ms
-    // (one at 47.6 FPS, two at 23.8, three at 15.9); the headset's speed factor applies on top
-    // of its share.
+    // (one at 47.6 FPS, two at 23.8, three at 15.9).
     CapacityOptions o = remoteOptions(20.0);
     o.speed = {1.0, 1.5};
     const auto r = predictCapacity(flatTrace(120), serverBoundCosts(7.0), o);
