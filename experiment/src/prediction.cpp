@@ -89,7 +89,7 @@ PredictionError predictionError(const DesignMetrics& predicted, const DesignMetr
     return e;
 }
 
-std::optional<SpeedFactors> speedFactors(const DesignRun& run, const RuntimeCosts& calibrated) {
+std::optional<SideFactors> speedFactors(const DesignRun& run, const RuntimeCosts& calibrated) {
     double h = 0.0, sv = 0.0;
     int n = 0;
     for (const std::optional<SpeedSample>& p : {run.speed_before, run.speed_after})
@@ -101,8 +101,8 @@ std::optional<SpeedFactors> speedFactors(const DesignRun& run, const RuntimeCost
     if (n == 0 || calibrated.speed_reference_headset_ms <= 0.0 ||
         calibrated.speed_reference_server_ms <= 0.0)
         return std::nullopt;
-    return SpeedFactors{h / n / calibrated.speed_reference_headset_ms,
-                        sv / n / calibrated.speed_reference_server_ms};
+    return SideFactors{h / n / calibrated.speed_reference_headset_ms,
+                       sv / n / calibrated.speed_reference_server_ms};
 }
 
 bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg) {
@@ -190,7 +190,7 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     // A quota of `share` of the core per period: the headset's work takes 1 / share the wall
     // time (docs/MODEL.md, the headset's share); N headsets on one server each get 1/N of its
     // time and share the headset's core (sim/capacity.h capacityFactors).
-    const CapacityFactors f = capacityFactors(settings.headsets, settings.headset_share, true);
+    const SideFactors f = capacityFactors(settings.headsets, settings.headset_share, true);
     const RuntimeCosts costs =
         f.headset != 1.0 || f.server != 1.0 ? calibrated.atSpeed(f.headset, f.server) : calibrated;
     if (auto r = runModel(trace, sd, fixed_e1, costs, settings, inputs)) {

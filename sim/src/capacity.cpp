@@ -19,7 +19,7 @@ double perHeadsetServerMs(const CapacityPoint& p) {
 
 }  // namespace
 
-CapacityFactors capacityFactors(int headsets, double headset_share, bool share_one_core) {
+SideFactors capacityFactors(int headsets, double headset_share, bool share_one_core) {
     const double n = double(std::max(headsets, 1));
     const double own = 1.0 / std::clamp(headset_share, 1e-3, 1.0);
     return {share_one_core ? std::max(own, n) : own, n};

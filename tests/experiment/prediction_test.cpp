@@ -166,7 +166,7 @@ TEST(PredictDesign, ChargesTheLinksDelayAndTheProbesSpeed) {
     ModelSettings settings;
     settings.net = "rate:100";
     settings.pipeline_depth = 1;  // one frame at a time: the delay is on every frame's path
-    const DesignModelInputs remote{"remote", SpeedFactors{2.0, 2.0}, {}, {}};
+    const DesignModelInputs remote{"remote", SideFactors{2.0, 2.0}, {}, {}};
     const DesignPrediction fast = predictDesign(trace, remote, costs, settings, std::nullopt);
     settings.net = "rate:100,delay_ms=30";
     const DesignPrediction slow = predictDesign(trace, remote, costs, settings, std::nullopt);
@@ -219,7 +219,7 @@ TEST(PredictDesign, PaperHardwareOnlyWithANetworkAndNothingForAnUnknownDesign) {
     EXPECT_FALSE(no_link.calibrated);
     EXPECT_TRUE(no_link.paper_hardware);
     const DesignPrediction none =
-        predictDesign(trace, {"nonesuch", SpeedFactors{}, {}, {}}, flatCosts(), settings, *wifi);
+        predictDesign(trace, {"nonesuch", SideFactors{}, {}, {}}, flatCosts(), settings, *wifi);
     EXPECT_FALSE(none.calibrated || none.paper_hardware || none.speed);
 }
 

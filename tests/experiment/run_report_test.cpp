@@ -47,7 +47,7 @@ DesignResult predictedQvr() {
     d.speed_before = SpeedSample{10.0, 20.0};
     d.prediction.calibrated =
         RuntimePrediction{{55.0, 30.0, 45.0, 2200.0, 11.0, 16.5, 8.0}, 12.0, 3};
-    d.prediction.speed = SpeedFactors{1.1, 1.2};
+    d.prediction.speed = SideFactors{1.1, 1.2};
     d.prediction.at_probe_speed = DesignMetrics{50.0, 31.0, 46.0, 2200.0, 10.5, 18.0, 9.0};
     d.prediction.paper_hardware =
         DesignMetrics{70.0, 20.0, 25.0, 1800.0, 9.0, std::nullopt, std::nullopt};

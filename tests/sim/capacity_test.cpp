@@ -54,7 +54,7 @@ CapacityOptions remoteOptions(double target_fps) {
 }
 
 TEST(CapacityFactors, ServerTimesNHeadsetByShare) {
-    const CapacityFactors own = capacityFactors(4, 0.25, false);
+    const SideFactors own = capacityFactors(4, 0.25, false);
     EXPECT_DOUBLE_EQ(own.server, 4.0);
     EXPECT_DOUBLE_EQ(own.headset, 4.0);
     EXPECT_DOUBLE_EQ(capacityFactors(3, 1.0, false).headset, 1.0);

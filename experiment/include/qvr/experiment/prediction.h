@@ -68,11 +68,7 @@ PredictionError predictionError(const DesignMetrics& predicted, const DesignMetr
 
 // The machine's speed around a design (the mean of its probes before and after) over the
 // calibration's speed reference, per side; none without probes or a reference.
-struct SpeedFactors {
-    double headset = 1.0;
-    double server = 1.0;
-};
-std::optional<SpeedFactors> speedFactors(const DesignRun& run, const RuntimeCosts& calibrated);
+std::optional<SideFactors> speedFactors(const DesignRun& run, const RuntimeCosts& calibrated);
 
 // The runtime designs on the simulator's: fixed:E is FFR at E degrees. False for a name the
 // simulator has no design for.
@@ -111,7 +107,7 @@ ModelSettings modelSettings(const RunOptions& plan);
 // One design's predictions on a workload whose frame k is the run's frame k.
 struct DesignPrediction {
     std::optional<RuntimePrediction> calibrated;
-    std::optional<SpeedFactors> speed;            // set where the probes give one
+    std::optional<SideFactors> speed;             // set where the probes give one
     std::optional<DesignMetrics> at_probe_speed;  // the calibrated model at `speed`
     std::optional<DesignMetrics> paper_hardware;  // the paper's model
 };
@@ -119,7 +115,7 @@ struct DesignPrediction {
 // What a design's model run needs beyond the workload and the costs.
 struct DesignModelInputs {
     std::string design;  // the run's label ("qvr", "fixed:10")
-    std::optional<SpeedFactors> speed;
+    std::optional<SideFactors> speed;
     LayerTrianglesFn layer_triangles;  // empty: the trace's BVH rings
     FoveaFragmentsFn fovea_fragments;  // empty: none known
 };

@@ -19,12 +19,6 @@
 
 namespace qvr {
 
-// The factors on the headset's and the server's times (1: the calibration's).
-struct CapacityFactors {
-    double headset = 1.0;
-    double server = 1.0;
-};
-
 struct CapacityOptions {
     Design design = Design::Qvr;
     double fixed_e1_deg = 5.0;
@@ -41,16 +35,16 @@ struct CapacityOptions {
     // The machine's speed over the calibration's: its times are the calibrated ones times these
     // (a run's speed probes measure them: summary.json calibration.speed_reference
     // .run_over_reference). On top of the headset count's factors.
-    CapacityFactors speed;
+    SideFactors speed;
 };
 
 // The factors on the headset's and the server's times with `headsets` headsets.
-CapacityFactors capacityFactors(int headsets, double headset_share, bool share_one_core);
+SideFactors capacityFactors(int headsets, double headset_share, bool share_one_core);
 
 // One headset count's prediction.
 struct CapacityPoint {
     int headsets = 0;
-    CapacityFactors factors;
+    SideFactors factors;
     RuntimeSummary summary;  // one headset's (every headset alike)
     // The server's busy time over its time: N × its time per served frame × FPS.
     double server_utilisation = 0.0;

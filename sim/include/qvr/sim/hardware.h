@@ -122,6 +122,14 @@ struct PartCost {
     }
 };
 
+// Factors on the calibrated times of each side, the headset's and the server's (1: as
+// calibrated): a machine slower than at its calibration (the speed probes), a share of a core, N
+// headsets on one server (RuntimeCosts::atSpeed takes them).
+struct SideFactors {
+    double headset = 1.0;
+    double server = 1.0;
+};
+
 // This machine's costs of the runtime's parts. The defaults are placeholders of the right order
 // for llvmpipe on one core of a 2-core Xeon (so tests and an uncalibrated `qvr sim --model
 // runtime` run); a calibration replaces every one of them.
