@@ -77,15 +77,21 @@ capacity() {  # capacity JSON [options]: qvr capacity on the workload, every cou
         { echo "validate_capacity: qvr capacity failed (see ${json%.json}.log)" >&2; exit 1; }
 }
 capacity "$out/capacity.json" --max-headsets "$max"
-# The median factors over every run: two words.
-read -r h_speed s_speed < <(python3 - "$out" "$max" "$repeats" <<'EOF'
+# The median factors over every run with probes: two words (none: the calibration has no speed
+# reference or the probes failed, and there is no speed to predict at).
+speeds=$(python3 - "$out" "$max" "$repeats" <<'EOF'
 import json, statistics, sys
 out, n_max, repeats = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 f = [json.load(open(f"{out}/r{r}/h{n}/summary.json"))["calibration"]["speed_reference"]
-     .get("run_over_reference", {}) for r in range(1, repeats + 1) for n in range(1, n_max + 1)]
-print(*(statistics.median(x.get(side, 1.0) for x in f) for side in ("headset", "server")))
+     .get("run_over_reference") for r in range(1, repeats + 1) for n in range(1, n_max + 1)]
+f = [x for x in f if x]
+if f:
+    print(*(statistics.median(x[side] for x in f) for side in ("headset", "server")))
 EOF
 )
+[ -n "$speeds" ] ||
+    { echo "validate_capacity: no run has speed probes (calibration.speed_reference)" >&2; exit 1; }
+read -r h_speed s_speed <<<"$speeds"
 capacity "$out/capacity_at_probe_speed.json" --max-headsets "$max" --headset-speed "$h_speed" \
     --server-speed "$s_speed"
 python3 - "$out" "$max" "$target" "$repeats" "$design" <<'EOF'
