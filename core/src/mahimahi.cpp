@@ -1,9 +1,13 @@
 // Mahimahi trace reader: a strict line grammar, checked before anything is stored.
 #include "qvr/core/mahimahi.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include "qvr/core/check.h"
 
 namespace qvr {
 
@@ -90,6 +94,82 @@ Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path) {
     std::ostringstream text;
     text << in.rdbuf();
     return parseMahimahiTrace(text.str(), path);
+}
+
+MahimahiDelivery::MahimahiDelivery(std::shared_ptr<const MahimahiTrace> trace, double target_bps)
+    : m_trace(std::move(trace)) {
+    QVR_CHECK(m_trace && m_trace->period_ms > 0 && !m_trace->stamps_ms.empty());
+    // Dividing every stamp by target / mean compresses time so the mean becomes the target.
+    if (target_bps > 0.0)
+        m_ms_per_trace_ms = m_trace->meanBps() / target_bps;
+}
+
+void MahimahiDelivery::restart() {
+    m_started = false;
+    m_index = 0;
+    m_left_bytes = kMahimahiPacketBytes;
+}
+
+double MahimahiDelivery::opportunityMs(int64_t index) const {
+    const auto& stamps = m_trace->stamps_ms;
+    const int64_t n = static_cast<int64_t>(stamps.size());
+    const int64_t loop = index / n;
+    const double ms = static_cast<double>(stamps[static_cast<size_t>(index % n)]) +
+                      static_cast<double>(loop) * static_cast<double>(m_trace->period_ms);
+    return m_origin_ms + ms * m_ms_per_trace_ms;
+}
+
+int64_t MahimahiDelivery::firstOpportunityAtOrAfter(double t_ms) const {
+    const auto& stamps = m_trace->stamps_ms;
+    const int64_t n = static_cast<int64_t>(stamps.size());
+    const double period = static_cast<double>(m_trace->period_ms);
+    const double trace_ms = std::max(0.0, (t_ms - m_origin_ms) / m_ms_per_trace_ms);
+    const int64_t loop = static_cast<int64_t>(std::floor(trace_ms / period));
+    // Within the loop, the first stamp whose time is not before t; rounding can put t a hair
+    // past the loop's last stamp, in which case the next loop's first stamp is it.
+    const double within = trace_ms - static_cast<double>(loop) * period;
+    const auto it = std::lower_bound(stamps.begin(), stamps.end(), within, [](int64_t s, double v) {
+        return static_cast<double>(s) < v;
+    });
+    int64_t index = loop * n + static_cast<int64_t>(it - stamps.begin());
+    while (opportunityMs(index) < t_ms)
+        ++index;
+    return index;
+}
+
+double MahimahiDelivery::departureMs(double t_ms, int64_t bytes) {
+    if (!m_started) {
+        m_started = true;
+        m_origin_ms = t_ms;
+        m_index = 0;
+        m_left_bytes = kMahimahiPacketBytes;
+    }
+    if (opportunityMs(m_index) < t_ms) {
+        // Opportunities that passed with nothing queued are lost, as in Mahimahi.
+        m_index = firstOpportunityAtOrAfter(t_ms);
+        m_left_bytes = kMahimahiPacketBytes;
+    }
+    int64_t remaining = std::max<int64_t>(bytes, 0);
+    // Whole loops at once, so a payload of many loops costs O(trace), not O(packets).
+    const int64_t n = m_trace->packets();
+    const int64_t loop_bytes = n * kMahimahiPacketBytes;
+    if (remaining > m_left_bytes + loop_bytes) {
+        const int64_t loops = (remaining - m_left_bytes) / loop_bytes;
+        m_index += loops * n;
+        remaining -= loops * loop_bytes;
+    }
+    while (true) {
+        const int64_t take = std::min(remaining, m_left_bytes);
+        remaining -= take;
+        m_left_bytes -= take;
+        const double t = opportunityMs(m_index);
+        if (m_left_bytes == 0) {
+            ++m_index;
+            m_left_bytes = kMahimahiPacketBytes;
+        }
+        if (remaining == 0)
+            return t;
+    }
 }
 
 }  // namespace qvr

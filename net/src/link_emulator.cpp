@@ -34,14 +34,8 @@ LinkEmulator::LinkEmulator(LinkSpec config)
     QVR_CHECK(m_config.spike_every_ms >= 0 && m_config.spike_len_ms >= 0 &&
               m_config.spike_len_ms <= m_config.spike_every_ms && m_config.spike_extra_ms >= 0 &&
               m_config.spike_extra_ms <= 10'000);
-    if (m_config.trace) {
-        QVR_CHECK(m_config.trace->period_ms > 0 && !m_config.trace->stamps_ms.empty());
-        // Dividing every stamp by target / mean compresses time so the mean becomes the target.
-        const double mean = m_config.trace->meanBps();
-        m_trace_ns_per_ms =
-            m_config.trace_target_bps > 0 ? 1e6 * mean / m_config.trace_target_bps : 1e6;
-        m_opp_left_bytes = kMahimahiPacketBytes;
-    }
+    if (m_config.trace)
+        m_trace.emplace(m_config.trace, m_config.trace_target_bps);
 }
 
 double LinkEmulator::uniform01(std::mt19937_64& rng) {
@@ -49,62 +43,11 @@ double LinkEmulator::uniform01(std::mt19937_64& rng) {
     return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
 
-double LinkEmulator::opportunityNs(int64_t index) const {
-    const auto& stamps = m_config.trace->stamps_ms;
-    const int64_t n = static_cast<int64_t>(stamps.size());
-    const int64_t loop = index / n;
-    const double ms = static_cast<double>(stamps[static_cast<size_t>(index % n)]) +
-                      static_cast<double>(loop) * static_cast<double>(m_config.trace->period_ms);
-    return m_trace_origin_ns + ms * m_trace_ns_per_ms;
-}
-
-int64_t LinkEmulator::firstOpportunityAtOrAfter(double t_ns) const {
-    const auto& stamps = m_config.trace->stamps_ms;
-    const int64_t n = static_cast<int64_t>(stamps.size());
-    const double period_ms = static_cast<double>(m_config.trace->period_ms);
-    const double t_ms = std::max(0.0, (t_ns - m_trace_origin_ns) / m_trace_ns_per_ms);
-    int64_t loop = static_cast<int64_t>(std::floor(t_ms / period_ms));
-    int64_t index = loop * n;
-    // Within the loop, the first stamp whose time is not before t; rounding can put t a hair
-    // past the loop's last stamp, in which case the next loop's first stamp is it.
-    const double within = t_ms - static_cast<double>(loop) * period_ms;
-    const auto it = std::lower_bound(stamps.begin(), stamps.end(), within, [](int64_t s, double v) {
-        return static_cast<double>(s) < v;
-    });
-    index += static_cast<int64_t>(it - stamps.begin());
-    while (opportunityNs(index) < t_ns) {
-        ++index;
-    }
-    return index;
-}
-
 double LinkEmulator::departureNs(double start_ns, int64_t bytes) {
-    if (m_config.trace) {
-        if (!m_trace_started) {
-            // The trace starts with the link's first packet, not at the clock's epoch, so a
-            // session always sees the trace from its beginning.
-            m_trace_started = true;
-            m_trace_origin_ns = start_ns;
-        }
-        if (opportunityNs(m_opp_index) < start_ns) {
-            // Opportunities that passed with nothing queued are lost, as in Mahimahi.
-            m_opp_index = firstOpportunityAtOrAfter(start_ns);
-            m_opp_left_bytes = kMahimahiPacketBytes;
-        }
-        int64_t remaining = bytes;
-        while (true) {
-            const int64_t take = std::min(remaining, m_opp_left_bytes);
-            remaining -= take;
-            m_opp_left_bytes -= take;
-            const double t = opportunityNs(m_opp_index);
-            if (m_opp_left_bytes == 0) {
-                ++m_opp_index;
-                m_opp_left_bytes = kMahimahiPacketBytes;
-            }
-            if (remaining == 0) {
-                return t;
-            }
-        }
+    if (m_trace) {
+        // Mahimahi's rule (qvr/core/mahimahi.h) on the ns clock: the trace starts with the
+        // link's first packet, so a session always sees the trace from its beginning.
+        return m_trace->departureMs(start_ns * 1e-6, bytes) * 1e6;
     }
     if (m_config.rate_bps > 0) {
         m_link_free_ns = std::max(start_ns, m_link_free_ns) +

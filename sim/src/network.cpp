@@ -49,50 +49,17 @@ double NoisyLink::noiseSigmaOver(double payload_bytes) const {
 
 TraceLink::TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
                      double efficiency, RadioPower radio)
-    : Link(std::move(name), target_mean_bps, efficiency, radio) {
+    : Link(std::move(name), target_mean_bps, efficiency, radio),
+      m_delivery(std::make_shared<const MahimahiTrace>(trace), target_mean_bps) {
     QVR_CHECK(target_mean_bps > 0.0 && trace.period_ms > 0);
-    // Dividing every stamp by target/trace mean scales the capacity to the target.
-    m_time_scale = trace.meanBps() / target_mean_bps;
-    m_opportunities_ms.reserve(trace.stamps_ms.size());
-    for (int64_t t : trace.stamps_ms)
-        m_opportunities_ms.push_back(static_cast<double>(t) * m_time_scale);
-    m_period_ms = static_cast<double>(trace.period_ms) * m_time_scale;
 }
 
 LinkTransfer TraceLink::transfer(double start_ms, double payload_bytes) {
     if (payload_bytes <= 0.0)
         return {0.0, meanGoodputBps()};
-    const auto& opp = m_opportunities_ms;
-    const double period = m_period_ms;
-    const int64_t packets = static_cast<int64_t>(packetsOf(payload_bytes));
     const double start = std::max(0.0, start_ms);
-    double cycle = std::floor(start / period);
-    const double offset = start - cycle * period;
-    // Opportunities strictly after the start instant carry the payload.
-    size_t idx =
-        static_cast<size_t>(std::upper_bound(opp.begin(), opp.end(), offset) - opp.begin());
-    const int64_t n = static_cast<int64_t>(opp.size());
-    // Whole loops first, so a huge payload on a thin trace costs O(trace) not O(packets).
-    int64_t remaining = packets;
-    auto advance = [&]() {
-        if (idx >= opp.size()) {
-            idx = 0;
-            cycle += 1.0;
-        }
-    };
-    advance();
-    if (remaining > n) {
-        const int64_t loops = (remaining - 1) / n;
-        cycle += static_cast<double>(loops);
-        remaining -= loops * n;
-    }
-    size_t last = idx;
-    for (int64_t k = 0; k < remaining; ++k) {
-        advance();
-        last = idx;
-        ++idx;
-    }
-    const double finish_ms = cycle * period + opp[last];
+    const auto wire = static_cast<int64_t>(std::ceil(payload_bytes / efficiency()));
+    const double finish_ms = m_delivery.departureMs(start, wire);
     const double duration_ms = std::max(finish_ms - start, 1e-6);
     return {duration_ms, payload_bytes * 8.0 / (duration_ms * 1e-3)};
 }

@@ -759,6 +759,7 @@ RuntimeRunResult summarizePass(RuntimeRunResult result, const RuntimeSimConfig& 
 
 RuntimeRunResult simulatePass(const WorkloadTrace& trace, const RuntimeSimConfig& config,
                               Link& link, const CoRunLog* previous, CoRunLog* log) {
+    link.restart();  // each pass is the session again, from the trace's start
     return PassReplay(trace, config, link, previous, log).run();
 }
 

@@ -428,6 +428,7 @@ FrameRecord Pipeline::step(int n, int n_frames) {
 RunResult simulate(const WorkloadTrace& trace, const SimConfig& config, Link& link) {
     const int n_frames =
         std::max(0, std::min<int>(config.frames, static_cast<int>(trace.frames.size())));
+    link.restart();  // a run is a session, from the trace's start
     Pipeline pipeline(trace, config, link);
     RunResult result;
     result.frames.reserve(static_cast<size_t>(n_frames));

@@ -87,8 +87,49 @@ TEST(Mahimahi, TraceLinkRescalesAndTimesTransfersByOpportunity) {
     // Payload efficiency inflates the packet count.
     TraceLink half("uniform", *trace, 24e6, 0.5, {});
     EXPECT_NEAR(half.transfer(0.0, 30 * 1500.0).duration_ms, 30.0, 1e-9);
-    // A payload many loops long costs whole loops.
+    // A payload many loops long costs whole loops (a new session: the trace from its start).
+    link.restart();
     EXPECT_NEAR(link.transfer(0.0, 2000.0 * 1500.0 * 3).duration_ms, 3000.0, 1e-9);
+}
+
+TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
+    // Bursts of four opportunities at one stamp, 100 ms apart: the shape of a cellular trace
+    // rescaled to a slow rate. Layers sent back to back share a burst, as the emulator's
+    // packets do; the model once let only the first layer use it (a start at a burst's instant
+    // saw only later opportunities), so a four-layer frame waited for four bursts.
+    std::string text;
+    for (int b = 1; b <= 10; ++b)
+        for (int k = 0; k < 4; ++k)
+            text += std::to_string(100 * b) + "\n";
+    auto trace = parseMahimahiTrace(text, "bursts");
+    ASSERT_TRUE(trace.ok());
+    TraceLink link("bursts", *trace, trace->meanBps(), 1.0, {});
+    // The first transfer starts the trace: its burst is 100 ms later.
+    EXPECT_NEAR(link.transfer(0.0, 1000.0).duration_ms, 100.0, 1e-9);
+    // Queued at that burst's instant, three more layers leave in it.
+    for (int layer = 0; layer < 3; ++layer)
+        EXPECT_NEAR(link.transfer(100.0, 1000.0).duration_ms, 0.0, 1e-5) << layer;
+    // The burst's 6,000 bytes are spent (4,000 used, 2,000 left in its last two opportunities:
+    // bytes share opportunities); 3,000 more leave in the next burst.
+    EXPECT_NEAR(link.transfer(100.0, 2000.0).duration_ms, 0.0, 1e-5);
+    EXPECT_NEAR(link.transfer(100.0, 3000.0).duration_ms, 100.0, 1e-9);
+    // Offered after a burst passed with nothing queued: its opportunities are lost.
+    EXPECT_NEAR(link.transfer(250.0, 100.0).duration_ms, 50.0, 1e-9);
+}
+
+TEST(Mahimahi, TraceLinkAndEmulatorRuleLeaveAtTheSameInstants) {
+    // One rule (MahimahiDelivery) for both: a sequence of offers gets the departures the rule
+    // gives a fresh copy of itself, through the simulator's link.
+    auto trace = parseMahimahiTrace("0\n0\n5\n10\n", "tiny");
+    ASSERT_TRUE(trace.ok());
+    MahimahiDelivery rule(std::make_shared<const MahimahiTrace>(*trace), 0.0);
+    TraceLink link("tiny", *trace, trace->meanBps(), 1.0, {});
+    const std::vector<std::pair<double, double>> offers = {{0.0, 750},  {0.0, 750}, {0.0, 1500},
+                                                           {3.0, 3000}, {12.0, 10}, {40.0, 20000}};
+    for (const auto& [t, bytes] : offers) {
+        const double expected = rule.departureMs(t, static_cast<int64_t>(bytes));
+        EXPECT_NEAR(t + link.transfer(t, bytes).duration_ms, expected, 1e-5) << t;
+    }
 }
 
 TEST(Mahimahi, SharedVerizonTraceHasItsDocumentedMeanAndRescales) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -33,5 +34,35 @@ struct MahimahiTrace {
 Expected<MahimahiTrace> parseMahimahiTrace(std::string_view text, const std::string& source);
 // Refuses files over kMaxMahimahiFileBytes before reading them.
 Expected<MahimahiTrace> loadMahimahiTrace(const std::string& path);
+
+// Mahimahi's delivery rule over a trace rescaled to a mean rate and looped: an opportunity
+// carries up to 1500 bytes, of one packet or of several; one that passes with nothing queued is
+// lost; several at one stamp all carry. The trace starts with the first bytes offered. The one
+// home of the rule, for net's link emulator (packets) and the simulator's trace links (layers):
+// the model must lose no more of a burst's opportunities than the emulator does.
+class MahimahiDelivery {
+public:
+    // target_bps <= 0: the trace's own rate.
+    MahimahiDelivery(std::shared_ptr<const MahimahiTrace> trace, double target_bps);
+    // When the last of `bytes` offered at t_ms leaves: after the bytes offered before it that
+    // have not left, on the first opportunity at or after t_ms otherwise. Instants in ms on the
+    // caller's clock; calls in non-decreasing t_ms.
+    double departureMs(double t_ms, int64_t bytes);
+    // The next offer starts the trace again (a new session on the link).
+    void restart();
+    // How long one millisecond of the trace lasts, in ms (mean / target).
+    double msPerTraceMs() const { return m_ms_per_trace_ms; }
+
+private:
+    double opportunityMs(int64_t index) const;
+    int64_t firstOpportunityAtOrAfter(double t_ms) const;
+
+    std::shared_ptr<const MahimahiTrace> m_trace;
+    double m_ms_per_trace_ms = 1.0;
+    bool m_started = false;
+    double m_origin_ms = 0.0;  // the first offer: trace time 0
+    int64_t m_index = 0;       // the opportunity being filled
+    int64_t m_left_bytes = kMahimahiPacketBytes;
+};
 
 }  // namespace qvr

@@ -55,13 +55,11 @@ public:
     LinkStats stats() const override { return m_stats; }
     const LinkSpec& config() const { return m_config; }
     // Trace mode: how much one trace millisecond lasts, in ns (1e6 · mean / target).
-    double traceNsPerMs() const { return m_trace_ns_per_ms; }
+    double traceNsPerMs() const { return m_trace ? 1e6 * m_trace->msPerTraceMs() : 1e6; }
 
 private:
     // When the last byte of a packet of `bytes` entering the bottleneck at start_ns leaves it.
     double departureNs(double start_ns, int64_t bytes);
-    double opportunityNs(int64_t index) const;
-    int64_t firstOpportunityAtOrAfter(double t_ns) const;
     double uniform01(std::mt19937_64& rng);
     void drainQueue(int64_t now_ns);
     struct InFlight;
@@ -83,13 +81,9 @@ private:
     std::mt19937_64 m_dup_rng;
     bool m_ge_bad = false;
     bool m_started = false;
-    int64_t m_origin_ns = 0;       // the link's first packet: the spikes' time 0
-    double m_link_free_ns = 0.0;   // rate mode: when the bottleneck finishes its backlog
-    int64_t m_opp_index = 0;       // trace mode: the opportunity being filled
-    int64_t m_opp_left_bytes = 0;  // bytes left in it
-    double m_trace_ns_per_ms = 1e6;
-    bool m_trace_started = false;
-    double m_trace_origin_ns = 0.0;  // the time of the first packet: trace time 0
+    int64_t m_origin_ns = 0;                  // the link's first packet: the spikes' time 0
+    double m_link_free_ns = 0.0;              // rate mode: when the bottleneck finishes its backlog
+    std::optional<MahimahiDelivery> m_trace;  // trace mode: the opportunities
     int64_t m_last_deliver_ns = 0;
     std::deque<Queued> m_queue;  // departure times of packets still in the bottleneck
     int64_t m_queue_bytes = 0;

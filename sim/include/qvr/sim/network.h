@@ -40,10 +40,13 @@ public:
     std::string_view name() const { return m_name; }
     double nominalBps() const { return m_nominal_bps; }
     double meanGoodputBps() const { return m_nominal_bps * m_efficiency; }
+    double efficiency() const { return m_efficiency; }
     const RadioPower& radio() const { return m_radio; }
     // The packets a payload occupies: payload / (η·1500 bytes), rounded up, at least one.
     double packetsOf(double payload_bytes) const;
     virtual LinkTransfer transfer(double start_ms, double payload_bytes) = 0;
+    // A new session on the link: a trace starts again with the next transfer.
+    virtual void restart() {}
 
 protected:
     Link(std::string name, double nominal_bps, double efficiency, RadioPower radio)
@@ -78,20 +81,20 @@ private:
     std::normal_distribution<double> m_normal{0.0, 1.0};
 };
 
-// Replays a Mahimahi trace (qvr/core/mahimahi.h) rescaled to a target mean capacity: every stamp
-// divided by target_mean / trace_mean. A payload of B bytes occupies ceil(B / (η·1500))
-// opportunities.
+// Replays a Mahimahi trace (qvr/core/mahimahi.h) rescaled to a target mean capacity, by
+// Mahimahi's rule as the runtime's link emulator applies it (MahimahiDelivery): a payload of B
+// bytes fills B / η bytes of opportunities, after what is still queued; the trace starts with
+// the first transfer. Transfers in non-decreasing start order; restart() begins a new session.
 class TraceLink final : public Link {
 public:
     TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
               double efficiency, RadioPower radio);
     LinkTransfer transfer(double start_ms, double payload_bytes) override;
-    double timeScale() const { return m_time_scale; }
+    void restart() override { m_delivery.restart(); }
+    double timeScale() const { return m_delivery.msPerTraceMs(); }
 
 private:
-    std::vector<double> m_opportunities_ms;  // the rescaled stamps, non-decreasing
-    double m_period_ms = 0.0;                // the rescaled loop length
-    double m_time_scale;
+    MahimahiDelivery m_delivery;
 };
 
 // The paper simulator's links, named in the link grammar (qvr/core/link_spec.h): "wifi", "lte" or
