@@ -117,14 +117,25 @@ double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
     return peripheryBits(gaze, e1_deg) / std::max(1.0, bps) * 1000.0;
 }
 
-double LiwcPolicy::moveCostFraction() const {
-    if (!m_have_moved_ratio || !m_have_held_ratio)
+void LiwcPolicy::MoveRatios::add(bool was_moved, double ratio) {
+    constexpr double kWeight = 0.2;
+    double& ema = was_moved ? moved : held;
+    bool& have = was_moved ? have_moved : have_held;
+    ema = have ? (1.0 - kWeight) * ema + kWeight * ratio : ratio;
+    have = true;
+}
+
+double LiwcPolicy::MoveRatios::extra() const {
+    if (!have_moved || !have_held)
         return 0.0;
-    const double extra =
-        std::max(0.0, m_moved_bits_ratio / std::max(1e-9, m_held_bits_ratio) - 1.0);
+    return std::max(0.0, moved / std::max(1e-9, held) - 1.0);
+}
+
+LiwcPolicy::MoveCost LiwcPolicy::moveCost() const {
     // Spread over the frames a chosen e1 is measured to hold, or has held since the last move if
     // that is longer (else a cost that stops moves would never see them grow).
-    return extra / std::max({1.0, m_frames_between_moves, double(m_frames_since_move)});
+    const double frames = std::max({1.0, m_frames_between_moves, double(m_frames_since_move)});
+    return {m_move_bits.extra() / frames, m_move_server.extra() / frames};
 }
 
 Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double hi) {
@@ -147,7 +158,7 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // then carries is R's motion-correlated error near the operating point.
     const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(m_e1_deg));
     const double in_flight = std::max(1, m_config.frames_in_flight);
-    const double move_cost = moveCostFraction();
+    const MoveCost move_cost = moveCost();
     auto evaluate = [&](double e) {
         Eval v;
         v.e1 = e;
@@ -161,9 +172,10 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         }
         v.latency = v.local + v.server + v.link;
         v.period = std::max({v.local, v.server, v.link, v.remote() / in_flight});
-        // A move re-sizes the encoders' canvases: the extra bytes it was measured to cost, on
-        // the link, spread over the frames a chosen e1 holds.
-        v.score = v.period + (std::fabs(e - m_e1_deg) > 1e-6 ? move_cost * v.link : 0.0);
+        // A move re-sizes the encoders' canvases: the extra bytes and server time it was
+        // measured to cost, spread over the frames a chosen e1 holds.
+        const bool moves = std::fabs(e - m_e1_deg) > 1e-6;
+        v.score = v.period + (moves ? move_cost.link * v.link + move_cost.server * v.server : 0.0);
         return v;
     };
     // Start from staying where we are: another candidate must shorten the period, or at an
@@ -373,10 +385,17 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
         const double server_ms = serverMsOf(m, sent_bits / bps * 1000.0);
+        const std::array<double, 3> x{1.0, decided->periphery_triangles * 1e-5,
+                                      decided->periphery_pixels * 1e-5};
+        // A moved frame's server time (its new canvases' key frames) against the fit's, beside
+        // the same for frames that held: what a move costs the server. Moved frames stay in the
+        // fit: they are the frames that show S's slope (left out, a walk of e1 across the range
+        // taught the fit nothing and left a stale slope).
+        const double predicted = m_server_fit.predict(x);
+        if (!opening && predicted > 0.0 && server_ms > 0.0)
+            m_move_server.add(moved_apart, server_ms / predicted);
         if (!opening)
-            m_server_fit.add(
-                {1.0, decided->periphery_triangles * 1e-5, decided->periphery_pixels * 1e-5},
-                server_ms);
+            m_server_fit.add(x, server_ms);
     } else if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
         const double transmission_ms = sent_bits / m_throughput_bps * 1000.0;
@@ -448,11 +467,7 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
     if (!(sent_bits > 0.0) || !(predicted_bits > 0.0))
         return moved;
-    const double ratio = sent_bits / predicted_bits;
-    double& ema = moved ? m_moved_bits_ratio : m_held_bits_ratio;
-    bool& have = moved ? m_have_moved_ratio : m_have_held_ratio;
-    ema = have ? (1.0 - kWeight) * ema + kWeight * ratio : ratio;
-    have = true;
+    m_move_bits.add(moved, sent_bits / predicted_bits);
     return moved;
 }
 

@@ -60,6 +60,9 @@ struct Truth {
     // A frame whose e1 differs from the previous measured one's carries this fraction more bits
     // (the encoders' new canvas: a key frame), and its link time grows with them.
     double move_extra_bits = 0.0;
+    // A frame whose e1 moved takes the server this fraction longer (its new canvases' key
+    // frames: qvr run measured 1.1-2.5x a held frame's encode).
+    double move_extra_server = 0.0;
     // The session's first frame carries this fraction more bits (every encoder's opening key
     // frame), and its link time grows with them.
     double opening_extra_bits = 0.0;
@@ -119,6 +122,8 @@ struct Truth {
             m.outer_bytes *= 1.0 + extra;
             m.t_remote_ms += extra * transmissionMs(plan) * u(rng);
         }
+        if (moved && move_extra_server > 0.0 && plan.hasRemote())
+            m.t_remote_ms += move_extra_server * serverMs(f, plan) * u(rng);
         m.throughput_bps = plan.hasRemote() ? throughput_bps : 0.0;
         return m;
     }
@@ -446,6 +451,37 @@ TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheLinkAKeyFrame) {
     ASSERT_GE(free_moves, 20);
     EXPECT_LE(costly_moves * 10, free_moves)
         << "free " << free_moves << ", costly " << costly_moves;
+}
+
+// The same on a server-bound machine: a moved frame's key frames cost the server's encoder time,
+// not the link's bytes. The server's speed flips every 25 frames; LIWC measures the moved
+// frames' server time over the held ones' and charges a move with it, so it follows the flips
+// less often than where a move is free.
+TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheServerTime) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    auto movesAfter = [&](double move_extra_server, int from) {
+        Truth truth;
+        truth.move_extra_server = move_extra_server;
+        truth.noise = 0.02;
+        LiwcPolicy liwc(h, periodConfig());
+        std::mt19937 rng(5);
+        int moves = 0;
+        double last_e1 = -1.0;
+        for (int i = 0; i < 300; ++i) {
+            WorkloadFrame fi = frame(i, 20'000.0);
+            truth.server_triangles_per_ms = (i / 25) % 2 ? 30'000.0 : 12'000.0;
+            const Decision d = liwc.decide(fi);
+            if (i >= from && std::fabs(d.e1_deg - last_e1) > 0.05)
+                ++moves;
+            last_e1 = d.e1_deg;
+            liwc.observe(truth.measure(planner, fi, d, rng));
+        }
+        return moves;
+    };
+    const int free_moves = movesAfter(0.0, 100), costly_moves = movesAfter(1.0, 100);
+    ASSERT_GE(free_moves, 20);
+    EXPECT_LE(costly_moves * 3, free_moves) << "free " << free_moves << ", costly " << costly_moves;
 }
 
 // The session's first frame opens every encoder: key frames several times a P-frame's size (a

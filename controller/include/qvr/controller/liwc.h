@@ -110,9 +110,14 @@ private:
     double remoteMs(const Gaze& gaze, double e1_deg) const;
     // frame_period_objective: the server's part and the transmission, separately.
     double transmissionMs(const Gaze& gaze, double e1_deg) const;
-    // The measured extra bits of a frame whose e1 moved, as a fraction of the bits predicted
-    // for it, spread over the frames a chosen e1 is measured to hold (docs/LIWC.md).
-    double moveCostFraction() const;
+    // What a move adds to a frame's link time and server time, as fractions of them: the
+    // measured extra of frames whose e1 moved over frames that held, spread over the frames a
+    // chosen e1 is measured to hold (docs/LIWC.md).
+    struct MoveCost {
+        double link = 0.0;
+        double server = 0.0;
+    };
+    MoveCost moveCost() const;
     // Whether the measured frame is kept apart from the steady-state fits: its e1 moved from the
     // previous one's, or it is the session's first (its encoders' opening key frames).
     bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
@@ -149,11 +154,17 @@ private:
     WindowedFit m_local_fit;
     WindowedFit m_server_fit;
     double m_link_bps = 0.0;  // setLinkEstimate
-    // frame_period_objective: what moving e1 costs in bytes. EMAs of measured / predicted bits
-    // for frames whose e1 moved and for frames whose e1 held, and of the frames between moves.
-    double m_moved_bits_ratio = 1.0;
-    double m_held_bits_ratio = 1.0;
-    bool m_have_moved_ratio = false, m_have_held_ratio = false;
+    // frame_period_objective: what moving e1 costs. EMAs (weight 0.2) of measured / predicted
+    // for frames whose e1 moved and for frames whose e1 held: of the bits (a new canvas is a key
+    // frame, a grown one carries padding) and of the server's time (the key frames' encode).
+    struct MoveRatios {
+        double moved = 1.0, held = 1.0;
+        bool have_moved = false, have_held = false;
+        void add(bool was_moved, double ratio);
+        double extra() const;  // moved / held − 1, at least 0; 0 until both are measured
+    };
+    MoveRatios m_move_bits;
+    MoveRatios m_move_server;
     bool m_seen_held_frame = false;    // a frame whose e1 held has been observed
     bool m_bits_law_measured = false;  // the bits law has been measured
     // The period objective's bits law takes its first measurement outright (the prior is far off).
