@@ -418,36 +418,43 @@ TEST(LiwcPeriodObjective, ReactiveDecidesWithTheRingsOfTheNewestObservedFrame) {
     EXPECT_GT(s1.t_local_pred_ms, s1_calm.t_local_pred_ms);
 }
 
+// The moves LIWC makes over frames `from`-299 of a run on `truth`, which `flip` changes before
+// each frame (the best e1 moves with it).
+template <typename Flip>
+int movesOver(Truth truth, Flip flip, int from) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    LiwcPolicy liwc(h, periodConfig());
+    std::mt19937 rng(5);
+    int moves = 0;
+    double last_e1 = -1.0;
+    for (int i = 0; i < 300; ++i) {
+        WorkloadFrame fi = frame(i, 20'000.0);
+        flip(truth, i);
+        const Decision d = liwc.decide(fi);
+        if (i >= from && std::fabs(d.e1_deg - last_e1) > 0.05)
+            ++moves;
+        last_e1 = d.e1_deg;
+        liwc.observe(truth.measure(planner, fi, d, rng));
+    }
+    return moves;
+}
+
 // The cost of moving e1 (docs/LIWC.md): on a link-bound machine a frame whose e1 moved carries
-// a key frame's bits. The scene's density flips every 25 frames, which moves the best e1; LIWC
+// a key frame's bits. The link's rate flips every 25 frames, which moves the best e1; LIWC
 // measures the extra (κ) from the sizes it is sent and charges a move with it, spread over the
 // frames an e1 holds, so it follows the flips far less often than on the same machine where a
 // move is free.
 TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheLinkAKeyFrame) {
-    const WorkloadHeader h = header();
-    const LayerPlanner planner(h.profile);
-    auto movesAfter = [&](double move_extra_bits, int from) {
+    auto moves = [](double move_extra_bits) {
         Truth truth;
-        truth.throughput_bps = 20e6;  // the link is the slowest stage
         truth.move_extra_bits = move_extra_bits;
-        LiwcPolicy liwc(h, periodConfig());
-        std::mt19937 rng(5);
-        int moves = 0;
-        double last_e1 = -1.0;
-        for (int i = 0; i < 300; ++i) {
-            WorkloadFrame fi = frame(i, 20'000.0);
-            truth.throughput_bps = (i / 25) % 2 ? 60e6 : 15e6;
-            const Decision d = liwc.decide(fi);
-            if (i >= from && std::fabs(d.e1_deg - last_e1) > 0.05)
-                ++moves;
-            last_e1 = d.e1_deg;
-            liwc.observe(truth.measure(planner, fi, d, rng));
-        }
-        return moves;
+        return movesOver(
+            truth, [](Truth& t, int i) { t.throughput_bps = (i / 25) % 2 ? 60e6 : 15e6; }, 100);
     };
-    // Moves counted over frames 100-299. Free, e1 follows the link and the fits' noise 94 times;
-    // with the key frames charged it moves under a tenth as often (65 times with κ left out).
-    const int free_moves = movesAfter(0.0, 100), costly_moves = movesAfter(4.0, 100);
+    // Free, e1 follows the link and the fits' noise 94 times; with the key frames charged it
+    // moves under a tenth as often (65 times with κ left out).
+    const int free_moves = moves(0.0), costly_moves = moves(4.0);
     ASSERT_GE(free_moves, 20);
     EXPECT_LE(costly_moves * 10, free_moves)
         << "free " << free_moves << ", costly " << costly_moves;
@@ -456,30 +463,18 @@ TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheLinkAKeyFrame) {
 // The same on a server-bound machine: a moved frame's key frames cost the server's encoder time,
 // not the link's bytes. The server's speed flips every 25 frames; LIWC measures the moved
 // frames' server time over the held ones' and charges a move with it, so it follows the flips
-// less often than where a move is free.
+// less often than where a move is free (without κ_S the costly run moves more, not less).
 TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheServerTime) {
-    const WorkloadHeader h = header();
-    const LayerPlanner planner(h.profile);
-    auto movesAfter = [&](double move_extra_server, int from) {
+    auto moves = [](double move_extra_server) {
         Truth truth;
         truth.move_extra_server = move_extra_server;
         truth.noise = 0.02;
-        LiwcPolicy liwc(h, periodConfig());
-        std::mt19937 rng(5);
-        int moves = 0;
-        double last_e1 = -1.0;
-        for (int i = 0; i < 300; ++i) {
-            WorkloadFrame fi = frame(i, 20'000.0);
-            truth.server_triangles_per_ms = (i / 25) % 2 ? 30'000.0 : 12'000.0;
-            const Decision d = liwc.decide(fi);
-            if (i >= from && std::fabs(d.e1_deg - last_e1) > 0.05)
-                ++moves;
-            last_e1 = d.e1_deg;
-            liwc.observe(truth.measure(planner, fi, d, rng));
-        }
-        return moves;
+        return movesOver(
+            truth,
+            [](Truth& t, int i) { t.server_triangles_per_ms = (i / 25) % 2 ? 30'000.0 : 12'000.0; },
+            100);
     };
-    const int free_moves = movesAfter(0.0, 100), costly_moves = movesAfter(1.0, 100);
+    const int free_moves = moves(0.0), costly_moves = moves(1.0);
     ASSERT_GE(free_moves, 20);
     EXPECT_LE(costly_moves * 3, free_moves) << "free " << free_moves << ", costly " << costly_moves;
 }
