@@ -118,10 +118,9 @@ double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
 }
 
 void LiwcPolicy::MoveRatios::add(bool was_moved, double ratio) {
-    constexpr double kWeight = 0.2;
     double& ema = was_moved ? moved : held;
     bool& have = was_moved ? have_moved : have_held;
-    ema = have ? (1.0 - kWeight) * ema + kWeight * ratio : ratio;
+    ema = have ? (1.0 - kMoveEmaWeight) * ema + kMoveEmaWeight * ratio : ratio;
     have = true;
 }
 
@@ -456,10 +455,9 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     if (first)
         return true;
     m_seen_held_frame = m_seen_held_frame || !moved;
-    constexpr double kWeight = 0.2;
     if (moved) {
-        m_frames_between_moves =
-            (1.0 - kWeight) * m_frames_between_moves + kWeight * (m_frames_since_move + 1);
+        m_frames_between_moves = (1.0 - kMoveEmaWeight) * m_frames_between_moves +
+                                 kMoveEmaWeight * (m_frames_since_move + 1);
         m_frames_since_move = 0;
     } else {
         ++m_frames_since_move;

@@ -35,7 +35,7 @@ LinkEmulator::LinkEmulator(LinkSpec config)
               m_config.spike_len_ms <= m_config.spike_every_ms && m_config.spike_extra_ms >= 0 &&
               m_config.spike_extra_ms <= 10'000);
     if (m_config.trace)
-        m_trace.emplace(m_config.trace, m_config.trace_target_bps);
+        m_delivery.emplace(m_config.trace, m_config.trace_target_bps);
 }
 
 double LinkEmulator::uniform01(std::mt19937_64& rng) {
@@ -44,10 +44,10 @@ double LinkEmulator::uniform01(std::mt19937_64& rng) {
 }
 
 double LinkEmulator::departureNs(double start_ns, int64_t bytes) {
-    if (m_trace) {
+    if (m_delivery) {
         // Mahimahi's rule (qvr/core/mahimahi.h) on the ns clock: the trace starts with the
         // link's first packet, so a session always sees the trace from its beginning.
-        return m_trace->departureMs(start_ns * 1e-6, bytes) * 1e6;
+        return m_delivery->departureMs(start_ns * 1e-6, bytes) * 1e6;
     }
     if (m_config.rate_bps > 0) {
         m_link_free_ns = std::max(start_ns, m_link_free_ns) +

@@ -47,11 +47,11 @@ double NoisyLink::noiseSigmaOver(double payload_bytes) const {
     return m_sigma / std::sqrt(packetsOf(payload_bytes));
 }
 
-TraceLink::TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
-                     double efficiency, RadioPower radio)
+TraceLink::TraceLink(std::string name, std::shared_ptr<const MahimahiTrace> trace,
+                     double target_mean_bps, double efficiency, RadioPower radio)
     : Link(std::move(name), target_mean_bps, efficiency, radio),
-      m_delivery(std::make_shared<const MahimahiTrace>(trace), target_mean_bps) {
-    QVR_CHECK(target_mean_bps > 0.0 && trace.period_ms > 0);
+      m_delivery(std::move(trace), target_mean_bps) {
+    QVR_CHECK(target_mean_bps > 0.0);
 }
 
 LinkTransfer TraceLink::transfer(double start_ms, double payload_bytes) {
@@ -116,8 +116,9 @@ Expected<std::unique_ptr<Link>> makeLink(const NetworkSpec& spec, uint64_t seed)
     auto trace = loadMahimahiTrace(spec.trace_path);
     if (!trace)
         return makeError(trace.error());
-    return std::unique_ptr<Link>(
-        std::make_unique<TraceLink>(spec.name, *trace, spec.nominal_bps, efficiency, spec.radio));
+    return std::unique_ptr<Link>(std::make_unique<TraceLink>(
+        spec.name, std::make_shared<const MahimahiTrace>(std::move(*trace)), spec.nominal_bps,
+        efficiency, spec.radio));
 }
 
 }  // namespace qvr

@@ -122,7 +122,7 @@ Expected<std::unique_ptr<Link>> makeRuntimeLink(const std::string& spec, double*
         const double target_bps =
             link->trace_target_bps > 0.0 ? link->trace_target_bps : link->trace->meanBps();
         return std::unique_ptr<Link>(
-            std::make_unique<TraceLink>(link->name, *link->trace, target_bps, 1.0, RadioPower{}));
+            std::make_unique<TraceLink>(link->name, link->trace, target_bps, 1.0, RadioPower{}));
     }
     if (link->rate_bps > 0.0)
         return std::unique_ptr<Link>(

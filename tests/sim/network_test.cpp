@@ -5,11 +5,16 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 
 #include "qvr/sim/network.h"
 
 namespace qvr {
 namespace {
+
+std::shared_ptr<const MahimahiTrace> shared(const MahimahiTrace& trace) {
+    return std::make_shared<const MahimahiTrace>(trace);
+}
 
 TEST(Network, CalibrationReproducesTable1WithinAFewPercent) {
     const double eta = calibratedLinkEfficiency();
@@ -75,7 +80,7 @@ TEST(Mahimahi, TraceLinkRescalesAndTimesTransfersByOpportunity) {
     auto trace = parseMahimahiTrace(text, "uniform");
     ASSERT_TRUE(trace.ok());
     EXPECT_NEAR(trace->meanBps(), 12e6, 1e-6);
-    TraceLink link("uniform", *trace, 24e6, 1.0, {});
+    TraceLink link("uniform", shared(*trace), 24e6, 1.0, {});
     EXPECT_NEAR(link.timeScale(), 0.5, 1e-12);
     // 30 packets from t = 0 leave at 0.5, 1.0, …, 15.0 ms.
     const LinkTransfer t = link.transfer(0.0, 30 * 1500.0);
@@ -85,7 +90,7 @@ TEST(Mahimahi, TraceLinkRescalesAndTimesTransfersByOpportunity) {
     const LinkTransfer w = link.transfer(499.9, 3 * 1500.0);
     EXPECT_NEAR(w.duration_ms, 501.0 - 499.9, 1e-9);
     // Payload efficiency inflates the packet count.
-    TraceLink half("uniform", *trace, 24e6, 0.5, {});
+    TraceLink half("uniform", shared(*trace), 24e6, 0.5, {});
     EXPECT_NEAR(half.transfer(0.0, 30 * 1500.0).duration_ms, 30.0, 1e-9);
     // A payload many loops long costs whole loops (a new session: the trace from its start).
     link.restart();
@@ -103,7 +108,7 @@ TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
             text += std::to_string(100 * b) + "\n";
     auto trace = parseMahimahiTrace(text, "bursts");
     ASSERT_TRUE(trace.ok());
-    TraceLink link("bursts", *trace, trace->meanBps(), 1.0, {});
+    TraceLink link("bursts", shared(*trace), trace->meanBps(), 1.0, {});
     // The first transfer starts the trace: its burst is 100 ms later.
     EXPECT_NEAR(link.transfer(0.0, 1000.0).duration_ms, 100.0, 1e-9);
     // Queued at that burst's instant, three more layers leave in it.
@@ -117,13 +122,14 @@ TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
     EXPECT_NEAR(link.transfer(250.0, 100.0).duration_ms, 50.0, 1e-9);
 }
 
-TEST(Mahimahi, TraceLinkAndEmulatorRuleLeaveAtTheSameInstants) {
-    // One rule (MahimahiDelivery) for both: a sequence of offers gets the departures the rule
-    // gives a fresh copy of itself, through the simulator's link.
+TEST(Mahimahi, TraceLinkLeavesWhenTheSharedRuleSays) {
+    // The simulator's link is the emulator's rule (MahimahiDelivery) and nothing more: a sequence
+    // of offers, in bytes and not whole packets, gets the departures the rule gives a fresh copy
+    // of itself.
     auto trace = parseMahimahiTrace("0\n0\n5\n10\n", "tiny");
     ASSERT_TRUE(trace.ok());
-    MahimahiDelivery rule(std::make_shared<const MahimahiTrace>(*trace), 0.0);
-    TraceLink link("tiny", *trace, trace->meanBps(), 1.0, {});
+    MahimahiDelivery rule(shared(*trace), 0.0);
+    TraceLink link("tiny", shared(*trace), trace->meanBps(), 1.0, {});
     const std::vector<std::pair<double, double>> offers = {{0.0, 750},  {0.0, 750}, {0.0, 1500},
                                                            {3.0, 3000}, {12.0, 10}, {40.0, 20000}};
     for (const auto& [t, bytes] : offers) {
@@ -140,7 +146,7 @@ TEST(Mahimahi, SharedVerizonTraceHasItsDocumentedMeanAndRescales) {
     ASSERT_TRUE(trace.ok()) << trace.error();
     EXPECT_EQ(trace->stamps_ms.size(), 58655u);
     EXPECT_NEAR(trace->meanBps() / 1e6, 5.0, 0.1);
-    TraceLink link("verizon", *trace, 100e6, 1.0, {});
+    TraceLink link("verizon", shared(*trace), 100e6, 1.0, {});
     // Over the whole (rescaled) loop the goodput is the target mean.
     const double loop_bytes = 58655 * 1500.0;
     const LinkTransfer t = link.transfer(0.0, loop_bytes);

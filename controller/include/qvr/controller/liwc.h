@@ -157,6 +157,7 @@ private:
     // frame_period_objective: what moving e1 costs. EMAs (weight 0.2) of measured / predicted
     // for frames whose e1 moved and for frames whose e1 held: of the bits (a new canvas is a key
     // frame, a grown one carries padding) and of the server's time (the key frames' encode).
+    static constexpr double kMoveEmaWeight = 0.2;  // the move-cost EMAs' and frames-between's
     struct MoveRatios {
         double moved = 1.0, held = 1.0;
         bool have_moved = false, have_held = false;

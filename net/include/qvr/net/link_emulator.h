@@ -55,7 +55,7 @@ public:
     LinkStats stats() const override { return m_stats; }
     const LinkSpec& config() const { return m_config; }
     // Trace mode: how much one trace millisecond lasts, in ns (1e6 · mean / target).
-    double traceNsPerMs() const { return m_trace ? 1e6 * m_trace->msPerTraceMs() : 1e6; }
+    double traceNsPerMs() const { return m_delivery ? 1e6 * m_delivery->msPerTraceMs() : 1e6; }
 
 private:
     // When the last byte of a packet of `bytes` entering the bottleneck at start_ns leaves it.
@@ -81,9 +81,9 @@ private:
     std::mt19937_64 m_dup_rng;
     bool m_ge_bad = false;
     bool m_started = false;
-    int64_t m_origin_ns = 0;                  // the link's first packet: the spikes' time 0
-    double m_link_free_ns = 0.0;              // rate mode: when the bottleneck finishes its backlog
-    std::optional<MahimahiDelivery> m_trace;  // trace mode: the opportunities
+    int64_t m_origin_ns = 0;      // the link's first packet: the spikes' time 0
+    double m_link_free_ns = 0.0;  // rate mode: when the bottleneck finishes its backlog
+    std::optional<MahimahiDelivery> m_delivery;  // trace mode: the opportunities
     int64_t m_last_deliver_ns = 0;
     std::deque<Queued> m_queue;  // departure times of packets still in the bottleneck
     int64_t m_queue_bytes = 0;

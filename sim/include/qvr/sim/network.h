@@ -87,7 +87,7 @@ private:
 // the first transfer. Transfers in non-decreasing start order; restart() begins a new session.
 class TraceLink final : public Link {
 public:
-    TraceLink(std::string name, const MahimahiTrace& trace, double target_mean_bps,
+    TraceLink(std::string name, std::shared_ptr<const MahimahiTrace> trace, double target_mean_bps,
               double efficiency, RadioPower radio);
     LinkTransfer transfer(double start_ms, double payload_bytes) override;
     void restart() override { m_delivery.restart(); }
