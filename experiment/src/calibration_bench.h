@@ -39,7 +39,7 @@ inline double poseTimeMs(int k) {
 // A pass's shaded fragments for its cost sample; −1 (not counted) where the driver has no
 // pipeline statistics.
 inline double fragmentsOf(const RenderStats& st) {
-    return st.fragment_invocations > 0 ? double(st.fragment_invocations) : -1.0;
+    return st.statistics ? double(st.fragment_invocations) : -1.0;
 }
 
 struct CalibrationPose {

@@ -12,7 +12,7 @@ namespace qvr::experiment {
 
 std::string calibrationCacheKey(const CalibrateOptions& o) {
     // Raised whenever what the calibration measures, or how, changes: an older cache is not reused.
-    constexpr int kCalibrationVersion = 18;
+    constexpr int kCalibrationVersion = 19;
     const std::string text =
         fmt::format("v{}|{}|{}|{}|{}|{}|{}", kCalibrationVersion, machineDescription(), o.profile,
                     o.scene, o.codec, o.lod_px, o.core);

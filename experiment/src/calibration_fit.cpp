@@ -136,12 +136,13 @@ void fitCalibration(const CalibrationSamples& s, Calibration& cal) {
     // 3 kpx … 4 Mpx); the whole frame gets its own scale.
     const CostFitOptions render_fit{.use_px = true, .use_tri = true, .allow_power = true};
     const CostFitOptions px_only{.use_px = true, .use_tri = false, .allow_power = false};
-    // The fovea pass charges its shaded fragments (its overdraw) and triangles, not its pixels:
-    // two poses with the same pixels and triangles can cost 2× apart.
-    CostFitOptions fovea_fit = render_fit;
-    fovea_fit.use_frag = true;
-    cal.costs.fovea = fitPartCost(s.fovea, fovea_fit);
-    cal.costs.server_render = fitPartCost(s.server_render, render_fit);
+    // A render pass charges its shaded fragments (its overdraw) and triangles, not its pixels:
+    // two poses with the same pixels and triangles can cost 2× apart. The server's layers too:
+    // fitted on pixels, a run on another motion than the calibration's took 1.26× the law.
+    CostFitOptions fragment_fit = render_fit;
+    fragment_fit.use_frag = true;
+    cal.costs.fovea = fitPartCost(s.fovea, fragment_fit);
+    cal.costs.server_render = fitPartCost(s.server_render, fragment_fit);
     cal.costs.encode = fitPartCost(s.encode, px_only);
     cal.costs.decode = fitPartCost(s.decode, px_only);
     cal.costs.uca = fitPartCost(s.uca, px_only);

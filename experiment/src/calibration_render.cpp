@@ -44,7 +44,8 @@ Status sequenceLayer(CalibrationBench& b, const LayerPlan& plan, const Pose& hea
     if (!st)
         return makeError("layer render: " + st.error());
     const double ms = msSince(t0);
-    s.server_render.push_back({ms, double(rect.pixels()), b.drawnTriangles(plan, head, eye, kind)});
+    s.server_render.push_back({ms, double(rect.pixels()), b.drawnTriangles(plan, head, eye, kind),
+                               false, fragmentsOf(*st)});
     Chain& ch = chains[static_cast<size_t>(eye * 2 + li)];
     if (!ch.enc) {
         auto e = makeVideoEncoder(b.codec);
@@ -123,7 +124,7 @@ Status fullFrame(CalibrationBench& b, const CalibrationPose& p, ScanoutRecorder&
         const double tris = b.drawnTriangles(full, p.head, eye, LayerKind::kFovea);
         s.fovea.push_back({ms, b.eye_px, tris, true, fragmentsOf(*st)});
         // The server's whole-frame layer is the same view at scale 1.
-        s.server_render.push_back({ms, b.eye_px, tris, true});
+        s.server_render.push_back({ms, b.eye_px, tris, true, fragmentsOf(*st)});
     }
     for (int rep_i = 0; rep_i < 2; ++rep_i) {
         const auto t0 = CalibrationClock::now();

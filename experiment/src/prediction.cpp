@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <tuple>
 #include <variant>
@@ -172,6 +173,7 @@ std::optional<RuntimeRunResult> runModel(const WorkloadTrace& trace, Design desi
     // The trace's frame k is the run's frame k (same poses).
     rc.layer_triangles = inputs.layer_triangles;
     rc.fovea_fragments = inputs.fovea_fragments;
+    rc.server_fragments = inputs.server_fragments;
     return simulateRuntime(trace, rc, **link);
 }
 
@@ -289,6 +291,44 @@ FoveaFragmentsFn foveaFragmentsOf(const DesignRun& run, const HmdProfile& profil
         return run_px > 0.0 ? frags * double(model.pixels()) / run_px : -1.0;
     };
 }
+
+}  // namespace
+
+ServerFragmentsFn serverFragmentsOf(const std::vector<std::array<double, 4>>& fragments_per_px) {
+    const size_t n = fragments_per_px.size();
+    // Per stream and frame, the nearest counted frame's fragments per pixel (−1: none counted).
+    std::array<std::vector<double>, 4> nearest;
+    bool any = false;
+    for (size_t s = 0; s < 4; ++s) {
+        std::vector<double>& v = nearest[s];
+        v.assign(n, -1.0);
+        std::vector<size_t> distance(n, std::numeric_limits<size_t>::max());
+        for (size_t k = 0, last = n; k < n; ++k) {  // the nearest counted frame at or before k
+            if (fragments_per_px[k][s] >= 0.0)
+                last = k;
+            if (last < n)
+                std::tie(v[k], distance[k]) = std::pair(fragments_per_px[last][s], k - last);
+        }
+        for (size_t k = n, next = n; k-- > 0;) {  // or after it, when nearer
+            if (fragments_per_px[k][s] >= 0.0)
+                next = k;
+            if (next < n && next - k < distance[k])
+                v[k] = fragments_per_px[next][s];
+        }
+        any = any || (n > 0 && v[0] >= 0.0);
+    }
+    if (!any)
+        return {};
+    return [nearest](int64_t frame, int stream, double pixels) -> double {
+        if (stream < 0 || stream >= 4 || nearest[size_t(stream)].empty())
+            return -1.0;
+        const std::vector<double>& v = nearest[size_t(stream)];
+        const double per_px = v[size_t(std::clamp<int64_t>(frame, 0, int64_t(v.size()) - 1))];
+        return per_px >= 0.0 ? per_px * pixels : -1.0;
+    };
+}
+
+namespace {
 
 struct PredictionWorkload {
     Expected<WorkloadTrace> trace = makeError("no workload");
@@ -413,9 +453,14 @@ RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
         return rp;
     const ModelSettings settings = modelSettings(plan);
     const LayerTrianglesFn layer_triangles = makeLayerTriangles(plan, profile, inputs, draw_list);
-    for (const DesignRun& r : measurement.runs) {
-        const DesignModelInputs di{r.label(), speedFactors(r, calibrated), layer_triangles,
-                                   foveaFragmentsOf(r, profile, inputs.traces)};
+    for (size_t i = 0; i < measurement.runs.size(); ++i) {
+        const DesignRun& r = measurement.runs[i];
+        const DesignModelInputs di{
+            r.label(), speedFactors(r, calibrated), layer_triangles,
+            foveaFragmentsOf(r, profile, inputs.traces),
+            i < measurement.server_busy.size()
+                ? serverFragmentsOf(measurement.server_busy[i].fragments_per_px)
+                : ServerFragmentsFn{}};
         std::vector<RuntimeFrame> frames;
         DesignPrediction p = predictDesign(*w.trace, di, calibrated, settings, paper_net, &frames);
         writePredictedFrames(predicted_csv, di.design, frames);

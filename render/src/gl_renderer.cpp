@@ -578,6 +578,7 @@ struct GlRenderer::Impl {
             GLuint64 fragments = 0;
             glGetQueryObjectui64v(query_fragments, GL_QUERY_RESULT, &fragments);
             stats.fragment_invocations = fragments;
+            stats.statistics = true;
         }
         stats.clusters_drawn = selection.clusters_drawn;
         stats.clusters_culled = selection.clusters_culled;

@@ -109,16 +109,22 @@ Expected<std::vector<ServerFrameStamps>> readServerStamps(const std::string& pat
     std::vector<ServerFrameStamps> out;
     std::map<std::tuple<uint64_t, uint32_t, uint64_t>, size_t> index;
     for (int line_no = 2; std::getline(in, line); ++line_no) {
-        uint64_t v[11];
+        constexpr size_t kCells = 13;
+        constexpr size_t kFragments = kCells - 1;  // -1: the renderer counted none
+        uint64_t v[kCells];
+        bool uncounted = false;
         size_t pos = 0, n = 0;
-        bool ended = false;  // the 11th cell was the line's last
-        while (n < 11) {
+        bool ended = false;  // the last cell was the line's last
+        while (n < kCells) {
             const size_t comma = line.find(',', pos);
             const std::string cell =
                 line.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-            // Client ids are any 64-bit value; times must fit the signed clock.
-            if (!parseU64(cell, v[n]) ||
-                (n != 0 && v[n] > uint64_t(std::numeric_limits<int64_t>::max())))
+            // Client ids are any 64-bit value; times and counts must fit the signed clock.
+            if (n == kFragments && cell == "-1") {
+                uncounted = true;
+                v[n] = 0;
+            } else if (!parseU64(cell, v[n]) ||
+                       (n != 0 && v[n] > uint64_t(std::numeric_limits<int64_t>::max())))
                 break;
             ++n;
             if (comma == std::string::npos) {
@@ -127,7 +133,8 @@ Expected<std::vector<ServerFrameStamps>> readServerStamps(const std::string& pat
             }
             pos = comma + 1;
         }
-        if (n != 11 || !ended || v[1] > std::numeric_limits<uint32_t>::max() || v[6] >= kStreams)
+        if (n != kCells || !ended || v[1] > std::numeric_limits<uint32_t>::max() ||
+            v[6] >= kStreams)
             return makeError(fmt::format("{}:{}: malformed server stamps line", path, line_no));
         const auto key = std::make_tuple(uint64_t(v[0]), uint32_t(v[1]), uint64_t(v[2]));
         auto [it, added] = index.try_emplace(key, out.size());
@@ -141,8 +148,9 @@ Expected<std::vector<ServerFrameStamps>> readServerStamps(const std::string& pat
             s.end_ns = int64_t(v[5]);
             out.push_back(std::move(s));
         }
-        out[it->second].layers.push_back(
-            {uint8_t(v[6]), int64_t(v[7]), int64_t(v[8]), int64_t(v[9]), int64_t(v[10])});
+        out[it->second].layers.push_back({uint8_t(v[6]), int64_t(v[7]), int64_t(v[8]),
+                                          int64_t(v[9]), int64_t(v[10]), int64_t(v[11]),
+                                          uncounted ? -1 : int64_t(v[kFragments])});
     }
     return out;
 }
@@ -183,10 +191,17 @@ std::vector<ServerBusy> serverBusyPerDesign(const std::vector<TraceDesign>& desi
         int d = 0;
         if (!match(index, designs, s, &d))
             continue;
-        double ms = 0.0;
-        for (const ServerFrameStamps::Layer& l : s.layers)
-            ms += double(std::max<int64_t>(0, l.encode_end_ns - l.render_start_ns)) * 1e-6;
         ServerBusy& b = out[size_t(d)];
+        double ms = 0.0;
+        for (const ServerFrameStamps::Layer& l : s.layers) {
+            ms += double(std::max<int64_t>(0, l.encode_end_ns - l.render_start_ns)) * 1e-6;
+            // match() found the design's own frame of that id: the index is bounded by its run.
+            if (l.pixels <= 0 || l.fragments < 0)
+                continue;
+            if (b.fragments_per_px.size() <= s.frame_id)
+                b.fragments_per_px.resize(size_t(s.frame_id) + 1, {-1.0, -1.0, -1.0, -1.0});
+            b.fragments_per_px[s.frame_id][l.stream_id] = double(l.fragments) / double(l.pixels);
+        }
         ++b.frames;
         b.busy_ms_mean += (ms - b.busy_ms_mean) / double(b.frames);
     }

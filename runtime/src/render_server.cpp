@@ -400,6 +400,14 @@ struct RenderServer::Impl final : net::ServerHandler {
         record(w);
     }
 
+    // A render's fragments onto its stream's; a render that counted none leaves it uncounted.
+    static void countFragments(ServerFrameRecord& rec, uint8_t sid, const RenderStats& rs) {
+        if (!rs.statistics || rec.fragments[sid] < 0)
+            rec.fragments[sid] = -1;
+        else
+            rec.fragments[sid] += int64_t(rs.fragment_invocations);
+    }
+
     // An eye's middle and outer layers from one geometry pass.
     void renderEyeInOnePass(Renderer& r, Images& images, const LayerPlan& plan, int eye, Work& w,
                             ServerFrameStamps& stamps) {
@@ -417,6 +425,7 @@ struct RenderServer::Impl final : net::ServerHandler {
         w.rec.render_ms[mid] += rs->render_ms;
         w.rec.readback_ms[mid] += rs->readback_ms;
         w.rec.triangles[mid] += rs->primitives_generated;
+        countFragments(w.rec, mid, *rs);
         w.delta.readback_ms_total += rs->readback_ms;
         w.delta.layers_rendered += 2;
         ++w.delta.periphery_passes;
@@ -448,7 +457,7 @@ struct RenderServer::Impl final : net::ServerHandler {
             w.rec.render_ms[sid] += rs->render_ms;
             w.rec.readback_ms[sid] += rs->readback_ms;
             w.rec.triangles[sid] += rs->primitives_generated;
-            w.rec.pixels[sid] = int64_t(images.image.width()) * images.image.height();
+            countFragments(w.rec, sid, *rs);
             w.delta.readback_ms_total += rs->readback_ms;
             ++w.delta.layers_rendered;
             send(w, stamps, sid, images.image);
@@ -510,6 +519,7 @@ struct RenderServer::Impl final : net::ServerHandler {
     // Encodes one layer with its stream's encoder and hands it to the transport, which never
     // blocks: a session whose media queue is full loses this stream, not the worker's time.
     void send(Work& w, ServerFrameStamps& stamps, uint8_t sid, const ImageRgba8& layer_image) {
+        w.rec.pixels[sid] = int64_t(layer_image.width()) * layer_image.height();
         auto& enc = w.state->encoders[sid];
         if (!enc) {
             auto made = makeVideoEncoder(config.codec);
@@ -533,8 +543,8 @@ struct RenderServer::Impl final : net::ServerHandler {
         const int64_t encode_end_ns = clock->nowNs();
         const bool key = encoded->is_keyframe;
         if (config.on_frame)  // stamped before the transport can deliver it
-            stamps.layers.push_back(
-                {sid, w.render_start_ns, w.render_end_ns, encode_end_ns, clock->nowNs()});
+            stamps.layers.push_back({sid, w.render_start_ns, w.render_end_ns, encode_end_ns,
+                                     clock->nowNs(), w.rec.pixels[sid], w.rec.fragments[sid]});
         const int64_t send_start_ns = clock->nowNs();
         if (server->sendStream(w.id, w.req->frame_id, sid, key, std::move(encoded->bytes)))
             ++w.delta.streams_sent;

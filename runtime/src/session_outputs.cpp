@@ -198,16 +198,16 @@ Status writeServerFramesCsv(const std::string& path,
     for (int sid = 0; sid < 4; ++sid)
         f << fmt::format(
             ",pixels{0},triangles{0},render_ms{0},readback_ms{0},encode_ms{0},"
-            "send_ms{0},bytes{0}",
+            "send_ms{0},bytes{0},fragments{0}",
             sid);
     f << "\n";
     for (const ServerFrameRecord& r : records) {
         f << fmt::format("{},{},{:.3f},{},{},{}", r.client, r.frame_id, r.e1_deg, r.received_ns,
                          r.start_ns, r.done_ns);
         for (size_t sid = 0; sid < 4; ++sid)
-            f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{}", r.pixels[sid],
+            f << fmt::format(",{},{},{:.3f},{:.3f},{:.3f},{:.3f},{},{}", r.pixels[sid],
                              r.triangles[sid], r.render_ms[sid], r.readback_ms[sid],
-                             r.encode_ms[sid], r.send_ms[sid], r.bytes[sid]);
+                             r.encode_ms[sid], r.send_ms[sid], r.bytes[sid], r.fragments[sid]);
         f << "\n";
     }
     if (!f)
@@ -256,9 +256,10 @@ Status attachServerStampsCsv(const std::string& path, RenderServerConfig& config
         for (const ServerFrameStamps::Layer& l : st.layers) {
             if (++lines > kMaxServerStampLines)
                 return;
-            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{}\n", st.client, st.frame_id,
+            fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{}\n", st.client, st.frame_id,
                        st.client_send_ns, st.queued_ns, st.start_ns, st.end_ns, l.stream_id,
-                       l.render_start_ns, l.render_end_ns, l.encode_end_ns, l.sent_ns);
+                       l.render_start_ns, l.render_end_ns, l.encode_end_ns, l.sent_ns, l.pixels,
+                       l.fragments);
         }
         // Whole frames on disk: a client on this machine reads the file while we run.
         std::fflush(f);

@@ -441,9 +441,11 @@ double PassReplay::sendLayer(int64_t j, FrameState& fs, LayerJob& job, double t)
     // the calibration times each against its encoder's canvas (the snug canvas's own headroom
     // and alignment make it 1.2-1.4x a layer's pixels). Without the canvas model, the layer.
     const double coded_px = m_codecs.lastCanvasPx() > 0.0 ? m_codecs.lastCanvasPx() : job.pixels;
+    const double frags =
+        m_config.server_fragments ? m_config.server_fragments(j, job.stream, job.pixels) : -1.0;
     const double render = m_whole_frame
-                              ? m_costs.server_render.atFullFrame(job.pixels, job.triangles)
-                              : m_costs.server_render.at(job.pixels, job.triangles);
+                              ? m_costs.server_render.atFullFrame(job.pixels, job.triangles, frags)
+                              : m_costs.server_render.at(job.pixels, job.triangles, frags);
     // remote's whole frame: the encode's own scale, measured on whole frames, as the render's.
     const double encode = m_whole_frame ? m_costs.encode.atFullFrame(coded_px, 0.0)
                                         : m_costs.encode.at(coded_px, 0.0);

@@ -133,6 +133,26 @@ RuntimeCosts flatCosts() {
     return c;
 }
 
+TEST(ServerFragmentsOf, TheRunsOverdrawPerPixelFromTheNearestCountedFrame) {
+    // Stream 0 counted at frames 1 (4 a pixel) and 5 (8 a pixel); stream 3 never.
+    std::vector<std::array<double, 4>> per_px(7, {-1.0, -1.0, -1.0, -1.0});
+    per_px[1][0] = 4.0;
+    per_px[5][0] = 8.0;
+    const ServerFragmentsFn f = serverFragmentsOf(per_px);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f(1, 0, 1000.0), 4000.0);  // its own count, times the model's pixels
+    EXPECT_EQ(f(0, 0, 1000.0), 4000.0);  // before the first count: the first
+    EXPECT_EQ(f(2, 0, 1000.0), 4000.0);  // nearer frame 1 than frame 5
+    EXPECT_EQ(f(4, 0, 1000.0), 8000.0);
+    EXPECT_EQ(f(90, 0, 10.0), 80.0);  // past the run: its last count
+    EXPECT_EQ(f(-3, 0, 10.0), 40.0);
+    EXPECT_EQ(f(2, 3, 1000.0), -1.0);  // a stream never counted: the law's mean
+    EXPECT_EQ(f(2, 7, 1000.0), -1.0);  // no such stream
+    // Nothing counted (a design with no server frames): no function at all.
+    EXPECT_FALSE(serverFragmentsOf({}));
+    EXPECT_FALSE(serverFragmentsOf(std::vector<std::array<double, 4>>(3, {-1, -1, -1, -1})));
+}
+
 TEST(PredictDesign, RunsTheCalibratedModelAsTheRunWasSetUp) {
     const WorkloadTrace trace = flatTrace(60);
     const RuntimeCosts costs = flatCosts();
@@ -140,7 +160,7 @@ TEST(PredictDesign, RunsTheCalibratedModelAsTheRunWasSetUp) {
     settings.net = "rate:100";
     settings.warmup_frames = 5;
     std::vector<RuntimeFrame> frames;
-    const DesignPrediction p = predictDesign(trace, {"local", std::nullopt, {}, {}}, costs,
+    const DesignPrediction p = predictDesign(trace, {"local", std::nullopt, {}, {}, {}}, costs,
                                              settings, std::nullopt, &frames);
     ASSERT_TRUE(p.calibrated);
     EXPECT_FALSE(p.at_probe_speed);
@@ -166,7 +186,7 @@ TEST(PredictDesign, ChargesTheLinksDelayAndTheProbesSpeed) {
     ModelSettings settings;
     settings.net = "rate:100";
     settings.pipeline_depth = 1;  // one frame at a time: the delay is on every frame's path
-    const DesignModelInputs remote{"remote", SideFactors{2.0, 2.0}, {}, {}};
+    const DesignModelInputs remote{"remote", SideFactors{2.0, 2.0}, {}, {}, {}};
     const DesignPrediction fast = predictDesign(trace, remote, costs, settings, std::nullopt);
     settings.net = "rate:100,delay_ms=30";
     const DesignPrediction slow = predictDesign(trace, remote, costs, settings, std::nullopt);
@@ -186,13 +206,13 @@ TEST(PredictDesign, AHeadsetShareStretchesTheHeadsetsCostsOnly) {
     ModelSettings settings;
     settings.net = "rate:100";
     const DesignPrediction whole =
-        predictDesign(trace, {"local", std::nullopt, {}, {}}, costs, settings, std::nullopt);
+        predictDesign(trace, {"local", std::nullopt, {}, {}, {}}, costs, settings, std::nullopt);
     settings.headset_share = 0.5;
     const DesignPrediction half =
-        predictDesign(trace, {"local", std::nullopt, {}, {}}, costs, settings, std::nullopt);
+        predictDesign(trace, {"local", std::nullopt, {}, {}, {}}, costs, settings, std::nullopt);
     // The same as the costs at half the headset's speed, set by hand.
     settings.headset_share = 1.0;
-    const DesignPrediction by_hand = predictDesign(trace, {"local", std::nullopt, {}, {}},
+    const DesignPrediction by_hand = predictDesign(trace, {"local", std::nullopt, {}, {}, {}},
                                                    costs.atSpeed(2.0, 1.0), settings, std::nullopt);
     ASSERT_TRUE(whole.calibrated && half.calibrated && by_hand.calibrated);
     EXPECT_LT(half.calibrated->metrics.fps_mean, 0.6 * whole.calibrated->metrics.fps_mean);
@@ -209,17 +229,17 @@ TEST(PredictDesign, PaperHardwareOnlyWithANetworkAndNothingForAnUnknownDesign) {
     auto wifi = networkSpecByName("wifi");
     ASSERT_TRUE(wifi);
     const DesignPrediction p =
-        predictDesign(trace, {"ffr", std::nullopt, {}, {}}, flatCosts(), settings, *wifi);
+        predictDesign(trace, {"ffr", std::nullopt, {}, {}, {}}, flatCosts(), settings, *wifi);
     ASSERT_TRUE(p.paper_hardware);
     EXPECT_GT(p.paper_hardware->fps_mean, 0.0);
     EXPECT_FALSE(p.paper_hardware->headset_busy_ms_mean);
     settings.net = "nonesuch";  // no calibrated prediction on a link the model cannot make
     const DesignPrediction no_link =
-        predictDesign(trace, {"ffr", std::nullopt, {}, {}}, flatCosts(), settings, *wifi);
+        predictDesign(trace, {"ffr", std::nullopt, {}, {}, {}}, flatCosts(), settings, *wifi);
     EXPECT_FALSE(no_link.calibrated);
     EXPECT_TRUE(no_link.paper_hardware);
     const DesignPrediction none =
-        predictDesign(trace, {"nonesuch", SideFactors{}, {}, {}}, flatCosts(), settings, *wifi);
+        predictDesign(trace, {"nonesuch", SideFactors{}, {}, {}, {}}, flatCosts(), settings, *wifi);
     EXPECT_FALSE(none.calibrated || none.paper_hardware || none.speed);
 }
 

@@ -218,6 +218,7 @@ TEST(GlRenderer, FragmentInvocationsCoverEveryDrawnPixelAndAreDeterministic) {
                     static_cast<unsigned long long>(g->fragment_invocations),
                     static_cast<unsigned long long>(covered), img.width() * img.height());
         EXPECT_GT(covered, 0u);
+        EXPECT_TRUE(g->statistics);  // a count, where 0 would mean none shaded
         EXPECT_GE(g->fragment_invocations, covered) << "yaw " << yaw;
         counts.push_back(g->fragment_invocations);
     }

@@ -47,7 +47,10 @@ void makeRun(int frames, std::vector<FrameTelemetry>& telemetry,
         s.start_ns = s.queued_ns + kMs / 5;
         int64_t at = s.start_ns;
         for (uint8_t sid : {uint8_t{0}, uint8_t{2}}) {
-            ServerFrameStamps::Layer l{sid, at, at + 2 * kMs, at + 3 * kMs, at + 3 * kMs + 10'000};
+            // 1000 pixels shading (k + 1)·(sid + 1) fragments each; frame 5's right eye uncounted.
+            const int64_t fragments = k == 5 && sid == 2 ? -1 : 1000 * (k + 1) * (sid + 1);
+            ServerFrameStamps::Layer l{
+                sid, at, at + 2 * kMs, at + 3 * kMs, at + 3 * kMs + 10'000, 1000, fragments};
             s.layers.push_back(l);
             at = l.sent_ns;
             t.stream_rx_ns[sid] = l.sent_ns - kOrigin - kServerAhead + kDown + (k % 2) * kMs / 10;
@@ -97,6 +100,14 @@ TEST(ChromeTrace, SumsTheServersRenderAndEncodePerDesign) {
     EXPECT_NEAR(busy[0].busy_ms_mean, 6.0, 1e-9);
     EXPECT_EQ(busy[1].frames, 0);
     EXPECT_EQ(busy[1].busy_ms_mean, 0.0);
+    // Each layer's fragments per pixel by frame id and stream; -1 where none was counted.
+    ASSERT_EQ(busy[0].fragments_per_px.size(), 30u);
+    for (size_t k : {size_t(0), size_t(5), size_t(29)}) {
+        EXPECT_EQ(busy[0].fragments_per_px[k][0], double(k + 1)) << k;
+        EXPECT_EQ(busy[0].fragments_per_px[k][1], -1.0) << k;
+        EXPECT_EQ(busy[0].fragments_per_px[k][2], k == 5 ? -1.0 : 3.0 * double(k + 1)) << k;
+    }
+    EXPECT_TRUE(busy[1].fragments_per_px.empty());
 }
 
 TEST(ChromeTrace, WritesEveryFramesStagesInOrderOnTheHeadsetClock) {
@@ -154,9 +165,9 @@ TEST(ChromeTrace, ReadsItsStampsFileAndRejectsMalformedOnes) {
     const fs::path path = tempPath("stamps.csv");
     {
         std::ofstream f(path);
-        f << kServerStampsHeader << "3,7,100,200,210,400,0,211,250,300,301\n"
-          << "3,7,100,200,210,400,2,302,350,390,399\n"
-          << "18181381301805239764,8,111,500,510,600,1,511,550,590,599\n";
+        f << kServerStampsHeader << "3,7,100,200,210,400,0,211,250,300,301,4096,20480\n"
+          << "3,7,100,200,210,400,2,302,350,390,399,4096,-1\n"
+          << "18181381301805239764,8,111,500,510,600,1,511,550,590,599,1024,3000\n";
     }
     auto read = readServerStamps(path.string());
     ASSERT_TRUE(read) << read.error();
@@ -165,10 +176,19 @@ TEST(ChromeTrace, ReadsItsStampsFileAndRejectsMalformedOnes) {
     EXPECT_EQ((*read)[0].layers[1].stream_id, 2);
     EXPECT_EQ((*read)[1].frame_id, 8u);
     EXPECT_EQ((*read)[1].client, 18181381301805239764ull);  // ids use all 64 bits
-    for (const std::string bad :
-         {"3,7,100,200,210,400,0,211,250,300\n", "3,7,100,200,210,400,9,211,250,300,301\n",
-          "3,7,100,200,x,400,0,211,250,300,301\n", "3,7,100,200,210,400,0,211,250,300,301,5\n",
-          "3,-7,100,200,210,400,0,211,250,300,301\n"}) {
+    EXPECT_EQ((*read)[0].layers[0].pixels, 4096);
+    EXPECT_EQ((*read)[0].layers[0].fragments, 20480);
+    EXPECT_EQ((*read)[0].layers[1].fragments, -1);  // not counted
+    EXPECT_EQ((*read)[1].layers[0].fragments, 3000);
+    for (const std::string bad : {"3,7,100,200,210,400,0,211,250,300,301,4096\n",
+                                  "3,7,100,200,210,400,9,211,250,300,301,4096,1\n",
+                                  "3,7,100,200,x,400,0,211,250,300,301,4096,1\n",
+                                  "3,7,100,200,210,400,0,211,250,300,301,4096,1,5\n",
+                                  "3,-7,100,200,210,400,0,211,250,300,301,4096,1\n",
+                                  "3,7,100,200,210,400,0,211,250,300,301,-4,1\n",
+                                  "3,7,100,200,210,400,0,211,250,300,301,11\n",
+                                  "3,7,100,200,210,400,0,211,250,300,301,4096,-2\n",
+                                  "3,7,100,200,210,400,0,211,250,300,301,-1,5\n"}) {
         std::ofstream(path) << kServerStampsHeader << bad;
         auto r = readServerStamps(path.string());
         ASSERT_FALSE(r) << bad;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <set>
 
 #include "qvr/foveation/layer_plan.h"
 #include "qvr/sim/network.h"
@@ -693,6 +694,39 @@ TEST(RuntimeModel, TheFoveaCostsTheFragmentsTheCallerSaysItShades) {
     cfg.fovea_fragments = nullptr;
     NoisyLink link2 = fastLink();
     EXPECT_NEAR(simulateRuntime(trace, cfg, link2).frames[7].t_local_ms, 2.5 * px * 1e-6, 1e-9);
+}
+
+TEST(RuntimeModel, TheServerCostsTheFragmentsTheCallerSaysItsLayersShade) {
+    // A server law of 1 ms per million fragments and nothing else: with a server_fragments count
+    // of 1e6·(stream + 1) per layer, every served ffr frame renders for 1 + 2 + 3 + 4 = 10 ms;
+    // where the count is not known (< 0, frame 4) the layers' pixels at 2.5 fragments a pixel.
+    RuntimeCosts c = flatCosts(0.0, 1.0, 0.0);
+    c.server_render = {};
+    c.server_render.ms_per_mfrag = 1.0;
+    c.server_render.frag_per_px = 2.5;
+    const WorkloadTrace trace = flatTrace(10);
+    const LayerPlan plan = LayerPlanner(trace.header.profile).plan(trace.frames[4].gaze, 5.0);
+    double px = 0.0;
+    for (const EyeLayers& e : plan.eyes)
+        px += double(e.middle.pixels() + e.outer.pixels());
+    RuntimeSimConfig cfg = ffrConfig(c, 10);
+    std::set<int> streams;
+    cfg.server_fragments = [&](int64_t frame, int stream, double pixels) {
+        streams.insert(stream);
+        EXPECT_GT(pixels, 0.0);
+        return frame == 4 ? -1.0 : 1e6 * double(stream + 1);
+    };
+    NoisyLink link = fastLink();
+    const RuntimeRunResult r = simulateRuntime(trace, cfg, link);
+    EXPECT_EQ(streams, (std::set<int>{0, 1, 2, 3}));
+    for (int k : {1, 3, 7})
+        EXPECT_NEAR(r.frames[size_t(k)].server_render_ms, 10.0, 1e-9) << k;
+    EXPECT_NEAR(r.frames[4].server_render_ms, 2.5 * px * 1e-6, 1e-9);
+    // Without counts every frame is charged its pixels.
+    cfg.server_fragments = nullptr;
+    NoisyLink link2 = fastLink();
+    EXPECT_NEAR(simulateRuntime(trace, cfg, link2).frames[7].server_render_ms, 2.5 * px * 1e-6,
+                1e-9);
 }
 
 TEST(RuntimeModel, WithoutTheCallersCountsTheFoveaCostsTheTracesRecordedFragments) {

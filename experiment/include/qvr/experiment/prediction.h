@@ -74,11 +74,18 @@ std::optional<SideFactors> speedFactors(const DesignRun& run, const RuntimeCosts
 // simulator has no design for.
 bool simDesignOf(const std::string& name, Design& design, double& fixed_e1_deg);
 
-// The triangles one layer draws and the fragments one eye's fovea pass shades
-// (RuntimeSimConfig::layer_triangles, fovea_fragments).
+// The triangles one layer draws, the fragments one eye's fovea pass shades and those the
+// server's render of one stream's layer shades (RuntimeSimConfig::layer_triangles,
+// fovea_fragments, server_fragments).
 using LayerTrianglesFn =
     std::function<double(int64_t frame, const LayerPlan& plan, int eye, int kind)>;
 using FoveaFragmentsFn = std::function<double(int64_t frame, const LayerPlan& plan, int eye)>;
+using ServerFragmentsFn = std::function<double(int64_t frame, int stream, double pixels)>;
+
+// The server's fragments for a design as its own run's server counted them, per layer pixel
+// (runtime::ServerBusy::fragments_per_px), times the model's layer pixels: a frame the server
+// did not render for the design takes the nearest counted frame's; none counted: empty.
+ServerFragmentsFn serverFragmentsOf(const std::vector<std::array<double, 4>>& fragments_per_px);
 
 // The triangles each layer draws as the renderer draws them (level of detail `lod_px`, the
 // periphery's holes unless `holes` is false) at frame k's head pose, counted off the clock: what
@@ -116,8 +123,9 @@ struct DesignPrediction {
 struct DesignModelInputs {
     std::string design;  // the run's label ("qvr", "fixed:10")
     std::optional<SideFactors> speed;
-    LayerTrianglesFn layer_triangles;  // empty: the trace's BVH rings
-    FoveaFragmentsFn fovea_fragments;  // empty: none known
+    LayerTrianglesFn layer_triangles;    // empty: the trace's BVH rings
+    FoveaFragmentsFn fovea_fragments;    // empty: none known
+    ServerFragmentsFn server_fragments;  // empty: none known
 };
 
 // Predicts one design: the calibrated model (and at the probes' speed when `speed` is set) on

@@ -31,6 +31,7 @@ struct RenderStats {
     // Fragment shader invocations (ARB_pipeline_statistics_query; 0 without it): the pixels
     // shaded, counting every layer of overdraw the depth test did not reject early.
     uint64_t fragment_invocations = 0;
+    bool statistics = false;      // the three counts above were taken (0 then means none)
     uint32_t clusters_drawn = 0;  // spatial clusters of the draw list (draw_list.h)
     uint32_t clusters_culled = 0;
     uint32_t clusters_skipped = 0;  // inside the view's hole

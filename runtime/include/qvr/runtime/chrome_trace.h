@@ -6,6 +6,7 @@
 // headset's clock with an offset estimated from the request and stream round trips.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -18,7 +19,7 @@ namespace qvr::runtime {
 
 inline constexpr const char* kServerStampsHeader =
     "client,frame_id,client_send_ns,queued_ns,start_ns,end_ns,stream,render_start_ns,"
-    "render_end_ns,encode_end_ns,sent_ns\n";
+    "render_end_ns,encode_end_ns,sent_ns,pixels,fragments\n";
 // A server keeps writing stamps for at most this many layers (about 30 MB).
 inline constexpr int64_t kMaxServerStampLines = 300000;
 
@@ -51,6 +52,9 @@ ClockOffset estimateClockOffset(const std::vector<TraceDesign>& designs,
 struct ServerBusy {
     int64_t frames = 0;
     double busy_ms_mean = 0.0;
+    // By frame id, per stream: the fragments the layer's render shaded per layer pixel (its
+    // overdraw, which the server's render law charges, docs/MODEL.md §9); < 0: not counted.
+    std::vector<std::array<double, 4>> fragments_per_px;
 };
 std::vector<ServerBusy> serverBusyPerDesign(const std::vector<TraceDesign>& designs,
                                             const std::vector<ServerFrameStamps>& server);

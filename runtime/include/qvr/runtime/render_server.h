@@ -47,6 +47,10 @@ struct ServerFrameStamps {
         int64_t render_end_ns = 0;
         int64_t encode_end_ns = 0;
         int64_t sent_ns = 0;  // about to be handed to the transport (and its link emulator)
+        // The layer's image and the fragments its render shaded (its overdraw; -1: not counted;
+        // a one-pass eye's middle layer carries both layers').
+        int64_t pixels = 0;
+        int64_t fragments = -1;
     };
     std::vector<Layer> layers;
 };
@@ -119,6 +123,7 @@ struct ServerFrameRecord {
     int64_t done_ns = 0;      // the last layer was handed to the transport
     std::array<int64_t, 4> pixels{};
     std::array<uint64_t, 4> triangles{};  // submitted after culling and LOD
+    std::array<int64_t, 4> fragments{};   // fragment shader invocations (-1: not counted)
     std::array<double, 4> render_ms{};    // commands to glFinish
     std::array<double, 4> readback_ms{};
     std::array<double, 4> encode_ms{};

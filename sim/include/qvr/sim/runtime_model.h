@@ -68,6 +68,11 @@ struct RuntimeSimConfig {
     // pass's pixels where the frame has them. `qvr run` gives the counts its headset's own passes
     // made (docs/MODEL.md §9).
     std::function<double(int64_t frame, const LayerPlan& plan, int eye)> fovea_fragments;
+    // The fragments the server's render of stream `stream` (2·eye + {middle or whole frame,
+    // outer}) shades for frame `frame` in a layer of `pixels` pixels, < 0 where not known: the
+    // server's law then charges the calibration's fragments per pixel. `qvr run` gives the
+    // counts its server's own renders made (docs/MODEL.md §9). Empty: none known.
+    std::function<double(int64_t frame, int stream, double pixels)> server_fragments;
 };
 
 // One frame, ms from the run's start, as the runtime's telemetry records it.
