@@ -67,6 +67,10 @@ std::vector<uint8_t> packFrame(FrameHeader header, std::span<const uint8_t> payl
     return out;
 }
 
+uint8_t frameFlags(std::span<const uint8_t> bytes) {
+    return bytes.size() >= FrameHeader::kSize ? bytes[5] : 0;
+}
+
 Expected<ParsedFrame> parseFrame(std::span<const uint8_t> bytes) {
     if (bytes.size() < FrameHeader::kSize)
         return makeError(fmt::format("encoded frame too short: {} bytes, header needs {}",
@@ -78,7 +82,9 @@ Expected<ParsedFrame> parseFrame(std::span<const uint8_t> bytes) {
         return makeError(fmt::format("encoded frame: unsupported version {}", p[4]));
     ParsedFrame f;
     f.header.flags = p[5];
-    if ((f.header.flags & ~(FrameHeader::kFlagKeyframe | FrameHeader::kFlagRaw)) != 0)
+    constexpr uint8_t kKnown =
+        FrameHeader::kFlagKeyframe | FrameHeader::kFlagRaw | FrameHeader::kFlagNewCanvas;
+    if ((f.header.flags & ~kKnown) != 0)
         return makeError(fmt::format("encoded frame: unknown flags 0x{:02x}", f.header.flags));
     f.header.refresh_frames = getU16(p + 6);
     f.header.frame_id = getU32(p + 8);

@@ -116,7 +116,8 @@ public:
             return makeError(fmt::format("x264 encoder: layer size {}x{} outside [1, {}]", w, h,
                                          m_config.max_side_px));
         const CanvasSize canvas = m_canvas.next(w, h);
-        if (m_canvas.changed() || !m_ctx) {
+        const bool new_canvas = m_canvas.changed() || !m_ctx;
+        if (new_canvas) {
             if (m_ctx)
                 ++m_stats.reopens;
             if (Status s = open(canvas); !s) {
@@ -158,7 +159,8 @@ public:
         if (idr)
             m_force_key = false;
         FrameHeader fh;
-        fh.flags = idr ? FrameHeader::kFlagKeyframe : 0;
+        fh.flags = static_cast<uint8_t>((idr ? FrameHeader::kFlagKeyframe : 0) |
+                                        (new_canvas ? FrameHeader::kFlagNewCanvas : 0));
         fh.refresh_frames =
             m_config.intra_refresh ? static_cast<uint16_t>(m_config.keyint_frames) : 0;
         fh.frame_id = m_next_id++;

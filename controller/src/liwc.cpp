@@ -345,6 +345,9 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // The session's first frame: its remote chain opened the encoders and its link carried their
     // key frames, so it teaches neither the server's fit nor the bits law.
     const bool opening = m_observed == 0;
+    // A held frame's new canvas (learnMoveCost) shows S no slope, only a key frame's encode.
+    const bool late_canvas = m.new_canvas_streams > 0 && m_last_observed_e1_deg >= 0.0 &&
+                             std::fabs(m.e1_deg - m_last_observed_e1_deg) <= 0.05;
     const bool moved_apart = m_config.frame_period_objective &&
                              learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
                                                   m.outer_pixels * bitsPerPixelAt(m.s2));
@@ -393,7 +396,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double predicted = m_server_fit.predict(x);
         if (!opening && predicted > 0.0 && server_ms > 0.0)
             m_move_server.add(moved_apart, server_ms / predicted);
-        if (!opening)
+        if (!opening && !late_canvas)
             m_server_fit.add(x, server_ms);
     } else if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
@@ -454,7 +457,13 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     m_last_observed_e1_deg = m.e1_deg;
     if (first)
         return true;
-    m_seen_held_frame = m_seen_held_frame || !moved;
+    // A frame that held e1 but whose encoder opened a new canvas pays an earlier move's cost
+    // late: a canvas shrinks 30 frames after the move that left its layer small, every stream
+    // at once (sweep 31337 c13: all four key frames on one held frame; read as the steady
+    // state, the predicted T_remote doubled and e1 jumped). Kept apart as a move is; it is
+    // not a move, so the moves' frequency does not count it.
+    const bool new_canvas = !moved && m.new_canvas_streams > 0;
+    m_seen_held_frame = m_seen_held_frame || (!moved && !new_canvas);
     if (moved) {
         m_frames_between_moves = (1.0 - kMoveEmaWeight) * m_frames_between_moves +
                                  kMoveEmaWeight * (m_frames_since_move + 1);
@@ -463,10 +472,9 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
         ++m_frames_since_move;
     }
     const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
-    if (!(sent_bits > 0.0) || !(predicted_bits > 0.0))
-        return moved;
-    m_move_bits.add(moved, sent_bits / predicted_bits);
-    return moved;
+    if (sent_bits > 0.0 && predicted_bits > 0.0)
+        m_move_bits.add(moved || new_canvas, sent_bits / predicted_bits);
+    return moved || new_canvas;
 }
 
 void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {

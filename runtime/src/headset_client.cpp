@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "qvr/codec/frame_header.h"
 #include "qvr/compose/uca.h"
 #include "qvr/controller/aimd.h"
 #include "qvr/controller/liwc.h"
@@ -71,6 +72,7 @@ struct PendingFrame {
     int64_t service_start_ns = 0;
     int64_t last_rx_ns = 0;  // the newest packet of any of its streams
     std::array<double, net::kMaxStreams> bytes{};
+    int new_canvas_streams = 0;  // decoded streams whose encoder opened a new canvas
     bool complete() const { return expected != 0 && (decoded & expected) == expected; }
     bool broken() const { return (failed & expected) != 0; }
 };
@@ -397,6 +399,8 @@ private:
         }
         layerSlot(*p->layers, cs.stream_id) = std::move(*image);
         p->decoded |= static_cast<uint8_t>(1u << cs.stream_id);
+        if (frameFlags(cs.bytes) & FrameHeader::kFlagNewCanvas)
+            ++p->new_canvas_streams;
         FrameTelemetry& t = tel(p->telemetry);
         t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
         if (p->complete()) {
@@ -802,6 +806,7 @@ private:
         if (p) {
             m.middle_bytes = p->bytes[0] + p->bytes[2];
             m.outer_bytes = p->bytes[1] + p->bytes[3];
+            m.new_canvas_streams = p->new_canvas_streams;
         }
         m.middle_pixels = 2.0 * double(plan.middle_pixels);
         m.outer_pixels = 2.0 * double(plan.outer_pixels);

@@ -56,7 +56,8 @@ struct FrameState {
     bool served = false;
     double server_render_ms = 0.0, server_encode_ms = 0.0;  // the server's work on it
     int key_frames = 0;                                     // its streams coded as IDRs
-    bool closed = false;  // its pending entry is gone: LIWC does not see later streams
+    int new_canvases = 0;  // of which a new encoder opened (FrameMeasurement::new_canvas_streams)
+    bool closed = false;   // its pending entry is gone: LIWC does not see later streams
 };
 
 // A layer the server renders and sends: its pixels, the triangles in its view, its bytes.
@@ -82,6 +83,7 @@ StreamCodecModel::StreamCodecModel(const RuntimeCosts& costs) : m_costs(costs) {
 
 double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes) {
     m_last_key = false;
+    m_last_opened = false;
     m_last_canvas_px = 0.0;
     if (!enabled() || width < 1 || height < 1 || stream < 0 || stream >= kStreams)
         return p_bytes;
@@ -101,6 +103,7 @@ double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes
         !opened && m_costs.keyint_frames > 0 && st.since_key + 1 >= m_costs.keyint_frames;
     st.since_key = opened || periodic ? 0 : st.since_key + 1;
     m_last_key = opened || periodic;
+    m_last_opened = opened;
     if (!m_last_key)
         return p;
     if (periodic && m_costs.keyframe_periodic_bits_ratio > 0.0)
@@ -452,6 +455,7 @@ double PassReplay::sendLayer(int64_t j, FrameState& fs, LayerJob& job, double t)
     fs.server_render_ms += render;
     fs.server_encode_ms += encode;
     fs.key_frames += m_codecs.lastWasKey() ? 1 : 0;
+    fs.new_canvases += m_codecs.lastOpenedCanvas() ? 1 : 0;
     const double layer_start = t;
     t = serverWork(t, render + encode);
     m_server_busy_total += t - layer_start;
@@ -703,6 +707,7 @@ void PassReplay::learn(int64_t i) {
     m.s1 = fs.plan.s1;
     m.s2 = fs.plan.s2;
     m.throughput_bps = m_ack_goodput_bps;
+    m.new_canvas_streams = fs.received_bytes > 0 ? fs.new_canvases : 0;
     m.periphery_late = rf.requested && fs.expected > 0 && fs.decoded < fs.expected &&
                        i >= static_cast<int64_t>(m_depth);
     if (rf.requested && fs.expected > 0 && fs.decoded == fs.expected) {

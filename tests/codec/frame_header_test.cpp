@@ -52,6 +52,24 @@ TEST(FrameHeader, RoundTripsEveryField) {
     EXPECT_EQ(std::string(parsed->payload.begin(), parsed->payload.end()), "some payload bytes");
 }
 
+// The headset reads a decoded frame's flags (a new canvas) without parsing it again; too few
+// bytes for a header say none. A flag no version knows is refused.
+TEST(FrameHeader, FlagsAreReadFromTheHeaderAlone) {
+    FrameHeader h = header(1, true);
+    h.flags |= FrameHeader::kFlagNewCanvas;
+    const auto opened = packFrame(h, payloadOf("idr"));
+    auto parsed = parseFrame(opened);
+    ASSERT_TRUE(parsed) << parsed.error();
+    EXPECT_TRUE(parsed->header.newCanvas());
+    EXPECT_EQ(frameFlags(opened), FrameHeader::kFlagKeyframe | FrameHeader::kFlagNewCanvas);
+    EXPECT_EQ(frameFlags(packFrame(header(2, false), payloadOf("p"))), 0);
+    EXPECT_EQ(frameFlags(std::span<const uint8_t>(opened).first(FrameHeader::kSize - 1)), 0);
+    EXPECT_EQ(frameFlags({}), 0);
+    auto unknown = opened;
+    unknown[5] |= 8;
+    EXPECT_FALSE(parseFrame(unknown));
+}
+
 TEST(FrameHeader, RejectsEachKindOfDamage) {
     const auto good = packFrame(header(3, false), payloadOf("0123456789abcdef"));
     auto expectError = [](std::vector<uint8_t> b, const std::string& what) {

@@ -128,6 +128,8 @@ TEST(X264Codec, OutgrowingTheCanvasReopensWithAKeyframeAndDecodes) {
         auto enc = p.encoder->encode(src, false);
         ASSERT_TRUE(enc.ok()) << enc.error();
         EXPECT_EQ(enc->is_keyframe, expect_key[i]) << i;
+        // The header says which key frames opened a canvas (LIWC reads them as a move's cost).
+        EXPECT_EQ((frameFlags(enc->bytes) & FrameHeader::kFlagNewCanvas) != 0, expect_key[i]) << i;
         auto dec = p.decoder->decode(enc->bytes);
         ASSERT_TRUE(dec.ok()) << dec.error();
         EXPECT_EQ(dec->width(), sizes[i][0]);

@@ -66,6 +66,11 @@ struct Truth {
     // The session's first frame carries this fraction more bits (every encoder's opening key
     // frame), and its link time grows with them.
     double opening_extra_bits = 0.0;
+    // Frame canvas_frame carries canvas_extra_bits more bits whatever its e1 (a canvas that
+    // shrank: every stream's key frame), and says so in new_canvas_streams when canvas_flagged.
+    int64_t canvas_frame = -1;
+    double canvas_extra_bits = 0.0;
+    bool canvas_flagged = true;
     mutable double last_e1_deg = -1.0;
 
     static double bitsPerPixel(double s) { return 0.4 * std::pow(s, 0.9); }
@@ -116,7 +121,13 @@ struct Truth {
         const bool moved = last_e1_deg >= 0.0 && std::fabs(d.e1_deg - last_e1_deg) > 0.05;
         const bool opening = last_e1_deg < 0.0;
         last_e1_deg = d.e1_deg;
-        const double extra = moved ? move_extra_bits : opening ? opening_extra_bits : 0.0;
+        const bool canvas = f.index == canvas_frame;
+        const double extra = moved     ? move_extra_bits
+                             : opening ? opening_extra_bits
+                             : canvas  ? canvas_extra_bits
+                                       : 0.0;
+        if (canvas && canvas_flagged && plan.hasRemote())
+            m.new_canvas_streams = 4;
         if (extra > 0.0 && plan.hasRemote()) {
             m.middle_bytes *= 1.0 + extra;
             m.outer_bytes *= 1.0 + extra;
@@ -477,6 +488,38 @@ TEST(LiwcPeriodObjective, MovesE1LessWhenAMoveCostsTheServerTime) {
     const int free_moves = moves(0.0), costly_moves = moves(1.0);
     ASSERT_GE(free_moves, 20);
     EXPECT_LE(costly_moves * 3, free_moves) << "free " << free_moves << ", costly " << costly_moves;
+}
+
+// A frame that held e1 but whose encoders opened new canvases (a canvas shrunk 30 frames after a
+// move, four key frames at once): read as the steady state, its bytes doubled the predicted
+// T_remote and moved e1 (sweep 31337 c13). Flagged by the server's headers, it is a move's late
+// cost: e1 stays within a degree of a run without it; unflagged, it moves (so the test can tell).
+TEST(LiwcPeriodObjective, AHeldFramesNewCanvasIsAMovesCostNotTheSteadyState) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    const WorkloadFrame f = frame(0, 20'000.0);
+    auto decisions = [&](double extra_bits, bool flagged) {
+        Truth truth;
+        truth.throughput_bps = 10e6;  // the link matters: a frame's bits move the period
+        truth.canvas_frame = 80;
+        truth.canvas_extra_bits = extra_bits;
+        truth.canvas_flagged = flagged;
+        LiwcConfig c = periodConfig();
+        c.frames_in_flight = 2;
+        LiwcPolicy liwc(h, c);
+        return run(liwc, truth, planner, f, 110, 2, 3);
+    };
+    const std::vector<Decision> plain = decisions(0.0, true);
+    auto widestGapAfterTheNewCanvas = [&](const std::vector<Decision>& d) {
+        double gap = 0.0;
+        for (size_t i = 80; i < d.size(); ++i)
+            gap = std::max(gap, std::fabs(d[i].e1_deg - plain[i].e1_deg));
+        return gap;
+    };
+    const double flagged = widestGapAfterTheNewCanvas(decisions(5.0, true));
+    const double unflagged = widestGapAfterTheNewCanvas(decisions(5.0, false));
+    EXPECT_LE(flagged, 1.0) << "unflagged " << unflagged;
+    EXPECT_GE(unflagged, 2.0) << "flagged " << flagged;
 }
 
 // The session's first frame opens every encoder: key frames several times a P-frame's size (a

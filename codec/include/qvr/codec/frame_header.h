@@ -12,7 +12,8 @@
 namespace qvr {
 
 // Wire layout, little-endian, 24 bytes:
-//   0  u32 magic "QVRF"      4  u8 version (1)    5  u8 flags (bit 0 key frame, bit 1 raw)
+//   0  u32 magic "QVRF"      4  u8 version (1)    5  u8 flags (bit 0 key frame, bit 1 raw,
+//                                                  bit 2 the encoder opened a new canvas)
 //   6  u16 refresh_frames (intra-refresh period, 0 = IDR-based recovery)
 //   8  u32 frame_id          12 u16 width        14 u16 height   (the layer's real size)
 //  16  u32 payload_bytes     20 u32 CRC-32 (IEEE) of the payload
@@ -22,6 +23,9 @@ struct FrameHeader {
     static constexpr size_t kSize = 24;
     static constexpr uint8_t kFlagKeyframe = 1;
     static constexpr uint8_t kFlagRaw = 2;
+    // The encoder (re)opened for this frame: a stream's first frame, or a canvas that grew or
+    // shrank (core/canvas_policy.h); its key frame is the cost of an e1 move, maybe a late one.
+    static constexpr uint8_t kFlagNewCanvas = 4;
 
     uint8_t flags = 0;
     uint16_t refresh_frames = 0;
@@ -32,6 +36,7 @@ struct FrameHeader {
     uint32_t crc32 = 0;
 
     bool keyframe() const { return (flags & kFlagKeyframe) != 0; }
+    bool newCanvas() const { return (flags & kFlagNewCanvas) != 0; }
 };
 
 uint32_t crc32Ieee(std::span<const uint8_t> bytes);
@@ -45,6 +50,9 @@ struct ParsedFrame {
 };
 // Validates magic, version, sizes and checksum; the payload span points into `bytes`.
 Expected<ParsedFrame> parseFrame(std::span<const uint8_t> bytes);
+// The flags of a frame a decoder took (after parseFrame accepted it); 0 for bytes too short to
+// hold a header.
+uint8_t frameFlags(std::span<const uint8_t> bytes);
 
 // Tracks the reference chain of one stream on the receiving side: a non-key frame is decodable
 // only if the frame before it was. Shared by every decoder so they agree on loss semantics.

@@ -119,7 +119,8 @@ private:
     };
     MoveCost moveCost() const;
     // Whether the measured frame is kept apart from the steady-state fits: its e1 moved from the
-    // previous one's, or it is the session's first (its encoders' opening key frames).
+    // previous one's, it held e1 but opened a new canvas (a late cost of a move), or it is the
+    // session's first (its encoders' opening key frames).
     bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
     // What the server took of a frame, from its T_remote and its transmission (sent_ms).
     double serverMsOf(const FrameMeasurement& m, double sent_ms) const;

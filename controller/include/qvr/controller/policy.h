@@ -42,6 +42,10 @@ struct FrameMeasurement {
     double arrival_ms = 0.0;
     // The periphery was requested but had not all arrived by the wait limit (shown late).
     bool periphery_late = false;
+    // Streams of the periphery whose encoder opened a new canvas for it (FrameHeader::
+    // kFlagNewCanvas): a key frame an e1 move caused, at the move or, for a canvas that shrank
+    // after the layer stayed small, frames later.
+    int new_canvas_streams = 0;
 };
 
 // Whether a frame is the session's start-up, whose timing reaches no policy's fits (the runtime's

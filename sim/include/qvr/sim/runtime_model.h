@@ -127,6 +127,8 @@ public:
     // takes p_bytes.
     double bytes(int stream, int width, int height, double p_bytes);
     bool lastWasKey() const { return m_last_key; }
+    // The last frame opened a new encoder (the stream's first frame, a canvas change).
+    bool lastOpenedCanvas() const { return m_last_opened; }
     // The last frame's canvas pixels (0 without the model): what the codec works on, and what
     // the encode and decode laws are per (`qvr calibrate` times them against their canvases).
     double lastCanvasPx() const { return m_last_canvas_px; }
@@ -139,6 +141,7 @@ private:
     RuntimeCosts m_costs;
     std::vector<State> m_streams;
     bool m_last_key = false;
+    bool m_last_opened = false;
     double m_last_canvas_px = 0.0;
 };
 
