@@ -346,8 +346,8 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // key frames, so it teaches neither the server's fit nor the bits law.
     const bool opening = m_observed == 0;
     // A held frame's new canvas (learnMoveCost) shows S no slope, only a key frame's encode.
-    const bool late_canvas = m.new_canvas_streams > 0 && m_last_observed_e1_deg >= 0.0 &&
-                             std::fabs(m.e1_deg - m_last_observed_e1_deg) <= 0.05;
+    const bool late_canvas =
+        m.new_canvas_streams > 0 && m_last_observed_e1_deg >= 0.0 && !movedFromLast(m.e1_deg);
     const bool moved_apart = m_config.frame_period_objective &&
                              learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
                                                   m.outer_pixels * bitsPerPixelAt(m.s2));
@@ -449,8 +449,7 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     // Whether this frame's e1 differs from the previous observed frame's: its encoders may have
     // opened a new canvas (a key frame, new padding). Its bits against what the bits law (fitted
     // on all frames) predicted, beside the same ratio for frames that held, is what a move costs.
-    const bool moved =
-        m_last_observed_e1_deg >= 0.0 && std::fabs(m.e1_deg - m_last_observed_e1_deg) > 0.05;
+    const bool moved = m_last_observed_e1_deg >= 0.0 && movedFromLast(m.e1_deg);
     // The session's first frame opens every encoder (a key frame on each stream): like a move's,
     // its bits are not what a frame that holds costs, so it is kept apart too.
     const bool first = m_last_observed_e1_deg < 0.0;
