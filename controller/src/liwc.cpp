@@ -345,12 +345,13 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // The session's first frame: its remote chain opened the encoders and its link carried their
     // key frames, so it teaches neither the server's fit nor the bits law.
     const bool opening = m_observed == 0;
-    // A held frame's new canvas (learnMoveCost) shows S no slope, only a key frame's encode.
-    const bool late_canvas =
-        m.new_canvas_streams > 0 && m_last_observed_e1_deg >= 0.0 && !movedFromLast(m.e1_deg);
-    const bool moved_apart = m_config.frame_period_objective &&
-                             learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
-                                                  m.outer_pixels * bitsPerPixelAt(m.s2));
+    const FrameKind kind = m_config.frame_period_objective
+                               ? learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
+                                                      m.outer_pixels * bitsPerPixelAt(m.s2))
+                               : FrameKind::kHeld;
+    const bool moved_apart = kind != FrameKind::kHeld;
+    // A held frame's new canvas shows S no slope, only a key frame's encode.
+    const bool late_canvas = kind == FrameKind::kLateCanvas;
     std::optional<PendingDecision> decided;
     if (!m_pending.empty()) {
         const PendingDecision p = m_pending.front();
@@ -445,17 +446,18 @@ double LiwcPolicy::serverMsOf(const FrameMeasurement& m, double sent_ms) const {
     return std::max(0.0, m.t_remote_ms - sent_ms);
 }
 
-bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {
+LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {
     // Whether this frame's e1 differs from the previous observed frame's: its encoders may have
     // opened a new canvas (a key frame, new padding). Its bits against what the bits law (fitted
     // on all frames) predicted, beside the same ratio for frames that held, is what a move costs.
-    const bool moved = m_last_observed_e1_deg >= 0.0 && movedFromLast(m.e1_deg);
+    const bool moved =
+        m_last_observed_e1_deg >= 0.0 && std::fabs(m.e1_deg - m_last_observed_e1_deg) > 0.05;
     // The session's first frame opens every encoder (a key frame on each stream): like a move's,
     // its bits are not what a frame that holds costs, so it is kept apart too.
     const bool first = m_last_observed_e1_deg < 0.0;
     m_last_observed_e1_deg = m.e1_deg;
     if (first)
-        return true;
+        return FrameKind::kOpening;
     // A frame that held e1 but whose encoder opened a new canvas pays an earlier move's cost
     // late: a canvas shrinks 30 frames after the move that left its layer small, every stream
     // at once (sweep 31337 c13: all four key frames on one held frame; read as the steady
@@ -473,7 +475,7 @@ bool LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits)
     const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
     if (sent_bits > 0.0 && predicted_bits > 0.0)
         m_move_bits.add(moved || new_canvas, sent_bits / predicted_bits);
-    return moved || new_canvas;
+    return moved ? FrameKind::kMoved : new_canvas ? FrameKind::kLateCanvas : FrameKind::kHeld;
 }
 
 void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {

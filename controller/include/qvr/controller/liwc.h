@@ -7,7 +7,6 @@
 #pragma once
 
 #include <array>
-#include <cmath>
 #include <deque>
 #include <optional>
 #include <string_view>
@@ -119,14 +118,11 @@ private:
         double server = 0.0;
     };
     MoveCost moveCost() const;
-    // Whether the measured frame is kept apart from the steady-state fits: its e1 moved from the
-    // previous one's, it held e1 but opened a new canvas (a late cost of a move), or it is the
-    // session's first (its encoders' opening key frames).
-    bool learnMoveCost(const FrameMeasurement& m, double predicted_bits);
-    // Whether an observed e1 differs from the previous observed frame's (more than 0.05°).
-    bool movedFromLast(double e1_deg) const {
-        return std::fabs(e1_deg - m_last_observed_e1_deg) > 0.05;
-    }
+    // What an observed frame was: the session's first (its encoders' opening key frames); e1
+    // held; e1 moved; or e1 held but its encoders opened a new canvas (a move's late cost).
+    // Every kind but kHeld is kept apart from the steady-state fits.
+    enum class FrameKind { kOpening, kHeld, kMoved, kLateCanvas };
+    FrameKind learnMoveCost(const FrameMeasurement& m, double predicted_bits);
     // What the server took of a frame, from its T_remote and its transmission (sent_ms).
     double serverMsOf(const FrameMeasurement& m, double sent_ms) const;
     // Both eyes' middle and outer layers' bits at e1 (0 once the fovea covers the frame).
