@@ -106,6 +106,7 @@ MahimahiDelivery::MahimahiDelivery(std::shared_ptr<const MahimahiTrace> trace, d
 
 void MahimahiDelivery::restart() {
     m_started = false;
+    m_last_departure_ms = 0.0;
     m_index = 0;
     m_left_bytes = kMahimahiPacketBytes;
 }
@@ -144,6 +145,8 @@ double MahimahiDelivery::departureMs(double t_ms, int64_t bytes) {
         m_index = 0;
         m_left_bytes = kMahimahiPacketBytes;
     }
+    if (t_ms <= m_last_departure_ms + kSameInstantMs)
+        t_ms = std::min(t_ms, m_last_departure_ms);  // queued behind the bytes that just left
     if (opportunityMs(m_index) < t_ms) {
         // Opportunities that passed with nothing queued are lost, as in Mahimahi.
         m_index = firstOpportunityAtOrAfter(t_ms);
@@ -167,8 +170,10 @@ double MahimahiDelivery::departureMs(double t_ms, int64_t bytes) {
             ++m_index;
             m_left_bytes = kMahimahiPacketBytes;
         }
-        if (remaining == 0)
+        if (remaining == 0) {
+            m_last_departure_ms = t;
             return t;
+        }
     }
 }
 

@@ -60,7 +60,12 @@ LinkTransfer TraceLink::transfer(double start_ms, double payload_bytes) {
     const double start = std::max(0.0, start_ms);
     const auto wire = static_cast<int64_t>(std::ceil(payload_bytes / efficiency()));
     const double finish_ms = m_delivery.departureMs(start, wire);
-    const double duration_ms = std::max(finish_ms - start, 1e-6);
+    // 0 when an opportunity at `start` carries it all: a caller that chains the next transfer at
+    // start + duration must land on that instant, where the burst's other opportunities still
+    // wait (a floor here once put it past them, so a frame's layers took a burst each).
+    const double duration_ms = std::max(finish_ms - start, 0.0);
+    if (duration_ms <= 0.0)
+        return {0.0, meanGoodputBps()};
     return {duration_ms, payload_bytes * 8.0 / (duration_ms * 1e-3)};
 }
 

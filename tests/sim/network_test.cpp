@@ -122,6 +122,44 @@ TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
     EXPECT_NEAR(link.transfer(250.0, 100.0).duration_ms, 50.0, 1e-9);
 }
 
+TEST(Mahimahi, TraceLinkChainedAtEachDepartureKeepsTheBurst) {
+    // The runtime model sends a frame's layers one after another, each at the link's free time
+    // (start + the previous duration). Bursts of four opportunities 100 ms apart: four 400-byte
+    // layers queued behind the first all leave in its burst. A duration floored above zero once
+    // put each start past the burst's instant, so every layer waited for the next burst (a
+    // stretched cellular trace then cost the model a quarter of its frames).
+    std::string text;
+    for (int b = 1; b <= 10; ++b)
+        for (int k = 0; k < 4; ++k)
+            text += std::to_string(100 * b) + "\n";
+    auto trace = parseMahimahiTrace(text, "bursts");
+    ASSERT_TRUE(trace.ok());
+    // A rescaled trace (an awkward ms-per-trace-ms), so the instants are not round numbers.
+    TraceLink link("bursts", shared(*trace), trace->meanBps() / 8.35, 1.0, {});
+    double free_ms = 3.7;
+    for (int layer = 0; layer < 4; ++layer) {
+        const LinkTransfer t = link.transfer(free_ms, 400.0);
+        free_ms += t.duration_ms;
+        EXPECT_GE(t.duration_ms, 0.0);
+    }
+    EXPECT_NEAR(free_ms, 3.7 + 835.0, 1e-6);
+    // Offered after the burst passed with nothing queued: the next one.
+    EXPECT_NEAR(free_ms + link.transfer(free_ms + 1.0, 100.0).duration_ms + 1.0, 3.7 + 1670.0,
+                1e-6);
+}
+
+TEST(Mahimahi, DeliveryQueuesAnOfferARoundingStepPastTheLastDeparture) {
+    auto trace = parseMahimahiTrace("10\n10\n10\n50\n", "same-stamp");
+    ASSERT_TRUE(trace.ok());
+    MahimahiDelivery rule(shared(*trace), 0.0);
+    const double first = rule.departureMs(0.0, 1000);
+    EXPECT_DOUBLE_EQ(first, 10.0);
+    // An ulp past the departure is the same instant: the stamp's other opportunities carry it.
+    EXPECT_DOUBLE_EQ(rule.departureMs(std::nextafter(first, 1e9), 1500), 10.0);
+    // A real gap after it is not: the stamp's last opportunity passed with nothing queued.
+    EXPECT_DOUBLE_EQ(rule.departureMs(first + 0.5, 100), 50.0);
+}
+
 TEST(Mahimahi, TraceLinkLeavesWhenTheSharedRuleSays) {
     // The simulator's link is the emulator's rule (MahimahiDelivery) and nothing more: a sequence
     // of offers, in bytes and not whole packets, gets the departures the rule gives a fresh copy

@@ -46,7 +46,9 @@ public:
     MahimahiDelivery(std::shared_ptr<const MahimahiTrace> trace, double target_bps);
     // When the last of `bytes` offered at t_ms leaves: after the bytes offered before it that
     // have not left, on the first opportunity at or after t_ms otherwise. Instants in ms on the
-    // caller's clock; calls in non-decreasing t_ms.
+    // caller's clock; calls in non-decreasing t_ms. An offer at the previous departure's instant
+    // (within kSameInstantMs: a caller that adds a duration back to its start can land a rounding
+    // step past it) is queued behind those bytes and takes what is left of that opportunity.
     double departureMs(double t_ms, int64_t bytes);
     // The next offer starts the trace again (a new session on the link).
     void restart();
@@ -59,9 +61,11 @@ private:
 
     std::shared_ptr<const MahimahiTrace> m_trace;
     double m_ms_per_trace_ms = 1.0;
+    static constexpr double kSameInstantMs = 1e-9;
     bool m_started = false;
     double m_origin_ms = 0.0;  // the first offer: trace time 0
-    int64_t m_index = 0;       // the opportunity being filled
+    double m_last_departure_ms = 0.0;
+    int64_t m_index = 0;  // the opportunity being filled
     int64_t m_left_bytes = kMahimahiPacketBytes;
 };
 
