@@ -97,16 +97,21 @@ TEST(Mahimahi, TraceLinkRescalesAndTimesTransfersByOpportunity) {
     EXPECT_NEAR(link.transfer(0.0, 2000.0 * 1500.0 * 3).duration_ms, 3000.0, 1e-9);
 }
 
-TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
-    // Bursts of four opportunities at one stamp, 100 ms apart: the shape of a cellular trace
-    // rescaled to a slow rate. Layers sent back to back share a burst, as the emulator's
-    // packets do; the model once let only the first layer use it (a start at a burst's instant
-    // saw only later opportunities), so a four-layer frame waited for four bursts.
+// Ten bursts of four opportunities at one stamp, 100 ms apart: the shape of a cellular trace
+// rescaled to a slow rate.
+auto burstTrace() {
     std::string text;
     for (int b = 1; b <= 10; ++b)
         for (int k = 0; k < 4; ++k)
             text += std::to_string(100 * b) + "\n";
-    auto trace = parseMahimahiTrace(text, "bursts");
+    return parseMahimahiTrace(text, "bursts");
+}
+
+TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
+    // Layers sent back to back share a burst, as the emulator's packets do; the model once let
+    // only the first layer use it (a start at a burst's instant saw only later opportunities),
+    // so a four-layer frame waited for four bursts.
+    auto trace = burstTrace();
     ASSERT_TRUE(trace.ok());
     TraceLink link("bursts", shared(*trace), trace->meanBps(), 1.0, {});
     // The first transfer starts the trace: its burst is 100 ms later.
@@ -124,15 +129,11 @@ TEST(Mahimahi, TraceLinkQueuesLikeTheEmulatorInsideABurst) {
 
 TEST(Mahimahi, TraceLinkChainedAtEachDepartureKeepsTheBurst) {
     // The runtime model sends a frame's layers one after another, each at the link's free time
-    // (start + the previous duration). Bursts of four opportunities 100 ms apart: four 400-byte
-    // layers queued behind the first all leave in its burst. A duration floored above zero once
+    // (start + the previous duration): four 400-byte layers queued behind the first all leave
+    // in its burst. A duration floored above zero once
     // put each start past the burst's instant, so every layer waited for the next burst (a
     // stretched cellular trace then cost the model a quarter of its frames).
-    std::string text;
-    for (int b = 1; b <= 10; ++b)
-        for (int k = 0; k < 4; ++k)
-            text += std::to_string(100 * b) + "\n";
-    auto trace = parseMahimahiTrace(text, "bursts");
+    auto trace = burstTrace();
     ASSERT_TRUE(trace.ok());
     // A rescaled trace (an awkward ms-per-trace-ms), so the instants are not round numbers.
     TraceLink link("bursts", shared(*trace), trace->meanBps() / 8.35, 1.0, {});
