@@ -63,9 +63,9 @@ private:
     double m_ms_per_trace_ms = 1.0;
     static constexpr double kSameInstantMs = 1e-9;
     bool m_started = false;
-    double m_origin_ms = 0.0;  // the first offer: trace time 0
-    double m_last_departure_ms = 0.0;
-    int64_t m_index = 0;  // the opportunity being filled
+    double m_origin_ms = 0.0;          // the first offer: trace time 0
+    double m_last_departure_ms = 0.0;  // when the last offer's bytes left
+    int64_t m_index = 0;               // the opportunity being filled
     int64_t m_left_bytes = kMahimahiPacketBytes;
 };
 
