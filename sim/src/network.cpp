@@ -63,7 +63,7 @@ LinkTransfer TraceLink::transfer(double start_ms, double payload_bytes) {
     // 0 when an opportunity at `start` carries it all: a caller that chains the next transfer at
     // start + duration must land on that instant, where the burst's other opportunities still
     // wait (a floor here once put it past them, so a frame's layers took a burst each).
-    const double duration_ms = std::max(finish_ms - start, 0.0);
+    const double duration_ms = finish_ms - start;
     if (duration_ms <= 0.0)
         return {0.0, meanGoodputBps()};
     return {duration_ms, payload_bytes * 8.0 / (duration_ms * 1e-3)};
