@@ -12,7 +12,7 @@
 
 #include "control_io.h"
 #include "qvr/core/clock.h"
-#include "qvr/net/throughput_estimator.h"
+#include "qvr/core/throughput_estimator.h"
 
 namespace qvr::net {
 namespace {
