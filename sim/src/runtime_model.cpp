@@ -20,6 +20,7 @@
 #include "qvr/core/canvas_policy.h"
 #include "qvr/core/link_spec.h"
 #include "qvr/core/silence.h"
+#include "qvr/core/throughput_estimator.h"
 #include "qvr/foveation/layer_plan.h"
 
 namespace qvr {
@@ -39,7 +40,6 @@ struct Stream {
     double rx_ms = 0.0;  // last packet arrived
     double payload_bytes = 0.0;
     double pixels = 0.0;  // pixels the decoder works on (the canvas)
-    double goodput_bps = 0.0;
     bool decoded = false;
 };
 
@@ -321,7 +321,9 @@ private:
     // wait one refresh instead.
     SilenceDetector m_silence;
     int64_t m_last_slot = -1;  // the newest scan-out's vsync slot index
-    double m_ack_goodput_bps = 0.0;
+    // The server's estimate from the acks (the runtime's, reported to the headset): a stream is
+    // handed to the link when encoded and acknowledged when its last packet arrives.
+    ThroughputEstimator m_link_estimate;
     // Server and link.
     std::deque<Request> m_queue;
     double m_server_free = 0.0, m_link_free = 0.0, m_server_busy_total = 0.0;
@@ -467,8 +469,9 @@ double PassReplay::sendLayer(int64_t j, FrameState& fs, LayerJob& job, double t)
     s.rx_ms = m_link_free + m_costs.link_delay_ms;
     s.payload_bytes = job.bytes;
     s.pixels = coded_px;
-    s.goodput_bps = tr.duration_ms > 0 ? job.bytes * 8.0 / (tr.duration_ms * 1e-3) : 0.0;
     m_streams.push_back(s);
+    m_link_estimate.onSend(static_cast<uint32_t>(j), static_cast<int64_t>(job.bytes),
+                           static_cast<int64_t>(t * 1e6));
     if (job.middle)
         fs.middle_bytes += job.bytes;
     else
@@ -507,7 +510,8 @@ void PassReplay::decodeNext() {
     m_hs = std::max(m_hs, s.rx_ms);
     work(m_costs.decode.at(s.pixels, 0.0));
     s.decoded = true;
-    m_ack_goodput_bps = s.goodput_bps;
+    m_link_estimate.onAck(static_cast<uint32_t>(s.frame), static_cast<int64_t>(s.payload_bytes),
+                          static_cast<int64_t>(s.rx_ms * 1e6));
     FrameState& fs = m_state[static_cast<size_t>(s.frame)];
     RuntimeFrame& rf = m_result.frames[static_cast<size_t>(s.frame)];
     fs.last_rx_ms = std::max(fs.last_rx_ms, s.rx_ms);
@@ -552,7 +556,7 @@ void PassReplay::decideLayers(FrameState& fs, RuntimeFrame& rf, const WorkloadFr
         rf.e1_deg = 0.0;
     } else {
         if (m_link_aware)
-            m_link_aware->setLinkEstimate(m_ack_goodput_bps);
+            m_link_aware->setLinkEstimate(m_link_estimate.throughputBps());
         const Decision d = m_policy->decide(wf);
         m_last_e1_deg = d.e1_deg;
         fs.plan = m_planner.plan(wf.gaze, d.e1_deg);
@@ -706,7 +710,7 @@ void PassReplay::learn(int64_t i) {
     m.outer_pixels = 2.0 * double(fs.plan.outer_pixels);
     m.s1 = fs.plan.s1;
     m.s2 = fs.plan.s2;
-    m.throughput_bps = m_ack_goodput_bps;
+    m.throughput_bps = m_link_estimate.throughputBps();
     m.new_canvas_streams = fs.received_bytes > 0 ? fs.new_canvases : 0;
     m.periphery_late = rf.requested && fs.expected > 0 && fs.decoded < fs.expected &&
                        i >= static_cast<int64_t>(m_depth);
