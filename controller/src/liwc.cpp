@@ -95,6 +95,19 @@ void LiwcPolicy::setLinkEstimate(double throughput_bps) {
         m_link_bps = throughput_bps;
 }
 
+double LiwcPolicy::linkBps() const {
+    if (m_config.reactive || m_link_bps <= 0.0)
+        return m_throughput_bps;
+    if (m_frames_without_link == 0)
+        return m_link_bps;
+    // Frames that sent nothing teach nothing of the link, and an estimate too low to send
+    // anything would hold forever: it relaxes (in log space) toward the prior, so the period
+    // objective tries the link again and a fresh sample replaces it.
+    const double w = 1.0 - std::exp(-double(m_frames_without_link) / kStaleLinkFrames);
+    const double prior = std::max(m_link_bps, m_config.throughput_bps_initial);
+    return std::exp((1.0 - w) * std::log(m_link_bps) + w * std::log(prior));
+}
+
 double LiwcPolicy::peripheryTriangles(double e1_deg) const {
     const size_t rings = m_prefix_tris.size() - 1;
     const double total = rings > 0 ? m_prefix_tris[rings] : 0.0;
@@ -113,7 +126,7 @@ double LiwcPolicy::peripheryPixels(const Gaze& gaze, double e1_deg) const {
 double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
     if (e1_deg >= m_cover_deg)
         return 0.0;
-    const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
+    const double bps = linkBps();
     return peripheryBits(gaze, e1_deg) / std::max(1.0, bps) * 1000.0;
 }
 
@@ -373,6 +386,10 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         }
     }
     ++m_observed;
+    // A frame that sent nothing says nothing of the link; one whose periphery came late does
+    // (its acks bring the estimate that explains it).
+    const bool link_seen = m.middle_bytes + m.outer_bytes > 0.0 || m.periphery_late;
+    m_frames_without_link = link_seen ? 0 : m_frames_without_link + 1;
     const double b = m_config.rate_ema;
     if (m.t_local_ms > 0.0) {
         if (m_config.frame_period_objective)
@@ -386,7 +403,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         // What the server took of the frame (serverMsOf, which reads the previous arrival
         // before it is replaced below), against what it had to draw.
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
-        const double bps = !m_config.reactive && m_link_bps > 0.0 ? m_link_bps : m_throughput_bps;
+        const double bps = linkBps();
         const double server_ms = serverMsOf(m, sent_bits / bps * 1000.0);
         const std::array<double, 3> x{1.0, decided->periphery_triangles * 1e-5,
                                       decided->periphery_pixels * 1e-5};

@@ -230,6 +230,58 @@ TEST(LiwcPeriodObjective, LeavesAFlatPeriodForTheAllLocalCoverWhenTRemoteExceeds
     }
 }
 
+// The acks' estimate changes only when a frame's periphery is acknowledged. In an outage the
+// periphery comes too late to be shown (so LIWC measures nothing of it) and its acks, when they
+// come, read 0.04 Mbit/s: LIWC heads for the all-local cover, sends nothing, and the estimate
+// stays where the outage left it although the link came back. An estimate that no frame has
+// refreshed relaxes toward the prior; LIWC tries the link again and the fresh sample brings e1
+// back to where it was before the outage. A late periphery is news of the link: in the outage
+// LIWC tries the link only now and then.
+TEST(LiwcPeriodObjective, TriesTheLinkAgainAfterAnOutageLeftItsEstimateLow) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.noise = 0.03;
+    truth.throughput_bps = 20e6;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    LiwcConfig c = periodConfig();
+    c.e1_initial_deg = 10.0;
+    LiwcPolicy liwc(h, c);
+    std::mt19937 rng(5);
+    double reported = truth.throughput_bps;  // what the server last reported
+    std::vector<Decision> d;
+    int first_cover = -1, back = -1;
+    for (int i = 0; i < 400; ++i) {
+        WorkloadFrame fi = f;
+        fi.index = i;
+        liwc.setLinkEstimate(reported);
+        d.push_back(liwc.decide(fi));
+        FrameMeasurement m = truth.measure(planner, fi, d.back(), rng);
+        const bool sent = m.middle_bytes + m.outer_bytes > 0.0;
+        if (sent && i >= 60 && i < 100) {  // the outage
+            m.periphery_late = true;
+            m.t_remote_ms = 0.0;
+            m.middle_bytes = m.outer_bytes = 0.0;
+            m.throughput_bps = 0.0;
+            reported = 0.04e6;
+        } else if (sent) {
+            reported = truth.throughput_bps;
+        }
+        liwc.observe(m);
+        if (!sent && first_cover < 0)
+            first_cover = i;
+        if (i >= 100 && first_cover >= 0 && back < 0 && sent)
+            back = i;
+    }
+    const double before = d[59].e1_deg;
+    ASSERT_TRUE(planner.plan(f.gaze, before).hasRemote()) << before;
+    ASSERT_GE(first_cover, 60) << "the outage sent LIWC to the all-local cover";
+    ASSERT_LT(first_cover, 100);
+    ASSERT_GE(back, 100) << "LIWC never tried the link again";
+    EXPECT_LT(back, 200);
+    EXPECT_NEAR(d.back().e1_deg, before, 2.5);
+}
+
 // T_local rises and T_remote falls with e1. With `depth` frames in flight the headset, the server
 // and the link each work on their own frame: the period is the slowest stage's and no shorter
 // than the remote chain over the frames in flight, max(L, S, X, (S + X) / depth) — at depth 1

@@ -110,6 +110,11 @@ private:
     double remoteMs(const Gaze& gaze, double e1_deg) const;
     // frame_period_objective: the server's part and the transmission, separately.
     double transmissionMs(const Gaze& gaze, double e1_deg) const;
+    // The link's throughput the objective uses: the acks' estimate at decision time (the
+    // reactive variant: its observed frames'), relaxing toward the prior over frames that sent
+    // nothing, with time constant kStaleLinkFrames (about a second of frames).
+    double linkBps() const;
+    static constexpr double kStaleLinkFrames = 30.0;
     // What a move adds to a frame's link time and server time, as fractions of them: the
     // measured extra of frames whose e1 moved over frames that held, spread over the frames a
     // chosen e1 is measured to hold (docs/LIWC.md).
@@ -155,7 +160,8 @@ private:
     // S ≈ σ·[1, periphery triangles, periphery pixels], in units of 1e5.
     WindowedFit m_local_fit;
     WindowedFit m_server_fit;
-    double m_link_bps = 0.0;  // setLinkEstimate
+    double m_link_bps = 0.0;        // setLinkEstimate
+    int m_frames_without_link = 0;  // observed frames in a row that carried no periphery
     // frame_period_objective: what moving e1 costs. EMAs (weight 0.2) of measured / predicted
     // for frames whose e1 moved and for frames whose e1 held: of the bits (a new canvas is a key
     // frame, a grown one carries padding) and of the server's time (the key frames' encode).
