@@ -280,9 +280,9 @@ Decision LiwcPolicy::decide(const WorkloadFrame& frame) {
     const double hi = std::min(m_config.e1_max_deg, m_cover_deg);
     const double lo = m_config.e1_min_deg;
     // Nothing measured yet: the first frame runs at the initial e1 (Fig. 14 starts at 5°). With
-    // the period objective e1 also holds until a frame that held has been observed: before it,
-    // the costs are the cold-start priors (1 bit a pixel, 20-50x a P-frame's) and the session's
-    // opening key frames, no basis for a move.
+    // the period objective e1 also holds until a frame that held, timed, has been observed:
+    // before it, the costs are the cold-start priors (1 bit a pixel, 20-50x a P-frame's; a
+    // mobile GPU's rates) and the session's opening key frames, no basis for a move.
     const bool cold = m_first_decision || (m_config.frame_period_objective && !m_seen_held_frame);
     if (cold) {
         if (m_first_decision)
@@ -481,7 +481,12 @@ LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, doubl
     // state, the predicted T_remote doubled and e1 jumped). Kept apart as a move is; it is
     // not a move, so the moves' frequency does not count it.
     const bool new_canvas = !moved && m.new_canvas_streams > 0;
-    m_seen_held_frame = m_seen_held_frame || (!moved && !new_canvas);
+    // The cold start ends on a held frame that also taught the fits: a start-up frame (no
+    // timing, isStartUpFrame) held at the initial e1 left L at its prior, a mobile GPU's rate,
+    // and on a slow headset that prior sent e1 to 25-30° for ten frames (rate:1, docs/LIWC.md).
+    const bool timed =
+        m.t_local_ms > 0.0 && (m.t_remote_ms > 0.0 || m.middle_bytes + m.outer_bytes <= 0.0);
+    m_seen_held_frame = m_seen_held_frame || (!moved && !new_canvas && timed);
     if (moved) {
         m_frames_between_moves = (1.0 - kMoveEmaWeight) * m_frames_between_moves +
                                  kMoveEmaWeight * (m_frames_since_move + 1);
