@@ -484,8 +484,9 @@ LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, doubl
     // The cold start ends on a held frame that also taught the fits: a start-up frame (no
     // timing, isStartUpFrame) held at the initial e1 left L at its prior, a mobile GPU's rate,
     // and on a slow headset that prior sent e1 to 25-30° for ten frames (rate:1, docs/LIWC.md).
-    const bool timed =
-        m.t_local_ms > 0.0 && (m.t_remote_ms > 0.0 || m.middle_bytes + m.outer_bytes <= 0.0);
+    // A late periphery is timed too: the link is slower than the wait.
+    const bool timed = m.t_local_ms > 0.0 && (m.t_remote_ms > 0.0 || m.periphery_late ||
+                                              m.middle_bytes + m.outer_bytes <= 0.0);
     m_seen_held_frame = m_seen_held_frame || (!moved && !new_canvas && timed);
     if (moved) {
         m_frames_between_moves = (1.0 - kMoveEmaWeight) * m_frames_between_moves +

@@ -222,6 +222,42 @@ TEST(LiwcPeriodObjective, UntimedStartUpFramesDoNotEndTheColdStart) {
     EXPECT_LT(periodAt(d.back().e1_deg), 1.1 * best);
 }
 
+// A link so slow that no periphery arrives within the wait: every frame's periphery is late, with
+// no T_remote of its own. Those frames are timed all the same (the link is slower than the wait),
+// so the cold start ends and LIWC leaves for the all-local cover.
+TEST(LiwcPeriodObjective, LatePeripheriesEndTheColdStart) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.throughput_bps = 0.05e6;
+    truth.noise = 0.03;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    LiwcPolicy liwc(h, periodConfig());
+    std::mt19937 rng(4);
+    std::vector<Decision> d;
+    constexpr int kDepth = 2;
+    for (int i = 0; i < 80; ++i) {
+        WorkloadFrame fi = f;
+        fi.index = i;
+        liwc.setLinkEstimate(truth.throughput_bps);
+        d.push_back(liwc.decide(fi));
+        const int observed = i + 1 - kDepth;
+        if (observed < 0)
+            continue;
+        WorkloadFrame fo = f;
+        fo.index = observed;
+        FrameMeasurement m = truth.measure(planner, fo, d[size_t(observed)], rng);
+        if (observed < kDepth) {  // the pipeline's fill: start-up, untimed
+            m.t_local_ms = m.t_remote_ms = 0.0;
+        } else if (m.middle_bytes + m.outer_bytes > 0.0) {
+            m.periphery_late = true;
+            m.t_remote_ms = 0.0;
+        }
+        liwc.observe(m);
+    }
+    EXPECT_FALSE(planner.plan(f.gaze, d.back().e1_deg).hasRemote()) << d.back().e1_deg;
+}
+
 // T_remote that does not fall with e1 (the server's fixed cost dominates): a larger fovea only
 // lengthens the headset's busy time, so every e1 with T_local below T_remote gives the same
 // period and the lower motion-to-photon latency wins — LIWC walks down to e1_min.
