@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -168,6 +169,30 @@ std::vector<Decision> run(LiwcPolicy& liwc, const Truth& truth, const LayerPlann
     return decided;
 }
 
+// As run(), with the server's link estimate (truth's throughput) given before every decision, as
+// the runtime's acks do, and `adjust` applied to each measurement (frame index at observation).
+std::vector<Decision> runWithLink(LiwcPolicy& liwc, const Truth& truth, const LayerPlanner& planner,
+                                  const WorkloadFrame& f, int frames, int depth, uint32_t seed,
+                                  const std::function<void(FrameMeasurement&, int)>& adjust) {
+    std::mt19937 rng(seed);
+    std::vector<Decision> d;
+    for (int i = 0; i < frames; ++i) {
+        WorkloadFrame fi = f;
+        fi.index = i;
+        liwc.setLinkEstimate(truth.throughput_bps);
+        d.push_back(liwc.decide(fi));
+        const int observed = i + 1 - depth;
+        if (observed < 0)
+            continue;
+        WorkloadFrame fo = f;
+        fo.index = observed;
+        FrameMeasurement m = truth.measure(planner, fo, d[size_t(observed)], rng);
+        adjust(m, observed);
+        liwc.observe(m);
+    }
+    return d;
+}
+
 // The runtime's first frames reach LIWC untimed (isStartUpFrame: t_local = t_remote = 0) though
 // they held the initial e1. Ending the cold start on them left the headset's fit at its prior, a
 // mobile GPU's rates: on a headset 5-10x slower and a slow link the fovea looked free, and e1
@@ -193,26 +218,13 @@ TEST(LiwcPeriodObjective, UntimedStartUpFramesDoNotEndTheColdStart) {
     for (double e = 1.0; e <= 60.0; e += 0.25)
         best = std::min(best, periodAt(e));
     ASSERT_GT(truth.localMs(f, 10.0), 40.0) << "a slow headset";
-    LiwcConfig c = periodConfig();
-    LiwcPolicy liwc(h, c);
-    std::mt19937 rng(9);
-    std::vector<Decision> d;
+    LiwcPolicy liwc(h, periodConfig());
     constexpr int kStartUp = 4, kDepth = 2;
-    for (int i = 0; i < 60; ++i) {
-        WorkloadFrame fi = f;
-        fi.index = i;
-        liwc.setLinkEstimate(truth.throughput_bps);  // the server's acks, from the first frame
-        d.push_back(liwc.decide(fi));
-        const int observed = i + 1 - kDepth;
-        if (observed < 0)
-            continue;
-        WorkloadFrame fo = f;
-        fo.index = observed;
-        FrameMeasurement m = truth.measure(planner, fo, d[size_t(observed)], rng);
-        if (observed < kStartUp)
-            m.t_local_ms = m.t_remote_ms = 0.0;
-        liwc.observe(m);
-    }
+    const std::vector<Decision> d =
+        runWithLink(liwc, truth, planner, f, 60, kDepth, 9, [](FrameMeasurement& m, int i) {
+            if (i < kStartUp)
+                m.t_local_ms = m.t_remote_ms = 0.0;
+        });
     // Past the cold start (the initial 5° is the paper's start, not a decision), no frame more
     // than a third slower than the best e1's: without the rule e1 went to 20° (1.7x).
     double worst = 0.0;
@@ -233,28 +245,16 @@ TEST(LiwcPeriodObjective, LatePeripheriesEndTheColdStart) {
     truth.noise = 0.03;
     const WorkloadFrame f = frame(0, 20'000.0);
     LiwcPolicy liwc(h, periodConfig());
-    std::mt19937 rng(4);
-    std::vector<Decision> d;
     constexpr int kDepth = 2;
-    for (int i = 0; i < 80; ++i) {
-        WorkloadFrame fi = f;
-        fi.index = i;
-        liwc.setLinkEstimate(truth.throughput_bps);
-        d.push_back(liwc.decide(fi));
-        const int observed = i + 1 - kDepth;
-        if (observed < 0)
-            continue;
-        WorkloadFrame fo = f;
-        fo.index = observed;
-        FrameMeasurement m = truth.measure(planner, fo, d[size_t(observed)], rng);
-        if (observed < kDepth) {  // the pipeline's fill: start-up, untimed
-            m.t_local_ms = m.t_remote_ms = 0.0;
-        } else if (m.middle_bytes + m.outer_bytes > 0.0) {
-            m.periphery_late = true;
-            m.t_remote_ms = 0.0;
-        }
-        liwc.observe(m);
-    }
+    const std::vector<Decision> d =
+        runWithLink(liwc, truth, planner, f, 80, kDepth, 4, [](FrameMeasurement& m, int i) {
+            if (i < kDepth) {  // the pipeline's fill: start-up, untimed
+                m.t_local_ms = m.t_remote_ms = 0.0;
+            } else if (m.middle_bytes + m.outer_bytes > 0.0) {
+                m.periphery_late = true;
+                m.t_remote_ms = 0.0;
+            }
+        });
     EXPECT_FALSE(planner.plan(f.gaze, d.back().e1_deg).hasRemote()) << d.back().e1_deg;
 }
 
