@@ -365,6 +365,13 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     const bool moved_apart = kind != FrameKind::kHeld;
     // A held frame's new canvas shows S no slope, only a key frame's encode.
     const bool late_canvas = kind == FrameKind::kLateCanvas;
+    // The cold start ends on a held frame that also taught the fits: a start-up frame (no
+    // timing, isStartUpFrame) held at the initial e1 left L at its prior, a mobile GPU's rate,
+    // and on a slow headset that prior sent e1 to 25-30° for ten frames (rate:1, docs/LIWC.md).
+    // A late periphery is timed too: the link is slower than the wait.
+    const bool timed = m.t_local_ms > 0.0 && (m.t_remote_ms > 0.0 || m.periphery_late ||
+                                              m.middle_bytes + m.outer_bytes <= 0.0);
+    m_seen_held_frame = m_seen_held_frame || (kind == FrameKind::kHeld && timed);
     std::optional<PendingDecision> decided;
     if (!m_pending.empty()) {
         const PendingDecision p = m_pending.front();
@@ -481,13 +488,6 @@ LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, doubl
     // state, the predicted T_remote doubled and e1 jumped). Kept apart as a move is; it is
     // not a move, so the moves' frequency does not count it.
     const bool new_canvas = !moved && m.new_canvas_streams > 0;
-    // The cold start ends on a held frame that also taught the fits: a start-up frame (no
-    // timing, isStartUpFrame) held at the initial e1 left L at its prior, a mobile GPU's rate,
-    // and on a slow headset that prior sent e1 to 25-30° for ten frames (rate:1, docs/LIWC.md).
-    // A late periphery is timed too: the link is slower than the wait.
-    const bool timed = m.t_local_ms > 0.0 && (m.t_remote_ms > 0.0 || m.periphery_late ||
-                                              m.middle_bytes + m.outer_bytes <= 0.0);
-    m_seen_held_frame = m_seen_held_frame || (!moved && !new_canvas && timed);
     if (moved) {
         m_frames_between_moves = (1.0 - kMoveEmaWeight) * m_frames_between_moves +
                                  kMoveEmaWeight * (m_frames_since_move + 1);

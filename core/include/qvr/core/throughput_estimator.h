@@ -37,7 +37,7 @@ public:
     static constexpr int64_t kIdleNs = 1'000'000'000;  // a second without a sample
 
 private:
-    static constexpr size_t kMaxStreamsPerFrame = 64;  // sends beyond it share the last's time
+    static constexpr size_t kMaxStreamsPerFrame = 64;  // sends beyond it add no busy time
     struct Pending {
         uint32_t frame_id;
         std::deque<int64_t> unacked_send_ns;  // its streams' sends not yet acknowledged
