@@ -103,7 +103,8 @@ double LiwcPolicy::linkBps() const {
     // Frames that sent nothing teach nothing of the link, and an estimate too low to send
     // anything would hold forever: it relaxes (in log space) toward the prior, so the period
     // objective tries the link again and a fresh sample replaces it.
-    const double w = 1.0 - std::exp(-double(m_frames_without_link) / kStaleLinkFrames);
+    const double w =
+        1.0 - std::exp(-double(m_frames_without_link) / (kStaleLinkFrames * m_stale_link_backoff));
     const double prior = std::max(m_link_bps, m_config.throughput_bps_initial);
     return std::exp((1.0 - w) * std::log(m_link_bps) + w * std::log(prior));
 }
@@ -130,17 +131,21 @@ double LiwcPolicy::transmissionMs(const Gaze& gaze, double e1_deg) const {
     return peripheryBits(gaze, e1_deg) / std::max(1.0, bps) * 1000.0;
 }
 
-void LiwcPolicy::MoveRatios::add(bool was_moved, double ratio) {
-    double& ema = was_moved ? moved : held;
-    bool& have = was_moved ? have_moved : have_held;
-    ema = have ? (1.0 - kMoveEmaWeight) * ema + kMoveEmaWeight * ratio : ratio;
-    have = true;
-}
-
-double LiwcPolicy::MoveRatios::extra() const {
-    if (!have_moved || !have_held)
-        return 0.0;
-    return std::max(0.0, moved / std::max(1e-9, held) - 1.0);
+void LiwcPolicy::MoveMeter::add(bool was_moved, double e1_deg, double value) {
+    if (was_moved) {
+        m_pending = {e1_deg, value};
+        return;
+    }
+    // Against the next frame that held the moved frame's e1: both at the same fovea, so what
+    // the model would have mispredicted at a new e1 cancels, and only the move's own cost is
+    // left (measured against the model, a move to an e1 the fits had not seen read their
+    // extrapolation error as the move's: 30x on the UMTS trace, every later move priced out).
+    if (m_pending && std::fabs(m_pending->e1_deg - e1_deg) <= 0.05 && value > 0.0) {
+        const double e = m_pending->value / value - 1.0;  // signed: noise averages out
+        m_extra = m_have ? (1.0 - kMoveEmaWeight) * m_extra + kMoveEmaWeight * e : e;
+        m_have = true;
+    }
+    m_pending.reset();
 }
 
 LiwcPolicy::MoveCost LiwcPolicy::moveCost() const {
@@ -396,6 +401,13 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // A frame that sent nothing says nothing of the link; one whose periphery came late does
     // (its acks bring the estimate that explains it).
     const bool link_seen = m.middle_bytes + m.outer_bytes > 0.0 || m.periphery_late;
+    // A try of the link after frames without one that came late again (the link is still down)
+    // doubles the wait before the next (a late periphery stalls its frame up to the wait limit);
+    // one on time resets it.
+    if (link_seen && m.periphery_late && m_frames_without_link > 0)
+        m_stale_link_backoff = std::min(kMaxStaleLinkBackoff, 2.0 * m_stale_link_backoff);
+    else if (link_seen && !m.periphery_late)
+        m_stale_link_backoff = 1.0;
     m_frames_without_link = link_seen ? 0 : m_frames_without_link + 1;
     const double b = m_config.rate_ema;
     if (m.t_local_ms > 0.0) {
@@ -414,14 +426,15 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double server_ms = serverMsOf(m, sent_bits / bps * 1000.0);
         const std::array<double, 3> x{1.0, decided->periphery_triangles * 1e-5,
                                       decided->periphery_pixels * 1e-5};
-        // A moved frame's server time (its new canvases' key frames) against the fit's, beside
-        // the same for frames that held: what a move costs the server. Moved frames stay in the
-        // fit: they are the frames that show S's slope (left out, a walk of e1 across the range
-        // taught the fit nothing and left a stale slope).
-        const double predicted = m_server_fit.predict(x);
-        if (!opening && predicted > 0.0 && server_ms > 0.0)
-            m_move_server.add(moved_apart, server_ms / predicted);
-        if (!opening && !late_canvas)
+        // A moved frame's server time (its new canvases' key frames) over the next held frame's
+        // at its e1: what a move costs the server. Moved frames stay in the fit: they are the
+        // frames that show S's slope (left out, a walk of e1 across the range taught the fit
+        // nothing and left a stale slope). A server time of 0 is the link estimate's, not the
+        // server's: T_remote held nothing beyond the transmission it predicts (the runtime's
+        // first frames, before the acks' estimate has settled), so it teaches neither.
+        if (!opening && server_ms > 0.0)
+            m_move_server.add(moved_apart, m.e1_deg, server_ms);
+        if (!opening && !late_canvas && server_ms > 0.0)
             m_server_fit.add(x, server_ms);
     } else if (m_config.learn_remote_base && m.t_remote_ms > 0.0) {
         const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
@@ -472,8 +485,9 @@ double LiwcPolicy::serverMsOf(const FrameMeasurement& m, double sent_ms) const {
 
 LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, double predicted_bits) {
     // Whether this frame's e1 differs from the previous observed frame's: its encoders may have
-    // opened a new canvas (a key frame, new padding). Its bits against what the bits law (fitted
-    // on all frames) predicted, beside the same ratio for frames that held, is what a move costs.
+    // opened a new canvas (a key frame, new padding). Its bits over what the bits law (fitted on
+    // held frames) predicted, against the same ratio of the next frame that held its e1, is what
+    // a move costs the link.
     const bool moved =
         m_last_observed_e1_deg >= 0.0 && std::fabs(m.e1_deg - m_last_observed_e1_deg) > 0.05;
     // The session's first frame opens every encoder (a key frame on each stream): like a move's,
@@ -497,7 +511,7 @@ LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, doubl
     }
     const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
     if (sent_bits > 0.0 && predicted_bits > 0.0)
-        m_move_bits.add(moved || new_canvas, sent_bits / predicted_bits);
+        m_move_bits.add(moved || new_canvas, m.e1_deg, sent_bits / predicted_bits);
     return moved ? FrameKind::kMoved : new_canvas ? FrameKind::kLateCanvas : FrameKind::kHeld;
 }
 

@@ -6,6 +6,7 @@
 // and throughput estimates. Choices where §4.1 is vague: docs/LIWC.md.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <optional>
@@ -115,9 +116,10 @@ private:
     // nothing, with time constant kStaleLinkFrames (about a second of frames).
     double linkBps() const;
     static constexpr double kStaleLinkFrames = 30.0;
+    static constexpr double kMaxStaleLinkBackoff = 16.0;  // the longest wait: 16x
     // What a move adds to a frame's link time and server time, as fractions of them: the
-    // measured extra of frames whose e1 moved over frames that held, spread over the frames a
-    // chosen e1 is measured to hold (docs/LIWC.md).
+    // measured extra of a moved frame over the next frame that held its e1, spread over the
+    // frames a chosen e1 is measured to hold (docs/LIWC.md).
     struct MoveCost {
         double link = 0.0;
         double server = 0.0;
@@ -160,20 +162,31 @@ private:
     // S ≈ σ·[1, periphery triangles, periphery pixels], in units of 1e5.
     WindowedFit m_local_fit;
     WindowedFit m_server_fit;
-    double m_link_bps = 0.0;        // setLinkEstimate
-    int m_frames_without_link = 0;  // observed frames in a row that carried no periphery
-    // frame_period_objective: what moving e1 costs. EMAs (weight 0.2) of measured / predicted
-    // for frames whose e1 moved and for frames whose e1 held: of the bits (a new canvas is a key
-    // frame, a grown one carries padding) and of the server's time (the key frames' encode).
+    double m_link_bps = 0.0;            // setLinkEstimate
+    int m_frames_without_link = 0;      // observed frames in a row that carried no periphery
+    double m_stale_link_backoff = 1.0;  // scales kStaleLinkFrames: doubled by a failed try
+    // frame_period_objective: what moving e1 costs the bits (a new canvas is a key frame, a grown
+    // one carries padding) and the server's time (the key frames' encode), measured per move.
     static constexpr double kMoveEmaWeight = 0.2;  // the move-cost EMAs' and frames-between's
-    struct MoveRatios {
-        double moved = 1.0, held = 1.0;
-        bool have_moved = false, have_held = false;
-        void add(bool was_moved, double ratio);
-        double extra() const;  // moved / held − 1, at least 0; 0 until both are measured
+    class MoveMeter {
+    public:
+        // A frame's value (its server time; its bits over the bits law's) and whether its e1
+        // moved (or its encoders opened a new canvas).
+        void add(bool was_moved, double e1_deg, double value);
+        // EMA over moves of a moved frame's value over the next held frame's at its e1, − 1;
+        // at least 0, and 0 until one is measured.
+        double extra() const { return m_have ? std::max(0.0, m_extra) : 0.0; }
+
+    private:
+        struct Pending {
+            double e1_deg = 0.0, value = 0.0;
+        };
+        std::optional<Pending> m_pending;  // the newest moved frame, until the next observed
+        double m_extra = 0.0;
+        bool m_have = false;
     };
-    MoveRatios m_move_bits;
-    MoveRatios m_move_server;
+    MoveMeter m_move_bits;
+    MoveMeter m_move_server;
     bool m_seen_held_frame = false;    // a frame whose e1 held has been observed
     bool m_bits_law_measured = false;  // the bits law has been measured
     // The period objective's bits law takes its first measurement outright (the prior is far off).
