@@ -1,4 +1,4 @@
-// Ack-based throughput EMA over the link's busy time (see the header).
+// Ack-based throughput over the link's busy time, averaged (see the header).
 #include "qvr/core/throughput_estimator.h"
 
 #include <algorithm>
@@ -51,7 +51,15 @@ void ThroughputEstimator::onAck(uint32_t frame_id, int64_t bytes_acked, int64_t 
         const double sample =
             static_cast<double>(it->bytes_acked) * 8.0 * 1e9 / static_cast<double>(it->busy_ns);
         const bool fresh = m_samples == 0 || it->restart;
-        m_ema_bps = fresh ? sample : (1.0 - m_alpha) * m_ema_bps + m_alpha * sample;
+        // Bits and busy time averaged apart, their ratio the estimate: an average of the
+        // frames' rates would let one frame acknowledged in a burst (a trace's queued packets
+        // released in one millisecond: 580 Mbit/s on the 2 Mbit/s UMTS trace) outweigh the
+        // rest; weighted by its busy time it counts for the little time it took.
+        const double bits = static_cast<double>(it->bytes_acked) * 8.0;
+        const double busy_s = static_cast<double>(it->busy_ns) * 1e-9;
+        m_ema_bits = fresh ? bits : (1.0 - m_alpha) * m_ema_bits + m_alpha * bits;
+        m_ema_busy_s = fresh ? busy_s : (1.0 - m_alpha) * m_ema_busy_s + m_alpha * busy_s;
+        m_ema_bps = m_ema_bits / m_ema_busy_s;
         m_last_sample_bps = sample;
         m_last_sample_ns = now_ns;
         ++m_samples;

@@ -1,6 +1,7 @@
 // Throughput from acknowledgements (paper §4.1: LIWC "monitors the network's ACK packets" for
-// Eq. 2's T_remote = DataSize / Throughput): per frame, the bytes acknowledged over the time the
-// link was busy with them, smoothed by an exponential moving average.
+// Eq. 2's T_remote = DataSize / Throughput): the bytes acknowledged over the time the link was
+// busy with them, each an exponential moving average over frames (a ratio of averages, not an
+// average of the frames' rates).
 //
 // A stream's busy time runs from its send, or from the previous ack if the link still carried
 // earlier bytes then, to its ack. So neither the server's work between a frame's layers (their
@@ -51,7 +52,9 @@ private:
     size_t m_max_frames;
     int64_t m_idle_ns;
     std::deque<Pending> m_pending;
-    double m_ema_bps = 0.0;
+    double m_ema_bps = 0.0;     // m_ema_bits / m_ema_busy_s
+    double m_ema_bits = 0.0;    // a frame's bits acknowledged
+    double m_ema_busy_s = 0.0;  // a frame's busy time
     uint32_t m_samples = 0;
     std::optional<double> m_last_sample_bps;
     std::optional<int64_t> m_last_ack_ns;     // the newest ack: the link was busy until then
