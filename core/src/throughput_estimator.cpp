@@ -52,9 +52,9 @@ void ThroughputEstimator::onAck(uint32_t frame_id, int64_t bytes_acked, int64_t 
             static_cast<double>(it->bytes_acked) * 8.0 * 1e9 / static_cast<double>(it->busy_ns);
         const bool fresh = m_samples == 0 || it->restart;
         // Bits and busy time averaged apart, their ratio the estimate: an average of the
-        // frames' rates would let one frame acknowledged in a burst (a trace's queued packets
-        // released in one millisecond: 580 Mbit/s on the 2 Mbit/s UMTS trace) outweigh the
-        // rest; weighted by its busy time it counts for the little time it took.
+        // frames' rates would let one frame acknowledged in a burst (within a millisecond of
+        // the one before: 580 Mbit/s on the 2 Mbit/s UMTS trace) outweigh the rest; weighted
+        // by its busy time it counts for the little time it took.
         const double bits = static_cast<double>(it->bytes_acked) * 8.0;
         const double busy_s = static_cast<double>(it->busy_ns) * 1e-9;
         m_ema_bits = fresh ? bits : (1.0 - m_alpha) * m_ema_bits + m_alpha * bits;
