@@ -48,19 +48,16 @@ void ThroughputEstimator::onAck(uint32_t frame_id, int64_t bytes_acked, int64_t 
         return;
     }
     if (it->busy_ns > 0 && it->bytes_acked > 0) {
-        const double sample =
-            static_cast<double>(it->bytes_acked) * 8.0 * 1e9 / static_cast<double>(it->busy_ns);
+        const double bits = static_cast<double>(it->bytes_acked) * 8.0;
+        const double busy_s = static_cast<double>(it->busy_ns) * 1e-9;
         const bool fresh = m_samples == 0 || it->restart;
         // Bits and busy time averaged apart, their ratio the estimate: an average of the
         // frames' rates would let one frame acknowledged in a burst (within a millisecond of
         // the one before: 580 Mbit/s on the 2 Mbit/s UMTS trace) outweigh the rest; weighted
         // by its busy time it counts for the little time it took.
-        const double bits = static_cast<double>(it->bytes_acked) * 8.0;
-        const double busy_s = static_cast<double>(it->busy_ns) * 1e-9;
         m_ema_bits = fresh ? bits : (1.0 - m_alpha) * m_ema_bits + m_alpha * bits;
         m_ema_busy_s = fresh ? busy_s : (1.0 - m_alpha) * m_ema_busy_s + m_alpha * busy_s;
-        m_ema_bps = m_ema_bits / m_ema_busy_s;
-        m_last_sample_bps = sample;
+        m_last_sample_bps = bits * 1e9 / static_cast<double>(it->busy_ns);
         m_last_sample_ns = now_ns;
         ++m_samples;
     }

@@ -113,7 +113,8 @@ private:
     double transmissionMs(const Gaze& gaze, double e1_deg) const;
     // The link's throughput the objective uses: the acks' estimate at decision time (the
     // reactive variant: its observed frames'), relaxing toward the prior over frames that sent
-    // nothing, with time constant kStaleLinkFrames (about a second of frames).
+    // nothing, with time constant kStaleLinkFrames (about a second of frames) times the backoff
+    // (doubled by each try of the link that came late again, up to kMaxStaleLinkBackoff).
     double linkBps() const;
     static constexpr double kStaleLinkFrames = 30.0;
     static constexpr double kMaxStaleLinkBackoff = 16.0;  // the longest wait: 16x

@@ -31,7 +31,8 @@ public:
     // stream sent for the frame is acknowledged the frame yields a sample.
     void onAck(uint32_t frame_id, int64_t bytes_acked, int64_t now_ns);
 
-    double throughputBps() const { return m_ema_bps; }  // 0 before the first sample
+    // 0 before the first sample.
+    double throughputBps() const { return m_samples > 0 ? m_ema_bits / m_ema_busy_s : 0.0; }
     uint32_t samples() const { return m_samples; }
     std::optional<double> lastSampleBps() const { return m_last_sample_bps; }
 
@@ -52,9 +53,8 @@ private:
     size_t m_max_frames;
     int64_t m_idle_ns;
     std::deque<Pending> m_pending;
-    double m_ema_bps = 0.0;     // m_ema_bits / m_ema_busy_s
     double m_ema_bits = 0.0;    // a frame's bits acknowledged
-    double m_ema_busy_s = 0.0;  // a frame's busy time
+    double m_ema_busy_s = 0.0;  // a frame's busy time (> 0 once there is a sample)
     uint32_t m_samples = 0;
     std::optional<double> m_last_sample_bps;
     std::optional<int64_t> m_last_ack_ns;     // the newest ack: the link was busy until then
