@@ -374,15 +374,18 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // timing, isStartUpFrame) held at the initial e1 left L at its prior, a mobile GPU's rate,
     // and on a slow headset that prior sent e1 to 25-30° for ten frames (rate:1, docs/LIWC.md).
     // A late periphery is timed too: the link is slower than the wait.
-    const bool timed = m.t_local_ms > 0.0 && (m.t_remote_ms > 0.0 || m.periphery_late ||
-                                              m.middle_bytes + m.outer_bytes <= 0.0);
+    // A withheld one is not: the remote chain has said nothing of it.
+    const bool timed =
+        m.t_local_ms > 0.0 && !m.periphery_withheld &&
+        (m.t_remote_ms > 0.0 || m.periphery_late || m.middle_bytes + m.outer_bytes <= 0.0);
     m_seen_held_frame = m_seen_held_frame || (kind == FrameKind::kHeld && timed);
     std::optional<PendingDecision> decided;
     if (!m_pending.empty()) {
         const PendingDecision p = m_pending.front();
         decided = p;
         m_pending.pop_front();
-        if (m_observed >= m_config.table_warmup_frames && !moved_apart) {
+        // A withheld periphery has no T_remote to learn from.
+        if (m_observed >= m_config.table_warmup_frames && !moved_apart && !m.periphery_withheld) {
             const double measured =
                 m_config.frame_period_objective ? m.t_remote_ms : m.t_remote_ms - m.t_local_ms;
             const double delta = measured - p.model_imbalance_ms;
@@ -408,7 +411,9 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         m_stale_link_backoff = std::min(kMaxStaleLinkBackoff, 2.0 * m_stale_link_backoff);
     else if (link_seen && !m.periphery_late)
         m_stale_link_backoff = 1.0;
-    m_frames_without_link = link_seen ? 0 : m_frames_without_link + 1;
+    // A withheld one did not try the link: the requests before it were still on it.
+    if (!m.periphery_withheld)
+        m_frames_without_link = link_seen ? 0 : m_frames_without_link + 1;
     const double b = m_config.rate_ema;
     if (m.t_local_ms > 0.0) {
         if (m_config.frame_period_objective)
@@ -442,31 +447,57 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         const double rest = std::max(0.0, m.t_remote_ms - transmission_ms);
         m_remote_base_ms = (1.0 - b) * m_remote_base_ms + b * rest;
     }
-    // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
-    const bool have_mid = !moved_apart && m.middle_pixels > 0 && m.middle_bytes > 0;
-    const bool have_out = !moved_apart && m.outer_pixels > 0 && m.outer_bytes > 0;
-    const double w = replacesPrior() ? 1.0 : b;  // a first measurement replaces the prior
-    if (have_mid && have_out && m.s2 > 1.05 * m.s1) {
-        const double lm = std::log(m.middle_bytes * 8.0 / m.middle_pixels);
-        const double lo = std::log(m.outer_bytes * 8.0 / m.outer_pixels);
-        const double gamma = std::clamp((lo - lm) / (std::log(m.s2) - std::log(m.s1)), 0.0, 2.0);
-        const double log_b1 = lm - gamma * std::log(m.s1);
-        m_bits_exponent = (1.0 - w) * m_bits_exponent + w * gamma;
-        m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
-    } else if (have_mid || have_out) {
-        const double bits = have_mid ? m.middle_bytes * 8.0 / m.middle_pixels
-                                     : m.outer_bytes * 8.0 / m.outer_pixels;
-        const double s = have_mid ? m.s1 : m.s2;
-        const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
-        m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
+    // What a late frame carried by its wait limit is part of its periphery: its sizes teach the
+    // bits law once the rest has come (observeLateArrival).
+    if (m.periphery_late && kind == FrameKind::kHeld) {
+        m_late.push_back({m.index, m.middle_pixels, m.outer_pixels, m.s1, m.s2});
+        while (m_late.size() > kMaxLateFrames)
+            m_late.pop_front();
+    } else if (!m.periphery_late && !m.periphery_withheld && !moved_apart) {
+        learnBits(m.middle_bytes * 8.0, m.middle_pixels, m.s1, m.outer_bytes * 8.0, m.outer_pixels,
+                  m.s2);
     }
-    m_bits_law_measured = m_bits_law_measured || have_mid || have_out;
     if (m.arrival_ms > 0.0)
         m_last_arrival_ms = m.arrival_ms;
     // The next candidates step from the newest decision; the measured e1 replaces it only when
     // no later decision is already out (a pipelined headset has one in flight).
     if (m_pending.empty())
         m_e1_deg = m.e1_deg;
+}
+
+void LiwcPolicy::observeLateArrival(const LateArrival& a) {
+    auto it = std::find_if(m_late.begin(), m_late.end(),
+                           [&](const LateFrame& f) { return f.index == a.index; });
+    if (it == m_late.end())
+        return;
+    const LateFrame f = *it;
+    m_late.erase(it);
+    // A new canvas's key frame is a move's cost, not what a frame that holds sends.
+    if (a.new_canvas_streams == 0)
+        learnBits(a.middle_bytes * 8.0, f.middle_pixels, f.s1, a.outer_bytes * 8.0, f.outer_pixels,
+                  f.s2);
+}
+
+void LiwcPolicy::learnBits(double middle_bits, double middle_pixels, double s1, double outer_bits,
+                           double outer_pixels, double s2) {
+    // Bits per pixel as b·s^γ, fitted to the two layers' measured sizes in log space.
+    const bool have_mid = middle_pixels > 0 && middle_bits > 0;
+    const bool have_out = outer_pixels > 0 && outer_bits > 0;
+    const double w = replacesPrior() ? 1.0 : m_config.rate_ema;  // a first one replaces the prior
+    if (have_mid && have_out && s2 > 1.05 * s1) {
+        const double lm = std::log(middle_bits / middle_pixels);
+        const double lo = std::log(outer_bits / outer_pixels);
+        const double gamma = std::clamp((lo - lm) / (std::log(s2) - std::log(s1)), 0.0, 2.0);
+        const double log_b1 = lm - gamma * std::log(s1);
+        m_bits_exponent = (1.0 - w) * m_bits_exponent + w * gamma;
+        m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
+    } else if (have_mid || have_out) {
+        const double bits = have_mid ? middle_bits / middle_pixels : outer_bits / outer_pixels;
+        const double s = have_mid ? s1 : s2;
+        const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
+        m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
+    }
+    m_bits_law_measured = m_bits_law_measured || have_mid || have_out;
 }
 
 double LiwcPolicy::serverMsOf(const FrameMeasurement& m, double sent_ms) const {
@@ -510,7 +541,8 @@ LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, doubl
         ++m_frames_since_move;
     }
     const double sent_bits = (m.middle_bytes + m.outer_bytes) * 8.0;
-    if (sent_bits > 0.0 && predicted_bits > 0.0)
+    // A late frame's sizes are what had come by the wait limit, not what it sent.
+    if (sent_bits > 0.0 && predicted_bits > 0.0 && !m.periphery_late)
         m_move_bits.add(moved || new_canvas, m.e1_deg, sent_bits / predicted_bits);
     return moved ? FrameKind::kMoved : new_canvas ? FrameKind::kLateCanvas : FrameKind::kHeld;
 }

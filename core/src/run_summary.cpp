@@ -44,7 +44,8 @@ void FrameSummarizer::add(const FrameSample& f) {
     if (!m_startup_done) {
         // The first m_warmup frames, and then every frame that still shows none of the
         // server's layers (RunStats::warmup_frames).
-        const bool no_remote_yet = m_warmup > 0 && f.remote_requested && !f.remote_shown;
+        const bool no_remote_yet =
+            m_warmup > 0 && (f.remote_requested || f.remote_withheld) && !f.remote_shown;
         if (m_startup.size() < m_warmup ||
             (no_remote_yet && m_startup.size() < kMaxStartupFrames)) {
             m_startup.push_back(f);

@@ -15,6 +15,7 @@
 #include "qvr/controller/aimd.h"
 #include "qvr/controller/liwc.h"
 #include "qvr/controller/policy.h"
+#include "qvr/core/request_window.h"
 #include "qvr/core/silence.h"
 #include "qvr/render/camera.h"
 #include "qvr/runtime/affinity.h"
@@ -73,6 +74,7 @@ struct PendingFrame {
     int64_t last_rx_ns = 0;  // the newest packet of any of its streams
     std::array<double, net::kMaxStreams> bytes{};
     int new_canvas_streams = 0;  // decoded streams whose encoder opened a new canvas
+    bool observed_late = false;  // the policy learnt the frame before its periphery came
     bool complete() const { return expected != 0 && (decoded & expected) == expected; }
     bool broken() const { return (failed & expected) != 0; }
 };
@@ -338,6 +340,23 @@ private:
         return n;
     }
 
+    // The requests still outstanding (qvr/core/request_window.h).
+    size_t outstandingRequests() {
+        const int64_t now_ns = m_clock.nowNs();
+        const uint64_t packets = m_client->stats().assembler.packets_accepted;
+        if (packets != m_packets_seen) {
+            m_packets_seen = packets;
+            m_last_packet_ns = now_ns;
+        }
+        const double last_packet_ms = m_last_packet_ns > 0 ? double(m_last_packet_ns) * 1e-6 : -1.0;
+        size_t n = 0;
+        for (const PendingFrame& p : m_pending)
+            n += !p.complete() && !p.broken() && p.frame > m_newest_complete_frame &&
+                 RequestWindow::holds(double(p.request_ns) * 1e-6, double(now_ns) * 1e-6,
+                                      last_packet_ms, m_config.remote_timeout_ms);
+        return n;
+    }
+
     PendingFrame* pendingFor(int64_t frame) {
         for (PendingFrame& p : m_pending)
             if (p.frame == frame)
@@ -404,8 +423,12 @@ private:
         FrameTelemetry& t = tel(p->telemetry);
         t.stream_decoded_ns[cs.stream_id] = rel(m_clock.nowNs());
         if (p->complete()) {
+            if (p->observed_late)
+                m_policy->observeLateArrival({p->frame, p->bytes[0] + p->bytes[2],
+                                              p->bytes[1] + p->bytes[3], p->new_canvas_streams});
             t.remote_done_ns = rel(m_clock.nowNs());
             m_last_complete_rx_ns = std::max(m_last_complete_rx_ns, p->last_rx_ns);
+            m_newest_complete_frame = std::max(m_newest_complete_frame, p->frame);
             for (PendingFrame& later : m_pending)
                 if (later.frame > p->frame)
                     later.service_start_ns = std::max(later.service_start_ns, p->last_rx_ns);
@@ -458,6 +481,7 @@ private:
         std::optional<WorkloadFrame> wf;
         bool decided = false;
         uint8_t expected = 0;
+        bool withheld = false;  // its periphery was not asked for: the request window was full
         std::shared_ptr<LayerFrame> layers;
     };
 
@@ -578,8 +602,16 @@ private:
         layers->plan = plan;
         layers->render_pose = head;
 
-        // 3. Request the periphery first, so the server works while the fovea renders.
-        const uint8_t expected = connected ? expectedStreams(plan) : 0;
+        // 3. Request the periphery first, so the server works while the fovea renders; not while
+        // the window of outstanding requests is full (qvr/core/request_window.h).
+        uint8_t expected = connected ? expectedStreams(plan) : 0;
+        const bool withheld =
+            expected != 0 && outstandingRequests() >= RequestWindow::window(m_depth);
+        if (withheld) {
+            expected = 0;
+            ++m_stats.requests_withheld;
+            t->request_withheld = true;
+        }
         if (expected != 0) {
             const net::FrameRequest req = net::makeFrameRequest(
                 static_cast<uint32_t>(i), static_cast<uint64_t>(pose_ns), head, plan);
@@ -609,6 +641,7 @@ private:
         prep.wf = std::move(wf);
         prep.decided = decided;
         prep.expected = expected;
+        prep.withheld = withheld;
         prep.layers = std::move(layers);
         return prep;
     }
@@ -616,7 +649,8 @@ private:
     // Steps 4–7: fovea, remote layers, UCA, scan-out, what the policy learns.
     void finish(Prepared& prep) {
         const int64_t local_end_ns = renderFovea(prep);
-        const bool have_current = prep.expected == 0 || waitForRemote(prep, local_end_ns);
+        const bool have_current =
+            !prep.withheld && (prep.expected == 0 || waitForRemote(prep, local_end_ns));
         composeAndScanOut(prep, have_current);
         if (prep.decided)
             learn(prep, have_current);
@@ -792,8 +826,8 @@ private:
         // fovea render (LIWC's GPU fit takes the fixed part as its intercept).
         m.t_local_ms = m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
         m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
-        if (isStartUpFrame(i, static_cast<int64_t>(m_depth), t->remote_requested,
-                           m_first_composed_frame)) {
+        if (isStartUpFrame(i, static_cast<int64_t>(m_depth),
+                           t->remote_requested || t->request_withheld, m_first_composed_frame)) {
             m.t_local_ms = 0.0;
             m.t_remote_ms = 0.0;
         }
@@ -815,11 +849,14 @@ private:
         m.throughput_bps = t->throughput_bps;
         m.periphery_late =
             t->remote_requested && !have_current && i >= static_cast<int64_t>(m_depth);
+        m.periphery_withheld = prep.withheld;
         if (p && have_current && p->last_rx_ns > 0) {
             m.request_ms = double(p->request_ns - m_origin_ns) * 1e-6;
             m.arrival_ms = double(p->last_rx_ns - m_origin_ns) * 1e-6;
         }
         m_policy->observe(m);
+        if (p && m.periphery_late)
+            p->observed_late = true;
         if (p && have_current)
             m_probe.observeBits(m.middle_bytes, m.middle_pixels, plan.s1, m.outer_bytes,
                                 m.outer_pixels, plan.s2);
@@ -857,6 +894,9 @@ private:
     int64_t m_last_shown = -1;
     int64_t m_first_composed_frame = -1;  // the first frame UCA composed from layers
     int64_t m_last_complete_rx_ns = 0;
+    int64_t m_newest_complete_frame = -1;  // the newest frame whose periphery all came
+    uint64_t m_packets_seen = 0;           // media packets accepted, at the last look
+    int64_t m_last_packet_ns = 0;          // when that count last grew (0: never)
     SilenceDetector m_silence;  // the newest streams from the server, or the session's start
     int64_t m_idle_ns = 0;      // waiting for the network or vsync since the last frame finished
     int64_t m_last_finish_ns = 0;

@@ -18,6 +18,7 @@ nlohmann::json designSummaryJson(const DesignSummary& s) {
 nlohmann::json headsetCountersJson(const HeadsetStats& st) {
     return {{"streams_lost", st.streams_lost},
             {"late_frames", st.late_frames},
+            {"requests_withheld", st.requests_withheld},
             {"nacks_sent", st.net.assembler.nacks},
             {"packets_recovered", st.net.assembler.packets_recovered},
             {"fec_recoveries", st.net.assembler.fec_recoveries},

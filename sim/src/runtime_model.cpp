@@ -19,6 +19,7 @@
 #include "qvr/controller/policy.h"
 #include "qvr/core/canvas_policy.h"
 #include "qvr/core/link_spec.h"
+#include "qvr/core/request_window.h"
 #include "qvr/core/silence.h"
 #include "qvr/core/throughput_estimator.h"
 #include "qvr/foveation/layer_plan.h"
@@ -37,7 +38,8 @@ double recordedFragments(const WorkloadFrame& wf, double pixels, bool whole_fram
 
 struct Stream {
     int64_t frame = 0;
-    double rx_ms = 0.0;  // last packet arrived
+    double send_ms = 0.0;  // first packet on the link
+    double rx_ms = 0.0;    // last packet arrived
     double payload_bytes = 0.0;
     double pixels = 0.0;  // pixels the decoder works on (the canvas)
     bool decoded = false;
@@ -58,6 +60,8 @@ struct FrameState {
     int key_frames = 0;                                     // its streams coded as IDRs
     int new_canvases = 0;  // of which a new encoder opened (FrameMeasurement::new_canvas_streams)
     bool closed = false;   // its pending entry is gone: LIWC does not see later streams
+    bool observed_late = false;  // LIWC learnt it before its periphery came (LateArrival)
+    bool withheld = false;       // not asked for: the request window was full
 };
 
 // A layer the server renders and sends: its pixels, the triangles in its view, its bytes.
@@ -147,6 +151,7 @@ FrameSample runtimeFrameSample(const RuntimeFrame& f, double first_layers_ms) {
     x.t_remote_ms = f.t_remote_ms;
     x.headset_busy_ms = f.headset_busy_ms;
     x.remote_requested = f.requested;
+    x.remote_withheld = f.withheld;
     // The runtime's shown_frame ≥ 0: the server's first layers were on screen by its UCA.
     x.remote_shown = f.uca_start_ms >= first_layers_ms;
     x.reused = f.reused;
@@ -277,6 +282,8 @@ private:
     void advanceServer(double until);
     void decodeNext();
     void pump();
+    size_t outstandingRequests(int64_t i) const;
+    double lastPacketMs() const;
     void decideLayers(FrameState& fs, RuntimeFrame& rf, const WorkloadFrame& wf);
     void prepare(int64_t i);
     void renderFovea(int64_t i);
@@ -316,6 +323,7 @@ private:
     double m_busy = 0.0;  // busy time since the previous frame finished
     double m_last_e1_deg = 5.0;
     double m_last_complete_rx_ms = 0.0;
+    int64_t m_newest_complete = -1;  // the newest frame whose periphery all came
     // The streams the headset took from the transport (the session's start, 0 ms, before any):
     // a server silent for a whole wait limit (or twice its spacing, if longer) makes the runtime
     // wait one refresh instead.
@@ -466,6 +474,7 @@ double PassReplay::sendLayer(int64_t j, FrameState& fs, LayerJob& job, double t)
     m_link_free = send + tr.duration_ms;
     Stream s;
     s.frame = j;
+    s.send_ms = send;
     s.rx_ms = m_link_free + m_costs.link_delay_ms;
     s.payload_bytes = job.bytes;
     s.pixels = coded_px;
@@ -523,8 +532,12 @@ void PassReplay::decodeNext() {
     if (!fs.closed)
         fs.received_bytes += s.payload_bytes;
     if (++fs.decoded == fs.expected) {
+        if (fs.observed_late && !fs.closed)
+            m_policy->observeLateArrival(
+                {s.frame, fs.middle_bytes, fs.outer_bytes, fs.new_canvases});
         rf.remote_done_ms = m_hs;
         m_last_complete_rx_ms = std::max(m_last_complete_rx_ms, fs.last_rx_ms);
+        m_newest_complete = std::max(m_newest_complete, s.frame);
         // Frames requested after it waited for it; not the frame itself, nor any before it (a
         // frame whose streams were decoded before its own wait kept its remote time).
         // (A frame not yet prepared has no request; the runtime holds at most 64 pending.)
@@ -585,7 +598,11 @@ void PassReplay::prepare(int64_t i) {
     }
     decideLayers(fs, rf, wf);
     rf.decision_ms = m_hs - decision_start;
-    if (fs.expected > 0) {
+    fs.withheld = fs.expected > 0 && outstandingRequests(i) >= RequestWindow::window(m_depth);
+    rf.withheld = fs.withheld;
+    if (fs.withheld)
+        ++m_result.summary.requests_withheld;
+    if (fs.expected > 0 && !fs.withheld) {
         rf.requested = true;
         rf.request_ms = m_hs;
         fs.service_start_ms = std::max(m_hs, m_last_complete_rx_ms);
@@ -596,6 +613,27 @@ void PassReplay::prepare(int64_t i) {
             ++m_result.summary.requests_dropped;
         }
     }
+}
+
+// When the newest media packet came: now while a stream is on the link, else the last stream's
+// arrival (−1: none yet).
+double PassReplay::lastPacketMs() const {
+    if (m_next_undecoded < m_streams.size() && m_streams[m_next_undecoded].send_ms <= m_hs)
+        return m_hs;
+    return m_next_undecoded > 0 ? m_streams[m_next_undecoded - 1].rx_ms : -1.0;
+}
+
+// The requests still outstanding (qvr/core/request_window.h), among the frames the runtime would
+// still hold pending.
+size_t PassReplay::outstandingRequests(int64_t i) const {
+    size_t n = 0;
+    for (int64_t k = i - 1; k > m_newest_complete && k >= i - 64; --k) {
+        const FrameState& fs = m_state[static_cast<size_t>(k)];
+        const RuntimeFrame& rf = m_result.frames[static_cast<size_t>(k)];
+        n += rf.requested && fs.decoded < fs.expected &&
+             RequestWindow::holds(rf.request_ms, m_hs, lastPacketMs(), m_config.wait_limit_ms);
+    }
+    return n;
 }
 
 // 4. The fovea (the whole frame for local), one pass per eye.
@@ -698,7 +736,8 @@ void PassReplay::learn(int64_t i) {
     m.e1_deg = fs.plan.e1_deg;
     m.t_local_ms = m_depth > 1 && rf.headset_busy_ms > 0.0 ? rf.headset_busy_ms : rf.t_local_ms;
     m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
-    if (isStartUpFrame(i, static_cast<int64_t>(m_depth), rf.requested, m_first_composed)) {
+    if (isStartUpFrame(i, static_cast<int64_t>(m_depth), rf.requested || rf.withheld,
+                       m_first_composed)) {
         m.t_local_ms = 0.0;
         m.t_remote_ms = 0.0;
     }
@@ -714,19 +753,22 @@ void PassReplay::learn(int64_t i) {
     m.new_canvas_streams = fs.received_bytes > 0 ? fs.new_canvases : 0;
     m.periphery_late = rf.requested && fs.expected > 0 && fs.decoded < fs.expected &&
                        i >= static_cast<int64_t>(m_depth);
+    m.periphery_withheld = fs.withheld;
     if (rf.requested && fs.expected > 0 && fs.decoded == fs.expected) {
         m.request_ms = rf.request_ms;
         m.arrival_ms = fs.last_rx_ms;
     }
     m_policy->observe(m);
+    m_state[static_cast<size_t>(i)].observed_late = m.periphery_late;
 }
 
 // Steps 4–8.
 void PassReplay::finish(int64_t i) {
     renderFovea(i);
-    const bool have_current = m_state[static_cast<size_t>(i)].expected == 0 || waitForStreams(i);
+    const FrameState& fs = m_state[static_cast<size_t>(i)];
+    const bool have_current = !fs.withheld && (fs.expected == 0 || waitForStreams(i));
     composeAndScanOut(i, have_current);
-    if (m_first_composed < 0 && m_state[static_cast<size_t>(i)].expected > 0 && have_current)
+    if (m_first_composed < 0 && fs.expected > 0 && have_current)
         m_first_composed = i;
     if (m_policy && !m_local_only && !m_whole_frame)
         learn(i);
@@ -761,8 +803,10 @@ RuntimeRunResult PassReplay::run() {
 RuntimeRunResult summarizePass(RuntimeRunResult result, const RuntimeSimConfig& config,
                                int served_frames, double server_busy_total) {
     const int requests_dropped = result.summary.requests_dropped;
+    const int requests_withheld = result.summary.requests_withheld;
     result.summary = summarizeRuntimeFrames(result.frames, config);
     result.summary.requests_dropped = requests_dropped;
+    result.summary.requests_withheld = requests_withheld;
     if (served_frames > 0)
         result.summary.server_busy_ms_mean = server_busy_total / served_frames;
     return result;

@@ -118,6 +118,7 @@ Status writeRuntimeSimOutputs(const std::filesystem::path& out, const RuntimeRun
               {"net", setting.net},
               {"pipeline_depth", setting.pipeline_depth},
               {"requests_dropped", s.requests_dropped},
+              {"requests_withheld", s.requests_withheld},
               {"t_local_ms_mean", s.t_local_ms_mean},
               {"t_remote_ms_mean", s.t_remote_ms_mean},
               {"headset_busy_ms_mean", s.headset_busy_ms_mean},

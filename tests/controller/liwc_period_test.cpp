@@ -269,6 +269,86 @@ TEST(LiwcPeriodObjective, LatePeripheriesEndTheColdStart) {
     }
 }
 
+// On a link slower than the wait limit every periphery is late: what had come by the wait is a
+// part of it, and the rest comes frames later. The bits law learns from the whole periphery when
+// it arrives (observeLateArrival), not from the part, and not from a moved frame's (its new
+// canvases' key frames). Before, the part was read as the frame's size or, when nothing had
+// come, the 1 bit a pixel prior stayed (20x what x264 sends): on the Verizon EVDO trace the
+// link's time looked 20x longer than it was and e1 fled to the all-local cover.
+TEST(LiwcPeriodObjective, ALatePeripheryTeachesTheBitsLawWhenItArrives) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.throughput_bps = 1e6;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    constexpr int kDepth = 2;
+    LiwcPolicy liwc(h, periodConfig());
+    const double prior = liwc.bitsPerPixelAt(1.0);
+    std::vector<LateArrival> coming;
+    runWithLink(liwc, truth, planner, f, 12, kDepth, 5, [&](FrameMeasurement& m, int i) {
+        if (i < kDepth) {  // the start-up: untimed, nothing arrived
+            m.t_local_ms = m.t_remote_ms = 0.0;
+            m.middle_bytes = m.outer_bytes = 0.0;
+            return;
+        }
+        coming.push_back({m.index, m.middle_bytes, m.outer_bytes, 0});
+        m.periphery_late = true;
+        m.middle_bytes *= 0.1;  // what had come by the wait limit
+        m.outer_bytes = 0.0;
+    });
+    ASSERT_FALSE(coming.empty());
+    EXPECT_DOUBLE_EQ(liwc.bitsPerPixelAt(1.0), prior) << "a part taught the law";
+    // A frame's new canvas (a key frame, 8x) teaches nothing either.
+    LateArrival key = coming.front();
+    key.middle_bytes *= 8.0;
+    key.outer_bytes *= 8.0;
+    key.new_canvas_streams = 4;
+    liwc.observeLateArrival(key);
+    EXPECT_DOUBLE_EQ(liwc.bitsPerPixelAt(1.0), prior);
+    for (const LateArrival& a : coming)
+        liwc.observeLateArrival(a);
+    EXPECT_NEAR(liwc.bitsPerPixelAt(1.0), Truth::bitsPerPixel(1.0), 0.01);
+    EXPECT_NEAR(liwc.bitsPerPixelAt(8.0), Truth::bitsPerPixel(8.0),
+                0.05 * Truth::bitsPerPixel(8.0));
+}
+
+// A frame the headset did not ask the server for (its window of outstanding requests was full,
+// the link behind) says nothing of T_remote: it does not end the cold start, teach the table, or
+// count as a frame that left the link idle (which relaxes the link's estimate toward the prior).
+TEST(LiwcPeriodObjective, AWithheldPeripheryTeachesNothingOfTheRemoteSide) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth;
+    truth.throughput_bps = 2e6;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    constexpr int kDepth = 2;
+    auto withheldFrom = [&](int first) {
+        return [first](FrameMeasurement& m, int i) {
+            if (i < kDepth) {
+                m.t_local_ms = m.t_remote_ms = 0.0;
+            } else if (i >= first) {
+                m.periphery_withheld = true;
+                m.t_remote_ms = 0.0;
+                m.middle_bytes = m.outer_bytes = 0.0;
+                m.throughput_bps = 0.0;
+            }
+        };
+    };
+    // Withheld from the start: the cold start holds the initial e1.
+    LiwcPolicy cold(h, periodConfig());
+    for (const Decision& d : runWithLink(cold, truth, planner, f, 40, kDepth, 3, withheldFrom(0)))
+        EXPECT_DOUBLE_EQ(d.e1_deg, 5.0);
+    // Withheld after a while: the table is not taught a T_remote of 0, nor does the link relax
+    // toward the 200 Mbit/s prior (which would walk e1 down to the smallest fovea).
+    LiwcPolicy warm(h, periodConfig());
+    const std::vector<Decision> d =
+        runWithLink(warm, truth, planner, f, 160, kDepth, 3, withheldFrom(40));
+    const float offset =
+        warm.table().offsetMs(warm.lastMotion(), LiwcTable::bucketOf(d.back().e1_deg));
+    EXPECT_GT(offset, -2.0f) << "the table learnt a T_remote of 0";
+    EXPECT_NEAR(d.back().e1_deg, d[40].e1_deg, 3.0);
+}
+
 // T_remote that does not fall with e1 (the server's fixed cost dominates): a larger fovea only
 // lengthens the headset's busy time, so every e1 with T_local below T_remote gives the same
 // period and the lower motion-to-photon latency wins — LIWC walks down to e1_min.

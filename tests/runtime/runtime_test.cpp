@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "qvr/core/request_window.h"
 #include "qvr/net/auth.h"
 #include "qvr/net/protocol.h"
 #include "qvr/render/gl_renderer.h"
@@ -442,6 +443,38 @@ TEST(Runtime, ALateFramesStreamsCountAsItsBytesAfterItWasShown) {
         bytes += t.bytes;
     }
     EXPECT_GE(late_with_bytes, 5) << bytes << " bytes counted in all";
+}
+
+TEST(Runtime, ALinkSlowerThanTheFramesQueuesNoMoreThanTheRequestWindow) {
+    // A 10 Mbit/s link carries a frame's raw periphery (~400 KB) in ~300 ms while the headset asks
+    // at its own pace, every ~11-30 ms. Asked for every frame, the peripheries queued in the link's
+    // buffer and each came later than the one before, seconds behind by the end. The headset
+    // keeps at most RequestWindow::window(depth) requests outstanding and shows the frames it
+    // did not ask for with the newest periphery at once: a periphery's delay stays within the
+    // window's transfers.
+    RenderServerConfig sc = serverConfig("rate:10", "raw");
+    auto server = RenderServer::start(sc, world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    HeadsetConfig h = headsetConfig(Design::Ffr, (*server)->port(), "raw", 150);
+    const HeadsetResult r = runOn(h);
+    ASSERT_EQ(r.frames.size(), 150u);
+    EXPECT_GT(r.stats.requests_withheld, 0u);
+    std::vector<double> delays_ms;
+    double bytes = 0.0;
+    for (const FrameTelemetry& t : r.frames) {
+        if (t.remote_requested && t.remote_done_ns > 0) {
+            delays_ms.push_back(double(t.remote_done_ns - t.request_ns) * 1e-6);
+            bytes += double(t.bytes);
+        }
+    }
+    ASSERT_GE(delays_ms.size(), 5u)
+        << r.stats.streams_received << " streams, " << r.stats.requests_withheld << " withheld, "
+        << r.stats.streams_lost << " lost";
+    const double transfer_ms = bytes / double(delays_ms.size()) * 8.0 / 10e6 * 1000.0;
+    const double window = double(RequestWindow::window(2));
+    const double worst = *std::max_element(delays_ms.begin() + 2, delays_ms.end());
+    EXPECT_LT(worst, (window + 1.0) * transfer_ms + 100.0)
+        << "a transfer " << transfer_ms << " ms, " << delays_ms.size() << " arrived";
 }
 
 TEST(Runtime, KillingTheServerLeavesTheHeadsetDisplayingAndItReconnects) {

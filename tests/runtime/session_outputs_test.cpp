@@ -29,6 +29,7 @@ HeadsetResult someResult() {
     r.summary.frames_fallback_local = 1;
     r.stats.connects = 1;
     r.stats.late_frames = 3;
+    r.stats.requests_withheld = 7;
     r.stats.key_frame_requests = 4;
     r.stats.net.key_frame_requests_sent = 5;
     r.stats.net.control_forged = 2;
@@ -50,12 +51,13 @@ TEST(SessionOutputs, ClientSummaryHasTheSharedKeysAndItsOwn) {
     EXPECT_EQ(j["clock_origin_ns"], 123456789);
     EXPECT_EQ(j["interrupted"], true);
     EXPECT_EQ(j["late_frames"], 3);
+    EXPECT_EQ(j["requests_withheld"], 7);
     EXPECT_EQ(j["nacks_sent"], 6);
     EXPECT_EQ(j["control_forged"], 2);
     // The client reports its own key-frame requests; `qvr run` adds the transport's.
     EXPECT_EQ(j["key_frame_requests"], 4);
     EXPECT_EQ(j["capacity_refusals"], 0);  // refusals by a server at its frame-rate floor
-    EXPECT_EQ(j.size(), 37u);              // the keys `qvr client` writes
+    EXPECT_EQ(j.size(), 38u);              // the keys `qvr client` writes
 }
 
 TEST(SessionOutputs, ClientWritesTraceAndSummaryAndWarnsOfForgedControl) {

@@ -37,6 +37,7 @@ TEST(SimRun, WritesTheRuntimePipelinesFramesAndSummary) {
     run.summary.design = "qvr";
     run.summary.frames = 2;
     run.summary.requests_dropped = 1;
+    run.summary.requests_withheld = 5;
     const fs::path out =
         fs::temp_directory_path() / ("qvr-simrun-" + std::to_string(getpid())) / "deeper";
     ASSERT_TRUE(writeRuntimeSimOutputs(out, run, {"lte", 1, 250.0, 2}));
@@ -46,8 +47,9 @@ TEST(SimRun, WritesTheRuntimePipelinesFramesAndSummary) {
     EXPECT_EQ(j["net"], "lte");
     EXPECT_EQ(j["pipeline_depth"], 1);
     EXPECT_EQ(j["requests_dropped"], 1);
+    EXPECT_EQ(j["requests_withheld"], 5);
     EXPECT_EQ(j["frames"], 2);
-    EXPECT_EQ(j.size(), 17u);
+    EXPECT_EQ(j.size(), 18u);
     std::ifstream csv(out / "frames.csv");
     int lines = 0;
     for (std::string line; std::getline(csv, line);)

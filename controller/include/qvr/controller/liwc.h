@@ -82,6 +82,9 @@ public:
     std::string_view name() const override { return "liwc"; }
     Decision decide(const WorkloadFrame& frame) override;
     void observe(const FrameMeasurement& m) override;
+    // A late periphery's sizes teach the bits law as a frame on time does: on a link slower
+    // than the wait limit they are the only sizes there are (docs/LIWC.md, T̂_remote).
+    void observeLateArrival(const LateArrival& a) override;
 
     // The link's throughput as the acknowledgements show it now (the hardware monitors them at
     // decision time, §4.1); ignored by the reactive variant.
@@ -188,6 +191,16 @@ private:
     };
     MoveMeter m_move_bits;
     MoveMeter m_move_server;
+    // The bits law, b·s^γ per layer pixel, fitted in log space to a held frame's layers.
+    void learnBits(double middle_bits, double middle_pixels, double s1, double outer_bits,
+                   double outer_pixels, double s2);
+    // Held frames observed late, whose periphery may still arrive (observeLateArrival).
+    struct LateFrame {
+        int64_t index = 0;
+        double middle_pixels = 0.0, outer_pixels = 0.0, s1 = 1.0, s2 = 1.0;
+    };
+    static constexpr size_t kMaxLateFrames = 64;  // the runtime holds no more pending frames
+    std::deque<LateFrame> m_late;
     bool m_seen_held_frame = false;    // a frame whose e1 held has been observed
     bool m_bits_law_measured = false;  // the bits law has been measured
     // The period objective's bits law takes its first measurement outright (the prior is far off).

@@ -42,9 +42,20 @@ struct FrameMeasurement {
     double arrival_ms = 0.0;
     // The periphery was requested but had not all arrived by the wait limit (shown late).
     bool periphery_late = false;
+    // The periphery was not asked for: the headset's window of outstanding requests was full
+    // (the link behind, qvr/core/request_window.h). The frame says nothing of T_remote.
+    bool periphery_withheld = false;
     // Streams of the periphery whose encoder opened a new canvas for it (FrameHeader::
     // kFlagNewCanvas): a key frame an e1 move caused, at the move or, for a canvas that shrank
     // after the layer stayed small, frames later.
+    int new_canvas_streams = 0;
+};
+
+// The whole periphery of a frame that came after its wait limit (its frame was observed late).
+struct LateArrival {
+    int64_t index = 0;
+    double middle_bytes = 0.0;  // both eyes
+    double outer_bytes = 0.0;
     int new_canvas_streams = 0;
 };
 
@@ -75,6 +86,9 @@ public:
     virtual Decision decide(const WorkloadFrame& frame) = 0;
     // Called once frame `m.index` completes, in frame order.
     virtual void observe(const FrameMeasurement& m) = 0;
+    // Called when the periphery of a frame observed as late (FrameMeasurement::periphery_late)
+    // has all arrived after all: its streams' sizes, now whole.
+    virtual void observeLateArrival(const LateArrival&) {}
 };
 
 // The paper's FFR: e1 fixed (5° by default).

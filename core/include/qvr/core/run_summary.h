@@ -35,6 +35,7 @@ struct FrameSample {
     double headset_busy_ms = 0.0;  // counted where > 0 (the first frame of a session has none)
     double uca_ms = 0.0;
     bool remote_requested = false;
+    bool remote_withheld = false;  // it would have asked, but the request window was full
     // Some layers from the server have been on screen by this frame: a design that asks for
     // layers has finished its start-up only then.
     bool remote_shown = true;

@@ -108,6 +108,9 @@ struct HeadsetStats {
     // Frames that waited one refresh, not the wait limit, because the server had sent nothing
     // for a whole limit (stalled, killed, or its link dead): the display keeps its rate.
     uint64_t silent_server_frames = 0;
+    // Frames shown with an older periphery at once because the window of outstanding requests
+    // was full (the link behind: qvr/core/request_window.h); none asked the server.
+    uint64_t requests_withheld = 0;
     uint64_t connects = 0;
     uint64_t connect_failures = 0;
     uint64_t disconnects = 0;

@@ -92,7 +92,8 @@ struct RuntimeFrame {
     double decision_ms = 0.0;
     double mtp_ms = 0.0;
     bool requested = false;
-    bool served = false;  // the server rendered it (not pushed out of its queue)
+    bool served = false;    // the server rendered it (not pushed out of its queue)
+    bool withheld = false;  // not asked: the request window was full (request_window.h)
     bool reused = false;
     // The server's render and encode time for its layers (before any co-run slowdown), and how
     // many of its streams were coded as key frames: per frame, beside server_frames.csv.
@@ -105,6 +106,7 @@ struct RuntimeFrame {
 struct RuntimeSummary : RunStats {
     std::string design;  // its label: "qvr", "ffr", "fixed:10"
     int requests_dropped = 0;
+    int requests_withheld = 0;         // the headset's request window was full (request_window.h)
     double server_busy_ms_mean = 0.0;  // render + encode per served frame
 };
 
