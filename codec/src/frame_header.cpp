@@ -63,8 +63,20 @@ std::vector<uint8_t> packFrame(FrameHeader header, std::span<const uint8_t> payl
     putU16(out, header.height);
     putU32(out, header.payload_bytes);
     putU32(out, header.crc32);
+    putU32(out, header.server_us);
     out.insert(out.end(), payload.begin(), payload.end());
     return out;
+}
+
+void stampServerUs(std::vector<uint8_t>& frame, uint32_t server_us) {
+    if (frame.size() < FrameHeader::kSize)
+        return;
+    for (size_t k = 0; k < 4; ++k)
+        frame[24 + k] = static_cast<uint8_t>(server_us >> (8 * k));
+}
+
+uint32_t frameServerUs(std::span<const uint8_t> bytes) {
+    return bytes.size() >= FrameHeader::kSize ? getU32(bytes.data() + 24) : 0;
 }
 
 uint8_t frameFlags(std::span<const uint8_t> bytes) {
@@ -92,6 +104,7 @@ Expected<ParsedFrame> parseFrame(std::span<const uint8_t> bytes) {
     f.header.height = getU16(p + 14);
     f.header.payload_bytes = getU32(p + 16);
     f.header.crc32 = getU32(p + 20);
+    f.header.server_us = getU32(p + 24);
     if (f.header.width == 0 || f.header.height == 0)
         return makeError("encoded frame: zero width or height");
     const size_t available = bytes.size() - FrameHeader::kSize;

@@ -75,6 +75,7 @@ struct PendingFrame {
     std::array<double, net::kMaxStreams> bytes{};
     int new_canvas_streams = 0;  // decoded streams whose encoder opened a new canvas
     bool observed_late = false;  // the policy learnt the frame before its periphery came
+    double server_ms = 0.0;      // the server's time on it, as its streams' headers say
     bool complete() const { return expected != 0 && (decoded & expected) == expected; }
     bool broken() const { return (failed & expected) != 0; }
 };
@@ -376,6 +377,9 @@ private:
             p->last_rx_ns = std::max(p->last_rx_ns, cs.last_rx_ns);
             t.bytes += static_cast<int64_t>(cs.bytes.size());
             p->bytes[cs.stream_id] += static_cast<double>(cs.bytes.size());
+            // A peer's number: bounded (10 s) before a fit sees it.
+            p->server_ms =
+                std::max(p->server_ms, std::min(10'000.0, frameServerUs(cs.bytes) * 1e-3));
         } else if (FrameTelemetry* shown = heldTelemetry(cs.frame_id)) {
             // Already shown (late, reused): its bytes crossed the link all the same.
             shown->bytes += static_cast<int64_t>(cs.bytes.size());
@@ -427,6 +431,7 @@ private:
                 m_policy->observeLateArrival({p->frame, p->bytes[0] + p->bytes[2],
                                               p->bytes[1] + p->bytes[3], p->new_canvas_streams});
             t.remote_done_ns = rel(m_clock.nowNs());
+            t.server_ms = p->server_ms;
             m_last_complete_rx_ns = std::max(m_last_complete_rx_ns, p->last_rx_ns);
             m_newest_complete_frame = std::max(m_newest_complete_frame, p->frame);
             for (PendingFrame& later : m_pending)
@@ -850,6 +855,8 @@ private:
         m.periphery_late =
             t->remote_requested && !have_current && i >= static_cast<int64_t>(m_depth);
         m.periphery_withheld = prep.withheld;
+        if (p && have_current)
+            m.server_ms = p->server_ms;
         if (p && have_current && p->last_rx_ns > 0) {
             m.request_ms = double(p->request_ns - m_origin_ns) * 1e-6;
             m.arrival_ms = double(p->last_rx_ns - m_origin_ns) * 1e-6;

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "qvr/codec/frame_header.h"
 #include "qvr/render/gl_renderer.h"
 #include "qvr/render/periphery_pass.h"
 #include "qvr/runtime/affinity.h"
@@ -545,6 +546,9 @@ struct RenderServer::Impl final : net::ServerHandler {
         if (config.on_frame)  // stamped before the transport can deliver it
             stamps.layers.push_back({sid, w.render_start_ns, w.render_end_ns, encode_end_ns,
                                      clock->nowNs(), w.rec.pixels[sid], w.rec.fragments[sid]});
+        // The server's time on the frame so far: the headset's LIWC learns S from it.
+        stampServerUs(encoded->bytes, static_cast<uint32_t>(std::clamp<int64_t>(
+                                          (encode_end_ns - w.rec.start_ns) / 1000, 0, 0xFFFFFFFF)));
         const int64_t send_start_ns = clock->nowNs();
         if (server->sendStream(w.id, w.req->frame_id, sid, key, std::move(encoded->bytes)))
             ++w.delta.streams_sent;

@@ -60,7 +60,7 @@ std::string telemetryCsvHeader() {
          "shown_frame,connected,fallback_local,t_local_ms,t_remote_ms,uca_ms,mtp_ms,"
          "throughput_bps,fovea_triangles,warp_deg,headset_busy_ms,t_remote_decoded_ms,"
          "t_local_pred_ms,t_remote_pred_ms,probe_ms,decode_ms,fovea_fragments,"
-         "request_withheld\n";
+         "request_withheld,server_ms\n";
     return h;
 }
 
@@ -73,12 +73,13 @@ std::string telemetryCsvRow(const std::string& design, const FrameTelemetry& t) 
                          t.stream_decoded_ns[static_cast<size_t>(s)]);
     r += fmt::format(
         ",{},{},{},{},{},{},{},{},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.0f},{:.0f},{:.3f},{:.3f},"
-        "{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.0f},{}\n",
+        "{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.0f},{},{:.3f}\n",
         t.remote_done_ns, t.uca_start_ns, t.uca_end_ns, t.display_ns, t.bytes,
         int(t.remote_requested), int(t.reused), t.shown_frame, int(t.connected),
         int(t.fallback_local), t.t_local_ms, t.t_remote_ms, t.uca_ms, t.mtp_ms, t.throughput_bps,
         t.fovea_triangles, t.warp_deg, t.headset_busy_ms, t.t_remote_decoded_ms, t.t_local_pred_ms,
-        t.t_remote_pred_ms, t.probe_ms, t.decode_ms, t.fovea_fragments, int(t.request_withheld));
+        t.t_remote_pred_ms, t.probe_ms, t.decode_ms, t.fovea_fragments, int(t.request_withheld),
+        t.server_ms);
     return r;
 }
 

@@ -58,8 +58,9 @@ struct FrameState {
     bool served = false;
     double server_render_ms = 0.0, server_encode_ms = 0.0;  // the server's work on it
     int key_frames = 0;                                     // its streams coded as IDRs
-    int new_canvases = 0;  // of which a new encoder opened (FrameMeasurement::new_canvas_streams)
-    bool closed = false;   // its pending entry is gone: LIWC does not see later streams
+    int new_canvases = 0;    // of which a new encoder opened (FrameMeasurement::new_canvas_streams)
+    double server_ms = 0.0;  // from the start of its service to its last layer's encode
+    bool closed = false;     // its pending entry is gone: LIWC does not see later streams
     bool observed_late = false;  // LIWC learnt it before its periphery came (LateArrival)
     bool withheld = false;       // not asked for: the request window was full
 };
@@ -498,6 +499,7 @@ void PassReplay::serve(int64_t j, double start) {
     std::vector<LayerJob> jobs = layerJobs(j, fs, wf);
     for (LayerJob& job : jobs)
         t = sendLayer(j, fs, job, t);
+    fs.server_ms = t - start;
     m_server_free = t;
 }
 
@@ -755,6 +757,7 @@ void PassReplay::learn(int64_t i) {
                        i >= static_cast<int64_t>(m_depth);
     m.periphery_withheld = fs.withheld;
     if (rf.requested && fs.expected > 0 && fs.decoded == fs.expected) {
+        m.server_ms = fs.server_ms;
         m.request_ms = rf.request_ms;
         m.arrival_ms = fs.last_rx_ms;
     }

@@ -52,6 +52,27 @@ TEST(FrameHeader, RoundTripsEveryField) {
     EXPECT_EQ(std::string(parsed->payload.begin(), parsed->payload.end()), "some payload bytes");
 }
 
+// The server stamps its time on the frame into a packed frame after encoding (outside the CRC,
+// so the frame still parses); the headset reads it back without parsing. Too few bytes for a
+// header say 0 and are left alone.
+TEST(FrameHeader, TheServersTimeIsStampedAfterPackingAndReadBack) {
+    FrameHeader h = header(7, false);
+    h.server_us = 11;
+    auto bytes = packFrame(h, payloadOf("layer"));
+    EXPECT_EQ(frameServerUs(bytes), 11u);
+    stampServerUs(bytes, 0xFEDCBA98u);
+    EXPECT_EQ(frameServerUs(bytes), 0xFEDCBA98u);
+    auto parsed = parseFrame(bytes);
+    ASSERT_TRUE(parsed.ok()) << parsed.error();
+    EXPECT_EQ(parsed->header.server_us, 0xFEDCBA98u);
+    EXPECT_EQ(parsed->header.frame_id, 7u);
+    std::vector<uint8_t> short_frame(bytes.begin(), bytes.begin() + FrameHeader::kSize - 1);
+    const std::vector<uint8_t> before = short_frame;
+    stampServerUs(short_frame, 5);
+    EXPECT_EQ(short_frame, before);
+    EXPECT_EQ(frameServerUs(short_frame), 0u);
+}
+
 // The headset reads a decoded frame's flags (a new canvas) without parsing it again; too few
 // bytes for a header say none. A flag no version knows is refused.
 TEST(FrameHeader, FlagsAreReadFromTheHeaderAlone) {

@@ -79,6 +79,7 @@ TEST(DesignJson, MeasuredPredictedErrorsAndSpeed) {
                                                 "streams_lost",
                                                 "decode_failures",
                                                 "late_frames",
+                                                "requests_withheld",
                                                 "key_frame_requests",
                                                 "fec_recoveries",
                                                 "fec_packets_recovered",

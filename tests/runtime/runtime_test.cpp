@@ -445,6 +445,32 @@ TEST(Runtime, ALateFramesStreamsCountAsItsBytesAfterItWasShown) {
     EXPECT_GE(late_with_bytes, 5) << bytes << " bytes counted in all";
 }
 
+TEST(Runtime, TheServerSaysHowLongItTookAndTheHeadsetSeesIt) {
+    // Each layer takes the server at least 15 ms to render, four layers a frame: each frame's
+    // headers say at least 60 ms from when the server started on it, and no more than the
+    // frame's T_remote, which also holds the transmission (give or take the few ms between the
+    // request leaving and the headset stamping it). LIWC learns the server's part from this, not
+    // from T_remote less an estimate of the link's (docs/LIWC.md).
+    RenderServerConfig sc = serverConfig("none", "raw");
+    sc.renderer = []() -> Expected<std::unique_ptr<Renderer>> {
+        return std::unique_ptr<Renderer>(std::make_unique<SlowRenderer>(15ms));
+    };
+    auto server = RenderServer::start(sc, world().scene);
+    ASSERT_TRUE(server.ok()) << server.error();
+    HeadsetConfig h = headsetConfig(Design::Ffr, (*server)->port(), "raw", 30);
+    h.pipeline_depth = 1;
+    const HeadsetResult r = runOn(h);
+    int said = 0;
+    for (const FrameTelemetry& t : r.frames) {
+        if (t.remote_done_ns < 0 || t.reused)
+            continue;
+        ++said;
+        EXPECT_GE(t.server_ms, 4 * 15.0) << t.frame;
+        EXPECT_LE(t.server_ms, t.t_remote_ms + 5.0) << t.frame;
+    }
+    EXPECT_GE(said, 10);
+}
+
 TEST(Runtime, ALinkSlowerThanTheFramesQueuesNoMoreThanTheRequestWindow) {
     // A 10 Mbit/s link carries a frame's raw periphery (~400 KB) in ~300 ms while the headset asks
     // at its own pace, every ~11-30 ms. Asked for every frame, the peripheries queued in the link's

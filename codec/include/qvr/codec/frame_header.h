@@ -11,16 +11,18 @@
 
 namespace qvr {
 
-// Wire layout, little-endian, 24 bytes:
-//   0  u32 magic "QVRF"      4  u8 version (1)    5  u8 flags (bit 0 key frame, bit 1 raw,
+// Wire layout, little-endian, 28 bytes:
+//   0  u32 magic "QVRF"      4  u8 version (2)    5  u8 flags (bit 0 key frame, bit 1 raw,
 //                                                  bit 2 the encoder opened a new canvas)
 //   6  u16 refresh_frames (intra-refresh period, 0 = IDR-based recovery)
 //   8  u32 frame_id          12 u16 width        14 u16 height   (the layer's real size)
 //  16  u32 payload_bytes     20 u32 CRC-32 (IEEE) of the payload
+//  24  u32 server_us: the server's time on the frame when this layer left its encoder, from
+//      when it started on the frame (0: not said); stamped after encoding, outside the CRC
 struct FrameHeader {
     static constexpr uint32_t kMagic = 0x46525651u;  // "QVRF" read as little-endian u32
-    static constexpr uint8_t kVersion = 1;
-    static constexpr size_t kSize = 24;
+    static constexpr uint8_t kVersion = 2;
+    static constexpr size_t kSize = 28;
     static constexpr uint8_t kFlagKeyframe = 1;
     static constexpr uint8_t kFlagRaw = 2;
     // The encoder (re)opened for this frame: a stream's first frame, or a canvas that grew or
@@ -34,6 +36,7 @@ struct FrameHeader {
     uint16_t height = 0;
     uint32_t payload_bytes = 0;
     uint32_t crc32 = 0;
+    uint32_t server_us = 0;
 
     bool keyframe() const { return (flags & kFlagKeyframe) != 0; }
     bool newCanvas() const { return (flags & kFlagNewCanvas) != 0; }
@@ -53,6 +56,11 @@ Expected<ParsedFrame> parseFrame(std::span<const uint8_t> bytes);
 // The flags of a frame a decoder took (after parseFrame accepted it); 0 for bytes too short to
 // hold a header.
 uint8_t frameFlags(std::span<const uint8_t> bytes);
+// The server's time on the frame (FrameHeader::server_us) of a packed frame, in place, and read
+// back; 0 for bytes too short to hold a header. The headset's LIWC learns the server's part of
+// T_remote from it (docs/LIWC.md).
+void stampServerUs(std::vector<uint8_t>& frame, uint32_t server_us);
+uint32_t frameServerUs(std::span<const uint8_t> bytes);
 
 // Tracks the reference chain of one stream on the receiving side: a non-key frame is decodable
 // only if the frame before it was. Shared by every decoder so they agree on loss semantics.

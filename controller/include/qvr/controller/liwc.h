@@ -201,6 +201,7 @@ private:
     };
     static constexpr size_t kMaxLateFrames = 64;  // the runtime holds no more pending frames
     std::deque<LateFrame> m_late;
+    bool m_server_says = false;        // frames carry the server's own time (server_ms)
     bool m_seen_held_frame = false;    // a frame whose e1 held has been observed
     bool m_bits_law_measured = false;  // the bits law has been measured
     // The period objective's bits law takes its first measurement outright (the prior is far off).

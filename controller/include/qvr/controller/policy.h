@@ -45,6 +45,9 @@ struct FrameMeasurement {
     // The periphery was not asked for: the headset's window of outstanding requests was full
     // (the link behind, qvr/core/request_window.h). The frame says nothing of T_remote.
     bool periphery_withheld = false;
+    // What the server said it spent on the frame, from when it started on it to its last
+    // layer's encode (FrameHeader::server_us; 0: not said, or the periphery was not all in).
+    double server_ms = 0.0;
     // Streams of the periphery whose encoder opened a new canvas for it (FrameHeader::
     // kFlagNewCanvas): a key frame an e1 move caused, at the move or, for a canvas that shrank
     // after the layer stayed small, frames later.

@@ -33,8 +33,9 @@ struct FrameTelemetry {
     int64_t bytes = 0;        // media payload received for this frame's streams
     bool remote_requested = false;
     bool request_withheld = false;  // not asked: the request window was full (request_window.h)
-    bool reused = false;            // the display re-warped older layers (remote layers late/lost)
-    int64_t shown_frame = -1;       // the frame whose layers were displayed
+    double server_ms = 0.0;    // the server's time on it, as its streams' headers said (0: unsaid)
+    bool reused = false;       // the display re-warped older layers (remote layers late/lost)
+    int64_t shown_frame = -1;  // the frame whose layers were displayed
     bool connected = false;
     bool fallback_local = false;  // the server was gone: everything rendered locally
     double t_local_ms = 0.0;
