@@ -273,8 +273,8 @@ TEST(LiwcPeriodObjective, LatePeripheriesEndTheColdStart) {
 // part of it, and the rest comes frames later. The bits law learns from the whole periphery when
 // it arrives (observeLateArrival), not from the part, and not from a moved frame's (its new
 // canvases' key frames). Before, the part was read as the frame's size or, when nothing had
-// come, the 1 bit a pixel prior stayed (20x what x264 sends): on the Verizon EVDO trace the
-// link's time looked 20x longer than it was and e1 fled to the all-local cover.
+// come, the 1 bit a pixel prior stayed (~17x what x264 sends): on the Verizon EVDO trace the
+// link's time looked ~17x longer than it was and e1 fled to the all-local cover.
 TEST(LiwcPeriodObjective, ALatePeripheryTeachesTheBitsLawWhenItArrives) {
     const WorkloadHeader h = header();
     const LayerPlanner planner(h.profile);
