@@ -25,7 +25,8 @@ namespace qvr::net {
 // direction, a message counter as nonce), and the server checks that the client receives at its
 // media port (a sealed UDP probe echoed back) before it sends any media there.
 // 6: Bye(over capacity) — the server refuses a headset it cannot serve at its frame-rate floor.
-inline constexpr uint8_t kProtocolVersion = 6;
+// 7: a stream's frame header (codec FrameHeader version 2) says the server's time on the frame.
+inline constexpr uint8_t kProtocolVersion = 7;
 
 // Limits a decoder enforces before it trusts any length a peer sent.
 inline constexpr size_t kControlHeaderBytes = 8;
