@@ -831,8 +831,8 @@ private:
         // fovea render (LIWC's GPU fit takes the fixed part as its intercept).
         m.t_local_ms = m_depth > 1 && t->headset_busy_ms > 0.0 ? t->headset_busy_ms : t->t_local_ms;
         m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
-        if (isStartUpFrame(i, static_cast<int64_t>(m_depth),
-                           t->remote_requested || t->request_withheld, m_first_composed_frame)) {
+        if (isStartUpFrame(i, static_cast<int64_t>(m_depth), t->remote_requested || prep.withheld,
+                           m_first_composed_frame)) {
             m.t_local_ms = 0.0;
             m.t_remote_ms = 0.0;
         }

@@ -36,6 +36,9 @@ double recordedFragments(const WorkloadFrame& wf, double pixels, bool whole_fram
                                                             : -1.0;
 }
 
+// The frames the runtime's headset holds pending (runtime kMaxPendingFrames).
+constexpr int64_t kPendingFrames = 64;
+
 struct Stream {
     int64_t frame = 0;
     double send_ms = 0.0;  // first packet on the link
@@ -542,8 +545,8 @@ void PassReplay::decodeNext() {
         m_newest_complete = std::max(m_newest_complete, s.frame);
         // Frames requested after it waited for it; not the frame itself, nor any before it (a
         // frame whose streams were decoded before its own wait kept its remote time).
-        // (A frame not yet prepared has no request; the runtime holds at most 64 pending.)
-        const size_t end = std::min(m_state.size(), size_t(s.frame) + 65);
+        // (A frame not yet prepared has no request; the runtime holds at most kPendingFrames.)
+        const size_t end = std::min(m_state.size(), size_t(s.frame) + 1 + kPendingFrames);
         for (size_t k = size_t(s.frame) + 1; k < end; ++k)
             if (m_result.frames[k].requested)
                 m_state[k].service_start_ms = std::max(m_state[k].service_start_ms, fs.last_rx_ms);
@@ -628,12 +631,13 @@ double PassReplay::lastPacketMs() const {
 // The requests still outstanding (qvr/core/request_window.h), among the frames the runtime would
 // still hold pending.
 size_t PassReplay::outstandingRequests(int64_t i) const {
+    const double last_packet_ms = lastPacketMs();
     size_t n = 0;
-    for (int64_t k = i - 1; k > m_newest_complete && k >= i - 64; --k) {
+    for (int64_t k = i - 1; k > m_newest_complete && k >= i - kPendingFrames; --k) {
         const FrameState& fs = m_state[static_cast<size_t>(k)];
         const RuntimeFrame& rf = m_result.frames[static_cast<size_t>(k)];
         n += rf.requested && fs.decoded < fs.expected &&
-             RequestWindow::holds(rf.request_ms, m_hs, lastPacketMs(), m_config.wait_limit_ms);
+             RequestWindow::holds(rf.request_ms, m_hs, last_packet_ms, m_config.wait_limit_ms);
     }
     return n;
 }
