@@ -72,15 +72,24 @@ double LiwcPolicy::localMs(double e1_deg) const {
     const double e = e1_deg >= m_cover_deg ? 1e9 : e1_deg;
     const double tris = prefixAt(m_prefix_tris, m_header.ring_deg, e);
     const double pixels = prefixAt(m_prefix_pixels, m_header.ring_deg, e);
-    if (m_config.frame_period_objective)
-        return std::max(0.0, m_local_fit.predict({1.0, tris * 1e-5, pixels * 1e-5}));
+    if (m_config.frame_period_objective) {
+        const double render = std::max(0.0, m_local_fit.predict({1.0, tris * 1e-5, pixels * 1e-5}));
+        if (!m_render_apart || m_local_rest.empty())
+            return render;
+        return m_local_rest_sum / double(m_local_rest.size()) + render;
+    }
     return std::max(0.0,
                     m_gpu_theta[0] + m_gpu_theta[1] * tris * 1e-5 + m_gpu_theta[2] * pixels * 1e-5);
 }
 
 double LiwcPolicy::peripheryBits(const Gaze& gaze, double e1_deg) const {
     const PeripheryShape p = m_sizes.lookup(gaze, e1_deg);
-    return 2.0 * (p.middle_pixels * bitsPerPixelAt(p.s1) + p.outer_pixels * bitsPerPixelAt(p.s2));
+    return 2.0 * (p.middle_pixels * layerBitsPerPixel(kMiddle, p.s1) +
+                  p.outer_pixels * layerBitsPerPixel(kOuter, p.s2));
+}
+
+double LiwcPolicy::layerBitsPerPixel(int layer, double scale) const {
+    return bitsPerPixelAt(scale) * std::exp(m_layer_log_ratio[static_cast<size_t>(layer)]);
 }
 
 double LiwcPolicy::remoteMs(const Gaze& gaze, double e1_deg) const {
@@ -160,10 +169,10 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // — the headset's L, the server's S, the link's X — and no shorter than the remote chain
     // S + X over the frames in flight (one frame in flight: the headset renders its fovea while
     // the server and the link work in turn, max(L, S + X)). Minimise it over a grid of
-    // ±max_delta in half degrees; the table's learned offset corrects the remote chain (on X,
-    // the link's part).
+    // ±max_delta in half degrees; the table's learned offset corrects the remote chain S + X.
     struct Eval {
-        double e1 = 0.0, local = 0.0, server = 0.0, link = 0.0, period = 0.0, latency = 0.0;
+        double e1 = 0.0, local = 0.0, server = 0.0, link = 0.0, chain = 0.0, period = 0.0;
+        double latency = 0.0;
         double score = 0.0;  // the period plus, for a move, its byte cost
         double triangles = 0.0, pixels = 0.0;
         double remote() const { return server + link; }
@@ -173,7 +182,7 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // early keep the cold start's errors and, added to lower candidates, pinned e1 high when R
     // does not fall with it (tests/controller: DriftsToTheSmallestFovea...). What the table
     // then carries is R's motion-correlated error near the operating point.
-    const double offset = m_table.offsetMs(m_motion, LiwcTable::bucketOf(m_e1_deg));
+    const double offset = remoteOffsetMs(m_motion, LiwcTable::bucketOf(m_e1_deg));
     const double in_flight = std::max(1, m_config.frames_in_flight);
     const MoveCost move_cost = moveCost();
     auto evaluate = [&](double e) {
@@ -185,10 +194,15 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         if (e < m_cover_deg) {
             v.server =
                 std::max(0.0, m_server_fit.predict({1.0, v.triangles * 1e-5, v.pixels * 1e-5}));
-            v.link = std::max(0.0, transmissionMs(frame.gaze, e) + offset);
+            v.link = transmissionMs(frame.gaze, e);
         }
-        v.latency = v.local + v.server + v.link;
-        v.period = std::max({v.local, v.server, v.link, v.remote() / in_flight});
+        // The table's offset corrects the remote chain — request to last packet — not the link's
+        // stage: the server sends each layer as it is encoded, so the chain is shorter than S + X,
+        // and read into X that overlap made a 1.33 Mbit/s link look free (X 11.5 ms, offset
+        // -11 ms: e1 chosen by L against S alone, 12.5° where the link-bound best was 15-20°).
+        v.chain = e < m_cover_deg ? std::max(0.0, v.remote() + offset) : 0.0;
+        v.latency = v.local + v.chain;
+        v.period = std::max({v.local, v.server, v.link, v.chain / in_flight});
         // A move re-sizes the encoders' canvases: the extra bytes and server time it was
         // measured to cost, spread over the frames a chosen e1 holds.
         const bool moves = std::fabs(e - m_e1_deg) > 1e-6;
@@ -236,14 +250,14 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     Decision d;
     d.e1_deg = best.e1;
     d.t_local_pred_ms = best.local;
-    d.t_remote_pred_ms = best.remote();
+    d.t_remote_pred_ms = best.chain;
     remember(d);
     m_pending.back().periphery_triangles = best.triangles;
     m_pending.back().periphery_pixels = best.pixels;
     // Here the table learns what the model (without the offset) mispredicted of T_remote alone:
     // T_local has its own fit, refreshed every frame, and an offset learned from the imbalance
     // would move R by L's error, which the period cannot absorb.
-    m_pending.back().model_imbalance_ms = best.remote() - offset;
+    m_pending.back().model_imbalance_ms = best.remote();
     return d;
 }
 
@@ -363,10 +377,11 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     // The session's first frame: its remote chain opened the encoders and its link carried their
     // key frames, so it teaches neither the server's fit nor the bits law.
     const bool opening = m_observed == 0;
-    const FrameKind kind = m_config.frame_period_objective
-                               ? learnMoveCost(m, m.middle_pixels * bitsPerPixelAt(m.s1) +
-                                                      m.outer_pixels * bitsPerPixelAt(m.s2))
-                               : FrameKind::kHeld;
+    const FrameKind kind =
+        m_config.frame_period_objective
+            ? learnMoveCost(m, m.middle_pixels * layerBitsPerPixel(kMiddle, m.s1) +
+                                   m.outer_pixels * layerBitsPerPixel(kOuter, m.s2))
+            : FrameKind::kHeld;
     const bool moved_apart = kind != FrameKind::kHeld;
     // A held frame's new canvas shows S no slope, only a key frame's encode.
     const bool late_canvas = kind == FrameKind::kLateCanvas;
@@ -389,7 +404,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
             const double measured =
                 m_config.frame_period_objective ? m.t_remote_ms : m.t_remote_ms - m.t_local_ms;
             const double delta = measured - p.model_imbalance_ms;
-            m_table.fold(p.motion, p.bucket, static_cast<float>(delta), m_config.alpha);
+            foldRemoteOffset(p.motion, p.bucket, delta);
         }
     }
     if (m_config.reactive) {
@@ -417,7 +432,7 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
     const double b = m_config.rate_ema;
     if (m.t_local_ms > 0.0) {
         if (m_config.frame_period_objective)
-            m_local_fit.add({1.0, m.triangles_local * 1e-5, m.pixels_local * 1e-5}, m.t_local_ms);
+            learnLocal(m);
         else
             updateGpuRates(m.triangles_local, m.pixels_local, m.t_local_ms);
     }
@@ -505,6 +520,22 @@ void LiwcPolicy::learnBits(double middle_bits, double middle_pixels, double s1, 
         const double log_b1 = std::log(bits) - m_bits_exponent * std::log(std::max(1.0, s));
         m_log_bits_at_1 = (1.0 - w) * m_log_bits_at_1 + w * log_b1;
     }
+    // What the law misses of each layer: the layers hold different content, which the one law
+    // can only read as γ (a glTF engine in the outer layer around an empty middle: γ at its
+    // bound of 2, the outer layer's bits 2.7x under, the link's time ~4x under, and e1 held
+    // 4-8° low on a 1.33 Mbit/s link). Its ratio per layer, measured over held frames, puts
+    // each layer's own content into what a candidate's bits are predicted from.
+    if (m_config.frame_period_objective) {
+        const std::array<std::array<double, 3>, 2> layers{
+            {{middle_bits, middle_pixels, s1}, {outer_bits, outer_pixels, s2}}};
+        for (size_t k = 0; k < layers.size(); ++k) {
+            const auto& [bits, pixels, s] = layers[k];
+            if (pixels <= 0 || bits <= 0)
+                continue;
+            const double r = std::log(bits / pixels / bitsPerPixelAt(s));
+            m_layer_log_ratio[k] = (1.0 - w) * m_layer_log_ratio[k] + w * r;
+        }
+    }
     m_bits_law_measured = m_bits_law_measured || have_mid || have_out;
 }
 
@@ -553,6 +584,53 @@ LiwcPolicy::FrameKind LiwcPolicy::learnMoveCost(const FrameMeasurement& m, doubl
     if (sent_bits > 0.0 && predicted_bits > 0.0 && !m.periphery_late)
         m_move_bits.add(moved || new_canvas, m.e1_deg, sent_bits / predicted_bits);
     return moved ? FrameKind::kMoved : new_canvas ? FrameKind::kLateCanvas : FrameKind::kHeld;
+}
+
+double LiwcPolicy::remoteOffsetMs(uint16_t motion, int bucket) const {
+    if (m_config.frame_period_objective && !m_cell_folded[LiwcTable::indexOf(motion, bucket)])
+        return m_remote_residual_ms;
+    return m_table.offsetMs(motion, bucket);
+}
+
+void LiwcPolicy::foldRemoteOffset(uint16_t motion, int bucket, double delta_ms) {
+    // The period objective: a cell no frame has folded reads the remote chain's error over every
+    // cell (an EMA at the table's α), and its first fold starts there. Read as 0, the error the
+    // table had learned vanished whenever the motion code or e1's bucket changed: every
+    // candidate's X moved by it at once (-2.5 to 0 ms on a 10 ms X), and e1 flipped 5° and back
+    // on consecutive frames (2CylinderEngine, rate:1.33), each move a key frame. Eq. 2's table
+    // (the paper simulator) keeps the paper's zero start.
+    const size_t cell = LiwcTable::indexOf(motion, bucket);
+    const float alpha = m_config.alpha;
+    if (m_config.frame_period_objective) {
+        if (!m_cell_folded[cell])
+            m_table.setOffsetMs(motion, bucket, static_cast<float>(m_remote_residual_ms));
+        m_cell_folded[cell] = true;
+        m_remote_residual_ms = (1.0 - alpha) * m_remote_residual_ms + alpha * delta_ms;
+    }
+    m_table.fold(motion, bucket, static_cast<float>(delta_ms), alpha);
+}
+
+void LiwcPolicy::learnLocal(const FrameMeasurement& m) {
+    const WindowedFit::Vec x{1.0, m.triangles_local * 1e-5, m.pixels_local * 1e-5};
+    m_render_apart = m_render_apart || m.t_render_ms > 0.0;
+    if (!m_render_apart) {
+        m_local_fit.add(x, m.t_local_ms);
+        return;
+    }
+    // The fovea render is the busy time's only part that e1 moves: its slope is fitted on the
+    // render's own time. Fitted on the whole busy time, whose rest (UCA ~8 ms at the default
+    // profile) a host's preemptions shake by several ms a frame, the slope was that noise's
+    // over the few degrees e1 had visited, or the prior's: L(15°) 21 ms predicted where the
+    // headset was busy 10 ms at any e1 (2CylinderEngine, rate:1.33), and e1 stayed at 5-6°.
+    if (m.t_render_ms <= 0.0 || m.t_render_ms > m.t_local_ms)
+        return;
+    m_local_fit.add(x, m.t_render_ms);
+    m_local_rest.push_back(m.t_local_ms - m.t_render_ms);
+    m_local_rest_sum += m_local_rest.back();
+    while (m_local_rest.size() > m_local_fit.window()) {
+        m_local_rest_sum -= m_local_rest.front();
+        m_local_rest.pop_front();
+    }
 }
 
 void LiwcPolicy::updateGpuRates(double triangles, double pixels, double t_local_ms) {

@@ -740,11 +740,14 @@ void PassReplay::learn(int64_t i) {
     FrameMeasurement m;
     m.index = wf.index;
     m.e1_deg = fs.plan.e1_deg;
-    m.t_local_ms = m_depth > 1 && rf.headset_busy_ms > 0.0 ? rf.headset_busy_ms : rf.t_local_ms;
+    const bool busy = m_depth > 1 && rf.headset_busy_ms > 0.0;
+    m.t_local_ms = busy ? rf.headset_busy_ms : rf.t_local_ms;
+    m.t_render_ms = busy ? rf.t_local_ms : 0.0;
     m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
     if (isStartUpFrame(i, static_cast<int64_t>(m_depth), rf.requested || rf.withheld,
                        m_first_composed)) {
         m.t_local_ms = 0.0;
+        m.t_render_ms = 0.0;
         m.t_remote_ms = 0.0;
     }
     m.triangles_local = sumWithinDeg(wf.triangles_per_ring, m_header.ring_deg, fs.plan.e1_deg);

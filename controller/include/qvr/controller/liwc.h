@@ -151,14 +151,25 @@ private:
     const WorkloadHeader& m_header;
     LiwcConfig m_config;
     LiwcTable m_table;
+    // frame_period_objective: the cells a frame has folded, and the remote chain's error over
+    // all of them (remoteOffsetMs, foldRemoteOffset).
+    std::vector<bool> m_cell_folded = std::vector<bool>(LiwcTable::kEntries, false);
+    double m_remote_residual_ms = 0.0;
+    double remoteOffsetMs(uint16_t motion, int bucket) const;
+    void foldRemoteOffset(uint16_t motion, int bucket, double delta_ms);
     RemoteSizeTable m_sizes;
     // Estimates the updater refreshes. The GPU: T_local ≈ θ0 + θ1·triangles + θ2·pixels (in
     // units of 1e5), fitted by recursive least squares with covariance m_gpu_cov.
     std::array<double, 3> m_gpu_theta;
     std::array<double, 9> m_gpu_cov;
     double m_throughput_bps;
-    double m_log_bits_at_1;         // log of bits per pixel at scale 1
-    double m_bits_exponent;         // growth with scale
+    double m_log_bits_at_1;  // log of bits per pixel at scale 1
+    double m_bits_exponent;  // growth with scale
+    // frame_period_objective: each layer's bits over the law's, in log space (EMA over held
+    // frames): the content the law cannot tell from scale.
+    static constexpr int kMiddle = 0, kOuter = 1;
+    std::array<double, 2> m_layer_log_ratio{0.0, 0.0};
+    double layerBitsPerPixel(int layer, double scale) const;
     double m_remote_base_ms = 0.0;  // learn_remote_base: T_remote beyond the transmission
     // frame_period_objective: S ≈ σ0 + σ1·periphery triangles + σ2·periphery pixels (1e-5 units),
     // recursive least squares like the GPU fit.
@@ -166,6 +177,13 @@ private:
     // S ≈ σ·[1, periphery triangles, periphery pixels], in units of 1e5.
     WindowedFit m_local_fit;
     WindowedFit m_server_fit;
+    // When frames say their fovea render apart (FrameMeasurement::t_render_ms), m_local_fit fits
+    // the render alone and the rest of the headset's busy time (UCA, decode, the frame's
+    // overheads, the host's preemptions) is its mean over the same window: L = rest + render.
+    bool m_render_apart = false;
+    std::deque<double> m_local_rest;
+    double m_local_rest_sum = 0.0;
+    void learnLocal(const FrameMeasurement& m);
     double m_link_bps = 0.0;            // setLinkEstimate
     int m_frames_without_link = 0;      // observed frames in a row that carried no periphery
     double m_stale_link_backoff = 1.0;  // scales kStaleLinkFrames: doubled by a failed try

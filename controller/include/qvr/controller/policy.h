@@ -26,6 +26,9 @@ struct FrameMeasurement {
     int64_t index = 0;
     double e1_deg = 0.0;
     double t_local_ms = 0.0;
+    // When t_local_ms is the headset's whole busy time (frames in flight): the part of it that
+    // rendered the fovea, the only part e1 moves (0: not measured apart).
+    double t_render_ms = 0.0;
     double t_remote_ms = 0.0;
     double triangles_local = 0.0;  // triangles in the fovea cone, both eyes
     double pixels_local = 0.0;     // shaded fovea pixels, both eyes

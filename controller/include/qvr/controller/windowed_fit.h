@@ -23,6 +23,7 @@ public:
     double predict(const Vec& x) const;
     const Vec& theta() const { return m_theta; }
     size_t size() const { return m_obs.size(); }
+    size_t window() const { return m_window; }
 
 private:
     void refit();
