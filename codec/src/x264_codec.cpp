@@ -115,7 +115,10 @@ public:
         if (w < 1 || h < 1 || w > m_config.max_side_px || h > m_config.max_side_px)
             return makeError(fmt::format("x264 encoder: layer size {}x{} outside [1, {}]", w, h,
                                          m_config.max_side_px));
-        const CanvasSize canvas = m_canvas.next(w, h);
+        // An IDR comes anyway when asked for or at keyint (x264 counts from the last IDR).
+        const bool periodic = m_config.keyint_frames > 0 && !m_config.intra_refresh &&
+                              m_since_idr + 1 >= m_config.keyint_frames;
+        const CanvasSize canvas = m_canvas.next(w, h, force_keyframe || m_force_key || periodic);
         const bool new_canvas = m_canvas.changed() || !m_ctx;
         if (new_canvas) {
             if (m_ctx)
@@ -158,6 +161,7 @@ public:
         const bool idr = annexBHasIdr(m_payload);
         if (idr)
             m_force_key = false;
+        m_since_idr = idr ? 0 : m_since_idr + 1;
         FrameHeader fh;
         fh.flags = static_cast<uint8_t>((idr ? FrameHeader::kFlagKeyframe : 0) |
                                         (new_canvas ? FrameHeader::kFlagNewCanvas : 0));
@@ -294,6 +298,7 @@ private:
 
     CodecConfig m_config;
     CanvasPolicy m_canvas;
+    int m_since_idr = 0;  // frames coded since the newest IDR
     std::vector<uint8_t> m_payload;
     EncoderStats m_stats;
     int64_t m_pts = 0;

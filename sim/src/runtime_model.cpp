@@ -96,8 +96,10 @@ double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes
     if (!enabled() || width < 1 || height < 1 || stream < 0 || stream >= kStreams)
         return p_bytes;
     State& st = m_streams[static_cast<size_t>(stream)];
+    const bool key_due =
+        st.since_key >= 0 && m_costs.keyint_frames > 0 && st.since_key + 1 >= m_costs.keyint_frames;
     const CanvasSize canvas =
-        st.canvas.next(std::min(width, kMaxSidePx), std::min(height, kMaxSidePx));
+        st.canvas.next(std::min(width, kMaxSidePx), std::min(height, kMaxSidePx), key_due);
     const CanvasSize snug =
         st.canvas.snugFor(std::min(width, kMaxSidePx), std::min(height, kMaxSidePx));
     // The bits law is a P-frame's in a snug canvas: each pixel beyond it costs padding_bits_ratio

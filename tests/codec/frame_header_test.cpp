@@ -176,38 +176,47 @@ TEST(ReferenceTracker, IntraRefreshWithholdsPicturesForOnePeriod) {
 
 TEST(CanvasPolicy, SmallSizeChangesKeepTheCanvas) {
     CanvasPolicy p(16, 0.10, 0.5, 30, 8192);
-    const CanvasSize first = p.next(170, 190);
+    const CanvasSize first = p.next(170, 190, true);
     EXPECT_TRUE(p.changed());
     EXPECT_EQ(first.width % 16, 0);
     EXPECT_EQ(first.height % 16, 0);
     EXPECT_GE(first.width, 187);
     EXPECT_GE(first.height, 209);
     for (int i = 0; i < 50; ++i) {
-        p.next(160 + (i * 7) % 25, 180 + (i * 5) % 26);
+        p.next(160 + (i * 7) % 25, 180 + (i * 5) % 26, i % 10 == 0);
         EXPECT_FALSE(p.changed()) << i;
     }
 }
 
-TEST(CanvasPolicy, GrowsAtOnceShrinksAfterAWhile) {
+// A canvas grows at once (the layer must fit: one IDR), and shrinks only after the layer stayed
+// small for a while *and* on a frame the stream codes as a key frame anyway: a shrink on any frame
+// was an IDR of its own, on all four streams at once 30 frames after a move up (6-7 KB, a
+// 1.33 Mbit/s run's worst motion-to-photon).
+TEST(CanvasPolicy, GrowsAtOnceShrinksOnlyAtAKeyFrameDue) {
     CanvasPolicy p(16, 0.10, 0.5, 5, 8192);
-    p.next(100, 100);
-    const CanvasSize grown = p.next(300, 120);
-    EXPECT_TRUE(p.changed());
+    p.next(100, 100, true);
+    const CanvasSize grown = p.next(300, 120, false);
+    EXPECT_TRUE(p.changed()) << "grows without a key frame due";
     EXPECT_GE(grown.width, 300);
     EXPECT_GE(grown.height, 120);
-    for (int i = 0; i < 4; ++i) {
-        p.next(60, 60);
-        EXPECT_FALSE(p.changed());
+    for (int i = 0; i < 40; ++i) {
+        p.next(60, 60, false);
+        EXPECT_FALSE(p.changed()) << i;
     }
-    const CanvasSize shrunk = p.next(60, 60);
+    const CanvasSize shrunk = p.next(60, 60, true);
     EXPECT_TRUE(p.changed());
     EXPECT_LT(shrunk.width, grown.width);
     EXPECT_GE(shrunk.width, 60);
+    // Small for fewer than shrink_after frames: a key frame due does not shrink it.
+    p.next(300, 120, false);
+    p.next(60, 60, false);
+    p.next(60, 60, true);
+    EXPECT_FALSE(p.changed());
 }
 
 TEST(CanvasPolicy, NeverSmallerThanTheLayerEvenAtTheSizeLimit) {
     CanvasPolicy p(16, 0.5, 0.5, 5, 512);
-    const CanvasSize c = p.next(500, 3);
+    const CanvasSize c = p.next(500, 3, true);
     EXPECT_EQ(c.width, 512);
     EXPECT_GE(c.height, 3);
 }

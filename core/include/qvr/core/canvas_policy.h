@@ -1,6 +1,7 @@
 // How a layer stream's coded canvas follows a layer whose size changes every frame as e1 moves
 // (paper §3.1–3.2): grow with headroom when the layer outgrows it, shrink only after the layer
-// has stayed much smaller for a while, so a canvas change (and its IDR) is rare.
+// has stayed much smaller for a while and on a frame that is a key frame anyway, so a canvas
+// change costs an IDR only when the layer outgrew it.
 #pragma once
 
 namespace qvr {
@@ -16,7 +17,9 @@ public:
     CanvasPolicy(int align_px, double headroom, double shrink_ratio, int shrink_after_frames,
                  int max_side_px);
     // The canvas for the next frame of a width×height layer; changed() tells whether it moved.
-    CanvasSize next(int width, int height);
+    // key_due: the stream codes this frame as an IDR whatever its canvas (its periodic key frame,
+    // a requested one), the only frame a shrink may take.
+    CanvasSize next(int width, int height, bool key_due);
     bool changed() const { return m_changed; }
     CanvasSize current() const { return m_canvas; }
     // The canvas a stream that starts at a width×height layer gets: the layer plus headroom,
