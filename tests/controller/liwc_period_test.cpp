@@ -896,13 +896,9 @@ TEST(LiwcPeriodObjective, EachLayersOwnContentEntersItsBits) {
     EXPECT_NEAR(liwc.predictRemoteMs(f, e1) / truth_ms, 1.0, 0.05) << e1 << "°";
 }
 
-// A server that sends each layer as it is encoded: the remote chain (request to last packet) is
-// shorter than S + X, and the table learns that overlap as a negative offset. Put on X, it made a
-// link-bound frame's link look free (X 11.5 ms, offset -11 ms at 1.33 Mbit/s), and e1 balanced
-// L against S alone. The link's stage is its transmission; the offset corrects the chain.
-TEST(LiwcPeriodObjective, TheChainsOverlapDoesNotHideTheLinksStage) {
-    const WorkloadHeader h = header();
-    const LayerPlanner planner(h.profile);
+// A fast headset (~9 ms of UCA and the rest, a cheap fovea render), a server of ~8 ms that sends
+// each layer as it is encoded, and a link that sets the pace at small e1.
+Truth overlappedLinkBound() {
     Truth truth;
     truth.local_fixed_ms = 9.0;
     truth.local_triangles_per_ms = 200'000.0;
@@ -911,6 +907,17 @@ TEST(LiwcPeriodObjective, TheChainsOverlapDoesNotHideTheLinksStage) {
     truth.server_triangles_per_ms = 600'000.0;
     truth.throughput_bps = 30e6;
     truth.overlapped = true;
+    return truth;
+}
+
+// A server that sends each layer as it is encoded: the remote chain (request to last packet) is
+// shorter than S + X, and the table learns that overlap as a negative offset. Put on X, it made a
+// link-bound frame's link look free (X 11.5 ms, offset -11 ms at 1.33 Mbit/s), and e1 balanced
+// L against S alone. The link's stage is its transmission; the offset corrects the chain.
+TEST(LiwcPeriodObjective, TheChainsOverlapDoesNotHideTheLinksStage) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth = overlappedLinkBound();
     truth.noise = 0.02;
     const WorkloadFrame f = frame(0, 20'000.0);
     auto periodAt = [&](double e1) {
@@ -942,14 +949,7 @@ TEST(LiwcPeriodObjective, TheChainsOverlapDoesNotHideTheLinksStage) {
 TEST(LiwcPeriodObjective, ACellNoFrameFoldedReadsTheChainsErrorNotZero) {
     const WorkloadHeader h = header();
     const LayerPlanner planner(h.profile);
-    Truth truth;
-    truth.local_fixed_ms = 9.0;
-    truth.local_triangles_per_ms = 200'000.0;
-    truth.local_pixels_per_ms = 2'000'000.0;
-    truth.server_fixed_ms = 6.0;
-    truth.server_triangles_per_ms = 600'000.0;
-    truth.throughput_bps = 30e6;
-    truth.overlapped = true;
+    const Truth truth = overlappedLinkBound();
     const WorkloadFrame f = frame(0, 20'000.0);
     LiwcPolicy liwc(h, periodConfig());
     const std::vector<Decision> d =
