@@ -827,11 +827,7 @@ private:
         FrameMeasurement m;
         m.index = i;
         m.e1_deg = plan.e1_deg;
-        // With frames in flight the headset's whole frame competes with the server, not only its
-        // fovea render (LIWC's GPU fit takes the fixed part as its intercept).
-        const bool busy = m_depth > 1 && t->headset_busy_ms > 0.0;
-        m.t_local_ms = busy ? t->headset_busy_ms : t->t_local_ms;
-        m.t_render_ms = busy ? t->t_local_ms : 0.0;
+        setHeadsetTimes(m, static_cast<int64_t>(m_depth), t->headset_busy_ms, t->t_local_ms);
         m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
         if (isStartUpFrame(i, static_cast<int64_t>(m_depth), t->remote_requested || prep.withheld,
                            m_first_composed_frame)) {

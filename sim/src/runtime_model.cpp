@@ -109,8 +109,7 @@ double StreamCodecModel::bytes(int stream, int width, int height, double p_bytes
         m_last_canvas_px / std::max(1.0, double(snug.width) * double(snug.height)) - 1.0;
     const double p = p_bytes * std::max(0.5, 1.0 + m_costs.padding_bits_ratio * extra);
     const bool opened = st.since_key < 0 || st.canvas.changed();  // a new encoder
-    const bool periodic =
-        !opened && m_costs.keyint_frames > 0 && st.since_key + 1 >= m_costs.keyint_frames;
+    const bool periodic = !opened && key_due;
     st.since_key = opened || periodic ? 0 : st.since_key + 1;
     m_last_key = opened || periodic;
     m_last_opened = opened;
@@ -742,9 +741,7 @@ void PassReplay::learn(int64_t i) {
     FrameMeasurement m;
     m.index = wf.index;
     m.e1_deg = fs.plan.e1_deg;
-    const bool busy = m_depth > 1 && rf.headset_busy_ms > 0.0;
-    m.t_local_ms = busy ? rf.headset_busy_ms : rf.t_local_ms;
-    m.t_render_ms = busy ? rf.t_local_ms : 0.0;
+    setHeadsetTimes(m, static_cast<int64_t>(m_depth), rf.headset_busy_ms, rf.t_local_ms);
     m.t_remote_ms = rf.requested ? rf.t_remote_ms : 0.0;
     if (isStartUpFrame(i, static_cast<int64_t>(m_depth), rf.requested || rf.withheld,
                        m_first_composed)) {

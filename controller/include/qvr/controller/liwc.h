@@ -171,10 +171,9 @@ private:
     std::array<double, 2> m_layer_log_ratio{0.0, 0.0};
     double layerBitsPerPixel(int layer, double scale) const;
     double m_remote_base_ms = 0.0;  // learn_remote_base: T_remote beyond the transmission
-    // frame_period_objective: S ≈ σ0 + σ1·periphery triangles + σ2·periphery pixels (1e-5 units),
-    // recursive least squares like the GPU fit.
-    // Both fits over a window (windowed_fit.h): L ≈ λ·[1, fovea triangles, fovea pixels] and
-    // S ≈ σ·[1, periphery triangles, periphery pixels], in units of 1e5.
+    // frame_period_objective, both fits over a window (windowed_fit.h), in units of 1e5: the fovea
+    // render (or, not measured apart, the whole busy time) ≈ λ·[1, fovea triangles, fovea
+    // pixels], and S ≈ σ·[1, periphery triangles, periphery pixels].
     WindowedFit m_local_fit;
     WindowedFit m_server_fit;
     // When frames say their fovea render apart (FrameMeasurement::t_render_ms), m_local_fit fits

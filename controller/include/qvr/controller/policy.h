@@ -78,6 +78,16 @@ constexpr bool isStartUpFrame(int64_t frame, int64_t depth, bool remote_requeste
     return frame < depth || (remote_requested && (first_composed < 0 || frame <= first_composed));
 }
 
+// The headset's own cost as LIWC reads it, the runtime's headset and its model alike: with frames
+// in flight (depth > 1) its whole busy time competes with the server, so t_local_ms is that, with
+// the fovea render's part apart (t_render_ms, the only part e1 moves); with one frame at a time,
+// the fovea render alone. busy_ms ≤ 0: not measured (the session's first frame).
+inline void setHeadsetTimes(FrameMeasurement& m, int64_t depth, double busy_ms, double render_ms) {
+    const bool busy = depth > 1 && busy_ms > 0.0;
+    m.t_local_ms = busy ? busy_ms : render_ms;
+    m.t_render_ms = busy ? render_ms : 0.0;
+}
+
 // What the headset would measure of a frame rendered with `plan` at cost `cost`, the remote part
 // having crossed a link of throughput_bps (0 if nothing was sent).
 FrameMeasurement measureFrame(int64_t index, const LayerPlan& plan, const FrameCost& cost,
