@@ -172,27 +172,5 @@ TEST(WindowedFit, IgnoresNonFiniteObservations) {
     EXPECT_NEAR(fit.predict({1.0, 0.5, 0.5}), dot(truth, {1.0, 0.5, 0.5}), 1e-3);
 }
 
-// A cost with a cliff along e1: flat at 1 up to 12°, 50 past it. One line through both sides
-// put 10° at several times its cost; the fit near 10° reads the frames there.
-TEST(WindowedFit, NearAPointTheObservationsThereDecide) {
-    WindowedFit fit({0.0, 0.0, 0.0}, 32, 1.0);
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<double> u(-0.05, 0.05);
-    for (int i = 0; i < 32; ++i) {
-        const double e1 = i % 4 == 3 ? 14.0 : (i % 2 == 0 ? 8.0 : 10.0);
-        const double pixels = e1 * e1 * 0.01;  // the fovea's pixels grow with e1
-        const double y = (e1 > 12.0 ? 50.0 : 1.0) * (1.0 + u(rng));
-        fit.add({1.0, 0.0, pixels}, y, e1);
-    }
-    const WindowedFit::Vec at10{1.0, 0.0, 1.0};
-    EXPECT_GT(fit.predict(at10), 5.0) << "the line through both sides";
-    EXPECT_NEAR(fit.predictNear(at10, 10.0, 2.5), 1.0, 0.5);
-    EXPECT_GT(fit.predictNear({1.0, 0.0, 1.96}, 14.0, 2.5), 40.0);
-    // Far from every observation: the nearest ones' (14°) fit carried by its slope, not the
-    // window's whole fit, whose level is another.
-    EXPECT_GT(fit.predictNear({1.0, 0.0, 2.1}, 40.0, 2.5), 40.0);
-    EXPECT_NEAR(fit.predictNear({1.0, 0.0, 0.64}, 2.0, 2.5), 1.0, 0.5);
-}
-
 }  // namespace
 }  // namespace qvr

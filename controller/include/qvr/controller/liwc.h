@@ -108,9 +108,6 @@ private:
     void remember(const Decision& d);
     static constexpr size_t kMaxPendingDecisions = 8;
     static constexpr double kFarStepDeg = 2.5;  // the coarse grid decidePeriod also scans
-    // L's fit at a candidate e1 weighs the window's frames by their e1's distance from it, over
-    // this width: the coarse grid's step, so a candidate between two grid points hears both.
-    static constexpr double kLocalFitBandwidthDeg = kFarStepDeg;
     // Per-frame quantities every candidate shares: computed once in decide().
     void prepareFrame(const WorkloadFrame& frame) const;
     double localMs(double e1_deg) const;
