@@ -73,7 +73,12 @@ double LiwcPolicy::localMs(double e1_deg) const {
     const double tris = prefixAt(m_prefix_tris, m_header.ring_deg, e);
     const double pixels = prefixAt(m_prefix_pixels, m_header.ring_deg, e);
     if (m_config.frame_period_objective) {
-        const double render = std::max(0.0, m_local_fit.predict({1.0, tris * 1e-5, pixels * 1e-5}));
+        // A larger fovea renders a superset of a smaller one's pixels, so L's fit at e1 reads
+        // the frames at e1 or below: a fovea that takes in a dense model past some e1 costs tens
+        // of ms more there, and one line through both sides put L below that cliff at 2-3x what
+        // it measured, so e1 fled to 3.5° where 10° was best (docs/LIWC.md "Fits").
+        const double render =
+            std::max(0.0, m_local_fit.predictAt({1.0, tris * 1e-5, pixels * 1e-5}, e1_deg));
         if (!m_render_apart || m_local_rest.empty())
             return render;
         return m_local_rest_sum / double(m_local_rest.size()) + render;
@@ -614,7 +619,7 @@ void LiwcPolicy::learnLocal(const FrameMeasurement& m) {
     const WindowedFit::Vec x{1.0, m.triangles_local * 1e-5, m.pixels_local * 1e-5};
     m_render_apart = m_render_apart || m.t_render_ms > 0.0;
     if (!m_render_apart) {
-        m_local_fit.add(x, m.t_local_ms);
+        m_local_fit.add(x, m.t_local_ms, m.e1_deg);
         return;
     }
     // The fovea render is the busy time's only part that e1 moves: its slope is fitted on the
@@ -624,7 +629,7 @@ void LiwcPolicy::learnLocal(const FrameMeasurement& m) {
     // headset was busy 10 ms at any e1 (2CylinderEngine, rate:1.33), and e1 stayed at 5-6°.
     if (m.t_render_ms <= 0.0 || m.t_render_ms > m.t_local_ms)
         return;
-    m_local_fit.add(x, m.t_render_ms);
+    m_local_fit.add(x, m.t_render_ms, m.e1_deg);
     m_local_rest.push_back(m.t_local_ms - m.t_render_ms);
     m_local_rest_sum += m_local_rest.back();
     while (m_local_rest.size() > m_local_fit.window()) {

@@ -865,13 +865,16 @@ TEST(LiwcPeriodObjective, TheFoveaRenderAloneTeachesHowLMovesWithE1) {
         });
         return liwc.predictLocalMs(f, e1) / (truth.localMs(f, e1) + busy_mean);
     };
-    for (const double e1 : {5.0, 15.0, 25.0})
-        EXPECT_NEAR(predictedOverTrue(true, e1), 1.0, 0.1) << e1 << "°";
-    // The whole busy time alone cannot say it: the same run fitted on it is off by more.
-    double worst_whole = 0.0;
-    for (const double e1 : {5.0, 15.0, 25.0})
+    double worst_apart = 0.0, worst_whole = 0.0;
+    for (const double e1 : {5.0, 15.0, 25.0}) {
+        const double apart = predictedOverTrue(true, e1);
+        EXPECT_NEAR(apart, 1.0, 0.1) << e1 << "°";
+        worst_apart = std::max(worst_apart, std::fabs(apart - 1.0));
+        // The whole busy time alone says it less well: the same run fitted on it is off by more
+        // (by 20-30% with one line over every e1; 3-9% read at each e1's frames).
         worst_whole = std::max(worst_whole, std::fabs(predictedOverTrue(false, e1) - 1.0));
-    EXPECT_GT(worst_whole, 0.2);
+    }
+    EXPECT_GT(worst_whole, 2.0 * worst_apart);
 }
 
 // The layers hold different content: a glTF engine in the outer layer around an empty middle
@@ -968,6 +971,51 @@ TEST(LiwcPeriodObjective, ACellNoFrameFoldedReadsTheChainsErrorNotZero) {
     ASSERT_NE(liwc.lastMotion(), 0) << "a new motion code";
     EXPECT_NEAR(next.t_remote_pred_ms / truth.remoteMs(f, planner.plan(f.gaze, next.e1_deg)), 1.0,
                 0.15);
+}
+
+// Past some e1 the fovea takes in a dense model the ring counts do not show as cost (a glTF
+// engine's overdraw: 1-2k triangles, 33-70 ms a render at 12-15° on a 0.3 share, under 1 ms at
+// 10°). One line of L through both sides put 10° at twice what it measured, and e1 fled to 3.5°
+// where 10° was best (qvr sweep --seed 80808 c09). What the window measured at a larger e1 caps
+// L. (What it does not yet do: remember the cliff once its frames leave the window, so e1 tries
+// past it again about once a window.)
+TEST(LiwcPeriodObjective, ACliffInTheFoveaRenderDoesNotBendLBelowIt) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    Truth truth = overlappedLinkBound();
+    truth.throughput_bps = 8e6;
+    truth.noise = 0.02;
+    constexpr double kCliffDeg = 12.0, kCliffMs = 60.0;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    auto cliff = [&](double e1) { return e1 > kCliffDeg ? kCliffMs : 0.0; };
+    auto periodAt = [&](double e1, bool with_cliff) {
+        const LayerPlan plan = planner.plan(f.gaze, e1);
+        const double link = plan.hasRemote() ? truth.transmissionMs(plan) : 0.0;
+        const double local = truth.localMs(f, e1) + (with_cliff ? cliff(e1) : 0.0);
+        return std::max({local, truth.serverMs(f, plan), link, truth.remoteMs(f, plan) / 2.0});
+    };
+    double best = 1e18, best_e1 = 0.0, free_e1 = 0.0, free_best = 1e18;
+    for (double e = 1.0; e <= 60.0; e += 0.25) {
+        if (periodAt(e, true) < best)
+            best = periodAt(e, true), best_e1 = e;
+        if (periodAt(e, false) < free_best)
+            free_best = periodAt(e, false), free_e1 = e;
+    }
+    ASSERT_GT(free_e1, kCliffDeg) << "without the cliff e1 would go past it";
+    ASSERT_LE(best_e1, kCliffDeg);
+    LiwcPolicy liwc(h, periodConfig());
+    const std::vector<Decision> d =
+        runWithLink(liwc, truth, planner, f, 160, 2, 13, [&](FrameMeasurement& m, int) {
+            m.t_render_ms = m.t_local_ms - truth.local_fixed_ms + cliff(m.e1_deg);
+            m.t_local_ms += cliff(m.e1_deg);
+            m.server_ms = truth.serverMs(f, planner.plan(f.gaze, m.e1_deg));
+        });
+    // L at the e1 it holds, below the cliff, is what the frames there measure: the line through
+    // both sides put it at 3.2-3.5x.
+    for (const double e1 : {d.back().e1_deg, 10.0}) {
+        ASSERT_LE(e1, kCliffDeg);
+        EXPECT_NEAR(liwc.predictLocalMs(f, e1) / truth.localMs(f, e1), 1.0, 0.2) << e1 << "°";
+    }
 }
 
 }  // namespace

@@ -172,5 +172,72 @@ TEST(WindowedFit, IgnoresNonFiniteObservations) {
     EXPECT_NEAR(fit.predict({1.0, 0.5, 0.5}), dot(truth, {1.0, 0.5, 0.5}), 1e-3);
 }
 
+// A cost with a cliff along e1: flat at 1 up to 12°, 50 past it. One line through both sides
+// puts 10° at several times its cost and 14° at less than its own; the fit over the positions
+// up to a point reads 10°, and what 14° measured floors it.
+TEST(WindowedFit, APointReadsThePositionsUpToIt) {
+    WindowedFit fit({0.0, 0.0, 0.0}, 32, 1.0);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-0.05, 0.05);
+    for (int i = 0; i < 32; ++i) {
+        const double e1 = i % 8 == 7 ? 14.0 : (i % 2 == 0 ? 8.0 : 10.0);
+        const double pixels = e1 * e1 * 0.01;  // the fovea's pixels grow with e1
+        const double y = (e1 > 12.0 ? 50.0 : 1.0) * (1.0 + u(rng));
+        fit.add({1.0, 0.0, pixels}, y, e1);
+    }
+    auto at = [&](double e1) { return fit.predictAt({1.0, 0.0, e1 * e1 * 0.01}, e1); };
+    EXPECT_GT(fit.predict({1.0, 0.0, 1.0}), 5.0) << "the line through both sides";
+    EXPECT_LT(fit.predict({1.0, 0.0, 1.96}), 45.0) << "the line through both sides";
+    EXPECT_NEAR(at(10.0), 1.0, 0.5);
+    EXPECT_NEAR(at(8.0), 1.0, 0.5);
+    EXPECT_NEAR(at(6.0), 1.0, 0.5) << "below every position: the fewest that hold enough";
+    EXPECT_NEAR(at(14.0), 50.0, 3.0);
+    EXPECT_GT(at(20.0), 45.0) << "above every position: no less than the largest measured";
+}
+
+// A cost that grows with e1 and carries noise: the fit over the positions up to a point is the
+// line there, within the noise.
+TEST(WindowedFit, ALinearCostReadsItsLineAtEveryPoint) {
+    WindowedFit fit({0.0, 0.0, 0.0}, 32, 1.0);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise(0.0, 0.5);
+    for (int i = 0; i < 200; ++i) {
+        const double e1 = 4.0 + (i % 9);
+        fit.add({1.0, 0.0, e1}, 2.0 + e1 + noise(rng), e1);
+    }
+    for (double e1 = 3.0; e1 <= 14.0; e1 += 0.5)
+        EXPECT_NEAR(fit.predictAt({1.0, 0.0, e1}, e1), 2.0 + e1, 0.6) << e1;
+}
+
+// Observations without a position, or too few with one, read the whole window's fit.
+TEST(WindowedFit, WithoutPositionsAPointReadsTheWholeFit) {
+    WindowedFit plain({0.0, 0.0, 0.0}, 32, 1.0);
+    for (int i = 0; i < 20; ++i)
+        plain.add({1.0, 0.0, i % 2 ? 1.0 : 2.0}, i % 2 ? 1.0 : 3.0);
+    EXPECT_DOUBLE_EQ(plain.predictAt({1.0, 0.0, 1.5}, 5.0), plain.predict({1.0, 0.0, 1.5}));
+    WindowedFit few({0.0, 0.0, 0.0}, 32, 1.0);
+    few.add({1.0, 0.0, 1.0}, 1.0, 10.0);
+    few.add({1.0, 0.0, 2.0}, 9.0, 12.0);
+    EXPECT_NEAR(few.predictAt({1.0, 0.0, 1.0}, 10.0), few.predict({1.0, 0.0, 1.0}), 1e-9);
+}
+
+// One observation the host preempted (a 51 ms render among 0.2 ms ones, a 0.3 headset share)
+// tilted the least-squares line so that half the fovea looked 11 ms cheaper, and e1 fled from
+// 9.5° to 4.5°. The fit weighs residuals by Huber's rule: one frame moves it little.
+TEST(WindowedFit, OneOutlierDoesNotTiltTheFit) {
+    WindowedFit fit({0.0, 0.0, 0.0}, 32, 1.0);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> content(0.8, 1.2), noise(-0.02, 0.02);
+    auto truth = [](const Vec& x) { return 0.1 + 0.1 * x[1] + 0.05 * x[2]; };
+    for (int i = 0; i < 32; ++i) {
+        const Vec x{1.0, content(rng), content(rng)};
+        fit.add(x, truth(x) + noise(rng) + (i == 20 ? 50.0 : 0.0), 9.5);
+    }
+    for (const Vec& x : {Vec{1.0, 0.5, 0.5}, Vec{1.0, 1.0, 1.0}, Vec{1.0, 2.0, 2.0}}) {
+        EXPECT_NEAR(fit.predict(x), truth(x), 0.1);
+        EXPECT_NEAR(fit.predictAt(x, 9.5), truth(x), 0.1);
+    }
+}
+
 }  // namespace
 }  // namespace qvr
