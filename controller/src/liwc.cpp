@@ -222,9 +222,11 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     const double step = 0.5;
     const int steps = 2 * m_config.max_delta_deg * 2;
     const double top = std::max(lo, hi);
-    Eval best = evaluate(std::clamp(m_e1_deg, lo, top));
+    const double trusted = std::max(lo, trustedTop(hi));
+    Eval best = evaluate(std::clamp(m_e1_deg, lo, trusted));
     for (int k = 0; k <= steps; ++k) {
-        const Eval v = evaluate(std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo, top));
+        const Eval v =
+            evaluate(std::clamp(m_e1_deg - m_config.max_delta_deg + k * step, lo, trusted));
         const double tie = m_config.period_tie * std::max(best.score, v.score);
         if (v.score < best.score - tie ||
             (std::fabs(v.score - best.score) <= tie &&
@@ -248,7 +250,7 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
         if (far.score < best.score - m_config.period_tie * best.score) {
             const double toward = std::clamp(far.e1, m_e1_deg - m_config.max_delta_deg,
                                              m_e1_deg + m_config.max_delta_deg);
-            best = evaluate(std::clamp(toward, lo, top));
+            best = evaluate(std::clamp(toward, lo, trusted));
         }
     }
     m_e1_deg = best.e1;
@@ -264,6 +266,15 @@ Decision LiwcPolicy::decidePeriod(const WorkloadFrame& frame, double lo, double 
     // would move R by L's error, which the period cannot absorb.
     m_pending.back().model_imbalance_ms = best.remote();
     return d;
+}
+
+double LiwcPolicy::trustedTop(double hi) const {
+    // Above the largest e1 measured, L is the fit's extrapolation, blind to a dense model that
+    // enters the fovea there. With decisions in flight unmeasured the far search walked 12° to
+    // 37° in five frames, one window step a frame, into a 60 ms render (tests/controller: a
+    // cliff in the fovea render). Candidates go at most one window step past what was measured.
+    const std::optional<double> measured = m_local_fit.highestPosition();
+    return measured ? std::min(hi, *measured + m_config.max_delta_deg) : hi;
 }
 
 double LiwcPolicy::predictLocalMs(const WorkloadFrame& frame, double e1_deg) const {

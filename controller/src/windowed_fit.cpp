@@ -25,8 +25,13 @@ void WindowedFit::add(const Vec& x, double y, double at) {
         if (!std::isfinite(v))
             return;
     m_obs.push_back({x, y, at});
-    while (m_obs.size() > m_window)
+    while (m_obs.size() > m_window) {
+        if (std::isfinite(m_obs.front().at))
+            m_recalled.push_back({m_obs.front().at, m_obs.front().y});
         m_obs.pop_front();
+    }
+    while (m_recalled.size() > kRecalledWindows * m_window)
+        m_recalled.pop_front();
     refit();
     refitPositions();
 }
@@ -173,16 +178,43 @@ void WindowedFit::refit() {
     m_theta = robustFit(std::move(samples), m_theta, m_ridge);
 }
 
+// The position at or below `at` (one position's width of slack), or the lowest when every
+// position lies above it; `end` when there are none.
+std::vector<WindowedFit::Position>::const_iterator WindowedFit::atOrBelow(
+    const std::vector<Position>& positions, double at) {
+    if (positions.empty())
+        return positions.end();
+    const auto above = std::upper_bound(positions.begin(), positions.end(), at + kSamePosition,
+                                        [](double v, const Position& p) { return v < p.at; });
+    return above == positions.begin() ? above : std::prev(above);
+}
+
 double WindowedFit::predictAt(const Vec& x, double at) const {
-    if (m_positions.empty())
+    const auto p = atOrBelow(m_positions, at);
+    if (p == m_positions.end())
         return predict(x);
-    auto above = std::upper_bound(m_positions.begin(), m_positions.end(), at + kSamePosition,
-                                  [](double v, const Position& p) { return v < p.at; });
-    const Position& p = above == m_positions.begin() ? m_positions.front() : *std::prev(above);
     double y = 0.0;
     for (size_t i = 0; i < kInputs; ++i)
-        y += p.theta[i] * x[i];
-    return above == m_positions.begin() ? y : std::max(y, p.floor);
+        y += p->theta[i] * x[i];
+    return std::max(y, floorAt(at));
+}
+
+double WindowedFit::floorAt(double at) const {
+    const auto above = std::upper_bound(m_floors.begin(), m_floors.end(), at + kSamePosition,
+                                        [](double v, const Floor& f) { return v < f.at; });
+    return above == m_floors.begin() ? -std::numeric_limits<double>::infinity()
+                                     : std::prev(above)->floor;
+}
+
+std::optional<double> WindowedFit::highestPosition() const {
+    std::optional<double> top;
+    for (const Obs& o : m_obs)
+        if (std::isfinite(o.at) && (!top || o.at > *top))
+            top = o.at;
+    for (const Recalled& r : m_recalled)
+        if (!top || r.at > *top)
+            top = r.at;
+    return top;
 }
 
 void WindowedFit::refitPositions() {
@@ -192,12 +224,10 @@ void WindowedFit::refitPositions() {
     const std::vector<Position> previous = std::move(m_positions);
     m_positions.clear();
     auto prior = [&](double at) -> const Vec& {
-        const auto above = std::upper_bound(previous.begin(), previous.end(), at + kSamePosition,
-                                            [](double v, const Position& p) { return v < p.at; });
-        if (previous.empty())
-            return m_theta;
-        return above == previous.begin() ? previous.front().theta : std::prev(above)->theta;
+        const auto p = atOrBelow(previous, at);
+        return p == previous.end() ? m_theta : p->theta;
     };
+    refitFloors();
     std::vector<const Obs*> obs;
     for (const Obs& o : m_obs)
         if (std::isfinite(o.at))
@@ -206,40 +236,89 @@ void WindowedFit::refitPositions() {
         return;
     std::stable_sort(obs.begin(), obs.end(),
                      [](const Obs* l, const Obs* r) { return l->at < r->at; });
-    // Groups of one position: [begin, end) in obs.
+    // Each position's fit reads the observations up to its last one, at least kMinAtOrBelow.
+    for (size_t i = 0; i < obs.size(); ++i) {
+        const bool last = i + 1 == obs.size() || obs[i + 1]->at - obs[i]->at > kSamePosition;
+        if (!last || i + 1 < kMinAtOrBelow)
+            continue;
+        std::vector<Sample> samples;
+        for (size_t k = 0; k <= i; ++k)
+            samples.push_back({&obs[k]->x, obs[k]->y, 1.0});
+        m_positions.push_back(
+            {obs[i]->at, robustFit(std::move(samples), prior(obs[i]->at), m_ridge)});
+    }
+}
+
+void WindowedFit::refitFloors() {
+    // The window's observations, and the recalled ones at positions the window no longer holds
+    // (a position the window holds reads only its fresh frames: the content moves on).
+    std::vector<Recalled> seen;
+    for (const Obs& o : m_obs)
+        if (std::isfinite(o.at))
+            seen.push_back({o.at, o.y});
+    const size_t fresh = seen.size();
+    for (const Recalled& r : m_recalled) {
+        bool held = false;
+        for (size_t i = 0; i < fresh && !held; ++i)
+            held = std::fabs(seen[i].at - r.at) <= kSamePosition;
+        if (!held)
+            seen.push_back(r);
+    }
+    m_floors.clear();
+    std::stable_sort(seen.begin(), seen.end(),
+                     [](const Recalled& l, const Recalled& r) { return l.at < r.at; });
+    // Per position: its mean and count, and the spread within positions pooled.
+    struct Block {
+        double at, mean, n;
+    };
+    std::vector<Block> blocks;
     std::vector<std::pair<size_t, size_t>> groups;
-    for (size_t i = 0; i < obs.size(); ++i)
-        if (groups.empty() || obs[i]->at - obs[groups.back().first]->at > kSamePosition)
+    for (size_t i = 0; i < seen.size(); ++i)
+        if (groups.empty() || seen[i].at - seen[groups.back().first].at > kSamePosition)
             groups.push_back({i, i + 1});
         else
             groups.back().second = i + 1;
-    // The spread within a position, pooled over the positions observed more than once.
     double within = 0.0;
     size_t dof = 0;
-    std::vector<double> mean(groups.size());
-    for (size_t g = 0; g < groups.size(); ++g) {
-        const auto [b, e] = groups[g];
+    for (const auto& [b, e] : groups) {
         double sum = 0.0;
         for (size_t i = b; i < e; ++i)
-            sum += obs[i]->y;
-        mean[g] = sum / double(e - b);
+            sum += seen[i].y;
+        const double mean = sum / double(e - b);
         for (size_t i = b; i < e; ++i)
-            within += (obs[i]->y - mean[g]) * (obs[i]->y - mean[g]);
+            within += (seen[i].y - mean) * (seen[i].y - mean);
         dof += e - b - 1;
+        blocks.push_back({seen[b].at, mean, double(e - b)});
     }
-    const double sd = dof > 0 ? std::sqrt(within / double(dof)) : 0.0;
+    if (dof == 0)
+        return;
+    const double sd = std::sqrt(within / double(dof));
+    // The cost cannot fall as the position grows: the means' isotonic regression (pool adjacent
+    // violators, weighed by counts). A frame the host preempted at a position seen once (51 ms
+    // among 0.2 ms renders) pools with the cheap positions above it and floors little; a cliff
+    // that every position past it measures stays whole, even seen once at each.
+    std::vector<Block> pooled;
+    std::vector<size_t> first;  // the index in `blocks` each pooled block starts at
+    for (size_t g = 0; g < blocks.size(); ++g) {
+        pooled.push_back(blocks[g]);
+        first.push_back(g);
+        while (pooled.size() >= 2 && pooled[pooled.size() - 2].mean > pooled.back().mean) {
+            Block& l = pooled[pooled.size() - 2];
+            const Block& r = pooled.back();
+            l.mean = (l.mean * l.n + r.mean * r.n) / (l.n + r.n);
+            l.n += r.n;
+            pooled.pop_back();
+            first.pop_back();
+        }
+    }
+    // Each position's floor: its pooled block's mean less two standard errors, never below a
+    // smaller position's.
     double floor = -std::numeric_limits<double>::infinity();
-    for (size_t g = 0; g < groups.size(); ++g) {
-        const auto [b, e] = groups[g];
-        if (dof > 0)
-            floor = std::max(floor, mean[g] - 2.0 * sd / std::sqrt(double(e - b)));
-        if (e < kMinAtOrBelow)
-            continue;
-        std::vector<Sample> samples;
-        for (size_t i = 0; i < e; ++i)
-            samples.push_back({&obs[i]->x, obs[i]->y, 1.0});
-        const Vec theta = robustFit(std::move(samples), prior(obs[b]->at), m_ridge);
-        m_positions.push_back({obs[b]->at, theta, floor});
+    for (size_t k = 0; k < pooled.size(); ++k) {
+        const size_t end = k + 1 < pooled.size() ? first[k + 1] : blocks.size();
+        floor = std::max(floor, pooled[k].mean - 2.0 * sd / std::sqrt(pooled[k].n));
+        for (size_t g = first[k]; g < end; ++g)
+            m_floors.push_back({blocks[g].at, floor});
     }
 }
 

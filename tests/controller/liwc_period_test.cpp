@@ -264,14 +264,15 @@ TEST(LiwcPeriodObjective, LatePeripheriesEndTheColdStart) {
                 m.t_remote_ms = 0.0;
             }
         });
-    // All local from frame 20 on but for a try of the link now and then, each after a longer
-    // wait (the stale estimate's relaxation, TriesTheLinkAgainAfterAnOutage...), each refused.
+    // All local from frame 30 on (e1 climbs one window step per measured frame, two frames
+    // apart at this depth) but for a try of the link now and then, each after a longer wait
+    // (the stale estimate's relaxation, TriesTheLinkAgainAfterAnOutage...), each refused.
     std::vector<size_t> tries;
-    for (size_t i = 20; i < d.size(); ++i)
+    for (size_t i = 30; i < d.size(); ++i)
         if (planner.plan(f.gaze, d[i].e1_deg).hasRemote() &&
             !planner.plan(f.gaze, d[i - 1].e1_deg).hasRemote())
             tries.push_back(i);
-    EXPECT_FALSE(planner.plan(f.gaze, d[20].e1_deg).hasRemote()) << d[20].e1_deg;
+    EXPECT_FALSE(planner.plan(f.gaze, d[30].e1_deg).hasRemote()) << d[30].e1_deg;
     EXPECT_LE(tries.size(), 2u);
     if (tries.size() == 2) {
         EXPECT_GT(tries[1] - tries[0], 35u);
@@ -1010,6 +1011,11 @@ TEST(LiwcPeriodObjective, ACliffInTheFoveaRenderDoesNotBendLBelowIt) {
             m.t_local_ms += cliff(m.e1_deg);
             m.server_ms = truth.serverMs(f, planner.plan(f.gaze, m.e1_deg));
         });
+    // No decision goes more than one window step past the cliff: with decisions in flight
+    // unmeasured the far search walked 12° to 37° in five frames, and once the cliff's frames
+    // left the window it walked there again every window.
+    for (size_t i = 0; i < d.size(); ++i)
+        ASSERT_LE(d[i].e1_deg, kCliffDeg + 5.0 + 1e-9) << "frame " << i;
     // L at the e1 it holds, below the cliff, is what the frames there measure: the line through
     // both sides put it at 3.2-3.5x.
     for (const double e1 : {d.back().e1_deg, 10.0}) {

@@ -239,5 +239,47 @@ TEST(WindowedFit, OneOutlierDoesNotTiltTheFit) {
     }
 }
 
+// A frame the host preempted at a position seen once (51 ms among 0.2 ms renders at a 0.3
+// headset share) floored every larger position at 51 ms for a window. The positions' means
+// are pooled where they fall as the position grows: one frame among 31 cheap ones above it
+// floors little.
+TEST(WindowedFit, OnePreemptedFrameAtAPositionSeenOnceFloorsLittle) {
+    WindowedFit fit({0.0, 0.0, 0.0}, 32, 1.0);
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> noise(-0.02, 0.02);
+    fit.add({1.0, 0.0, 0.2}, 51.0, 4.5);
+    for (int i = 0; i < 31; ++i)
+        fit.add({1.0, 0.0, 0.9}, 0.2 + noise(rng), 9.5);
+    EXPECT_LT(fit.predictAt({1.0, 0.0, 0.9}, 9.5), 2.5);
+    EXPECT_LT(fit.predictAt({1.0, 0.0, 1.0}, 10.0), 2.5);
+}
+
+// A cliff measured a few times and then left (e1 held below it for more than a window) is
+// still known: before, once its frames left the window the fit extrapolated the cheap side
+// past it and drew e1 back into it every window.
+TEST(WindowedFit, ACliffThatLeftTheWindowIsRecalled) {
+    WindowedFit fit({0.0, 0.0, 0.0}, 32, 1.0);
+    std::mt19937 rng(19);
+    std::uniform_real_distribution<double> u(-0.05, 0.05);
+    auto add = [&](double e1) {
+        fit.add({1.0, 0.0, e1 * e1 * 0.01}, (e1 > 12.0 ? 50.0 : 1.0) * (1.0 + u(rng)), e1);
+    };
+    for (int i = 0; i < 16; ++i)
+        add(i % 2 ? 10.0 : 8.0);
+    add(14.0);
+    add(14.0);
+    for (int i = 0; i < 48; ++i)
+        add(i % 2 ? 10.0 : 8.0);
+    ASSERT_TRUE(fit.highestPosition().has_value());
+    EXPECT_DOUBLE_EQ(*fit.highestPosition(), 14.0);
+    EXPECT_GT(fit.predictAt({1.0, 0.0, 1.96}, 14.0), 40.0);
+    EXPECT_GT(fit.predictAt({1.0, 0.0, 2.56}, 16.0), 40.0);
+    EXPECT_NEAR(fit.predictAt({1.0, 0.0, 1.0}, 10.0), 1.0, 0.5);
+    // Past kRecalledWindows windows more it is forgotten, and e1 may look again.
+    for (int i = 0; i < int(WindowedFit::kRecalledWindows * 32); ++i)
+        add(i % 2 ? 10.0 : 8.0);
+    EXPECT_DOUBLE_EQ(*fit.highestPosition(), 10.0);
+}
+
 }  // namespace
 }  // namespace qvr

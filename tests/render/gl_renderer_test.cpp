@@ -284,6 +284,53 @@ TEST(GlRenderer, ShadingIsTextureTimesLightmapTimesVertexColour) {
 namespace qvr {
 namespace {
 
+// The renderer keeps one framebuffer per sample count that only grows, and draws each view
+// into its corner: a view rendered after a larger one is, pixel for pixel, what a renderer that
+// never drew the larger one renders (the clear and the multisample resolve stay in the corner).
+TEST(GlRenderer, AViewAfterALargerOneIsWhatAFreshRendererDraws) {
+    QVR_GL_RENDERER_OR_SKIP(gl);
+    for (int samples : {1, 4}) {
+        if (gl->info().max_samples < samples)
+            continue;
+        GlRendererOptions options;
+        options.msaa_samples = samples;
+        auto used = GlRenderer::create(options);
+        auto fresh = GlRenderer::create(options);
+        ASSERT_TRUE(used && fresh);
+        const HmdProfile profile = test::smallProfile();
+        Pose head;
+        head.orientation = quatFromEulerDeg({12.0, -8.0, 0.0});
+        ASSERT_TRUE((*used)->upload(test::texturedRoom()));
+        ASSERT_TRUE((*fresh)->upload(test::texturedRoom()));
+        LayerRect l;
+        l.rect = {150, 40, 290, 200};
+        l.scale = 2.5;
+        l.width_px = 56;
+        l.height_px = 64;
+        ImageRgba8 large, after, alone;
+        ASSERT_TRUE((*used)->render(fullFrameView(profile, head, Eye::kLeft), large));
+        ASSERT_TRUE((*used)->render(layerView(profile, head, Eye::kLeft, l), after));
+        ASSERT_TRUE((*fresh)->render(layerView(profile, head, Eye::kLeft, l), alone));
+        ASSERT_EQ(after.width(), 56);
+        ASSERT_EQ(after.height(), 64);
+        ASSERT_EQ(alone.width(), 56);
+        int differ = 0;
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 56; ++x)
+                for (int c = 0; c < 4; ++c)
+                    differ += after.at(x, y, c) != alone.at(x, y, c);
+        EXPECT_EQ(differ, 0) << samples << " samples";
+        // And the larger view again, drawn into the same storage, is what it was.
+        ImageRgba8 again;
+        ASSERT_TRUE((*used)->render(fullFrameView(profile, head, Eye::kLeft), again));
+        int changed = 0;
+        for (int y = 0; y < large.height(); ++y)
+            for (int x = 0; x < large.width(); ++x)
+                changed += again.at(x, y, 0) != large.at(x, y, 0);
+        EXPECT_EQ(changed, 0) << samples << " samples";
+    }
+}
+
 TEST(GlRenderer, MultisamplingBlendsEdgesAndASecondContextCoexists) {
     QVR_GL_RENDERER_OR_SKIP(gl);
     GlRendererOptions options;

@@ -140,6 +140,8 @@ private:
     double peripheryBits(const Gaze& gaze, double e1_deg) const;
     double peripheryTriangles(double e1_deg) const;
     double peripheryPixels(const Gaze& gaze, double e1_deg) const;
+    // The largest e1 a candidate may take: hi, or one window step past the largest measured.
+    double trustedTop(double hi) const;
     Decision decidePeriod(const WorkloadFrame& frame, double lo, double hi);
     static double prefixAt(const std::vector<double>& prefix, double ring_deg, double e_deg);
 

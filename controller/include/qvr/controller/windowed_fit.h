@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace qvr {
@@ -28,11 +29,15 @@ public:
     double predict(const Vec& x) const;
     // For a cost that cannot fall as its position grows: the fit over the observations taken at
     // positions up to `at` (at least kMinAtOrBelow of them: the fewest positions that hold as
-    // many), so a cliff past `at` bends no line below it; and no less than any smaller
-    // position's mean observation less two standard errors (the window's spread within a
-    // position), which a line through a cliff's few observations and many cheap ones puts
-    // under it. predict(x) before any observation has a position.
+    // many), so a cliff past `at` bends no line below it; and no less than the floor at `at`:
+    // the isotonic (non-decreasing) regression of the positions' mean observations, less two
+    // standard errors (the spread within a position), over the window and the positions
+    // recalled from the kRecalledWindows windows before it — a line through a cliff's few
+    // observations and many cheap ones puts it under the cliff, and a cliff that left the
+    // window drew e1 back to it every window. predict(x) before any observation has a position.
     double predictAt(const Vec& x, double at) const;
+    // The largest position observed in the window or recalled: above it predictAt extrapolates.
+    std::optional<double> highestPosition() const;
     const Vec& theta() const { return m_theta; }
     size_t size() const { return m_obs.size(); }
     size_t window() const { return m_window; }
@@ -40,6 +45,8 @@ public:
     // Positions within this of a group's first are one position (e1 moves on a grid).
     static constexpr double kSamePosition = 0.05;
     static constexpr size_t kMinAtOrBelow = 8;
+    // Windows of positions and costs kept for the floor after they leave the window.
+    static constexpr size_t kRecalledWindows = 3;
 
 private:
     void refit();
@@ -49,14 +56,27 @@ private:
         double y;
         double at;
     };
-    // The fit over the observations at positions up to `at`, and the highest floor there.
+    void refitFloors();
+    double floorAt(double at) const;
+    // The fit over the observations at positions up to `at`.
     struct Position {
         double at;
         Vec theta;
+    };
+    struct Recalled {
+        double at;
+        double y;
+    };
+    struct Floor {
+        double at;
         double floor;
     };
+    static std::vector<Position>::const_iterator atOrBelow(const std::vector<Position>& positions,
+                                                           double at);
     std::deque<Obs> m_obs;
     std::vector<Position> m_positions;  // ascending `at`
+    std::deque<Recalled> m_recalled;    // observations with a position that left the window
+    std::vector<Floor> m_floors;        // ascending `at`, non-decreasing
     Vec m_theta;
     size_t m_window;
     double m_ridge;
