@@ -270,6 +270,7 @@ void WindowedFit::refitFloors() {
     // Per position: its mean and count, and the spread within positions pooled.
     struct Block {
         double at, mean, n;
+        size_t first;  // pooled: the first position (index in `blocks`) it holds
     };
     std::vector<Block> blocks;
     std::vector<std::pair<size_t, size_t>> groups;
@@ -288,7 +289,7 @@ void WindowedFit::refitFloors() {
         for (size_t i = b; i < e; ++i)
             within += (seen[i].y - mean) * (seen[i].y - mean);
         dof += e - b - 1;
-        blocks.push_back({seen[b].at, mean, double(e - b)});
+        blocks.push_back({seen[b].at, mean, double(e - b), blocks.size()});
     }
     if (dof == 0)
         return;
@@ -298,26 +299,23 @@ void WindowedFit::refitFloors() {
     // among 0.2 ms renders) pools with the cheap positions above it and floors little; a cliff
     // that every position past it measures stays whole, even seen once at each.
     std::vector<Block> pooled;
-    std::vector<size_t> first;  // the index in `blocks` each pooled block starts at
-    for (size_t g = 0; g < blocks.size(); ++g) {
-        pooled.push_back(blocks[g]);
-        first.push_back(g);
+    for (const Block& block : blocks) {
+        pooled.push_back(block);
         while (pooled.size() >= 2 && pooled[pooled.size() - 2].mean > pooled.back().mean) {
             Block& l = pooled[pooled.size() - 2];
             const Block& r = pooled.back();
             l.mean = (l.mean * l.n + r.mean * r.n) / (l.n + r.n);
             l.n += r.n;
             pooled.pop_back();
-            first.pop_back();
         }
     }
     // Each position's floor: its pooled block's mean less two standard errors, never below a
     // smaller position's.
     double floor = -std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < pooled.size(); ++k) {
-        const size_t end = k + 1 < pooled.size() ? first[k + 1] : blocks.size();
+        const size_t end = k + 1 < pooled.size() ? pooled[k + 1].first : blocks.size();
         floor = std::max(floor, pooled[k].mean - 2.0 * sd / std::sqrt(pooled[k].n));
-        for (size_t g = first[k]; g < end; ++g)
+        for (size_t g = pooled[k].first; g < end; ++g)
             m_floors.push_back({blocks[g].at, floor});
     }
 }
