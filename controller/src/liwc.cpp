@@ -41,6 +41,7 @@ double LiwcPolicy::gpuPixelsPerMs() const {
 
 void LiwcPolicy::prepareFrame(const WorkloadFrame& frame) const {
     m_cover_deg = m_sizes.coverDeg(frame.gaze);
+    m_gaze = frame.gaze;
     auto prefix = [](const std::vector<double>& rings, std::vector<double>& out) {
         out.resize(rings.size() + 1);
         out[0] = 0.0;
@@ -77,11 +78,17 @@ double LiwcPolicy::localMs(double e1_deg) const {
         // the frames at e1 or below: a fovea that takes in a dense model past some e1 costs tens
         // of ms more there, and one line through both sides put L below that cliff at 2-3x what
         // it measured, so e1 fled to 3.5° where 10° was best (docs/LIWC.md "Fits").
-        const double render =
-            std::max(0.0, m_local_fit.predictAt({1.0, tris * 1e-5, pixels * 1e-5}, e1_deg));
+        const double render = renderMs(tris, pixels, e1_deg);
         if (!m_render_apart || m_local_rest.empty())
             return render;
-        return m_local_rest_sum / double(m_local_rest.size()) + render;
+        const double rest = m_local_rest_sum / double(m_local_rest.size());
+        if (m_headset_share >= 1.0)
+            return rest + render;
+        // Under a CFS quota the rest holds the throttling the current e1's work brought on:
+        // the CPU a candidate costs more or less than the current e1 (its render, its
+        // periphery's decode) moves the busy time by 1/s of it, s the quota's share.
+        const double extra = headsetCpuMs(e1_deg) - headsetCpuMs(m_e1_deg);
+        return std::max(render, rest + render + (1.0 / m_headset_share - 1.0) * extra);
     }
     return std::max(0.0,
                     m_gpu_theta[0] + m_gpu_theta[1] * tris * 1e-5 + m_gpu_theta[2] * pixels * 1e-5);
@@ -102,6 +109,29 @@ double LiwcPolicy::remoteMs(const Gaze& gaze, double e1_deg) const {
     if (e1_deg >= m_cover_deg)
         return 0.0;
     return m_remote_base_ms + peripheryBits(gaze, e1_deg) / m_throughput_bps * 1000.0;
+}
+
+double LiwcPolicy::renderMs(double tris, double pixels, double e1_deg) const {
+    return std::max(0.0, m_local_fit.predictAt({1.0, tris * 1e-5, pixels * 1e-5}, e1_deg));
+}
+
+double LiwcPolicy::headsetCpuMs(double e1_deg) const {
+    const double e = e1_deg >= m_cover_deg ? 1e9 : e1_deg;
+    return renderMs(prefixAt(m_prefix_tris, m_header.ring_deg, e),
+                    prefixAt(m_prefix_pixels, m_header.ring_deg, e), e1_deg) +
+           decodeMs(e1_deg);
+}
+
+double LiwcPolicy::decodeMs(double e1_deg) const {
+    if (e1_deg >= m_cover_deg || m_decode_fit.size() == 0)
+        return 0.0;
+    const PeripheryShape p = m_sizes.lookup(m_gaze, e1_deg);
+    return std::max(0.0, m_decode_fit.predict(
+                             {1.0, 2.0 * p.middle_pixels * 1e-5, 2.0 * p.outer_pixels * 1e-5}));
+}
+
+void LiwcPolicy::setHeadsetShare(double share) {
+    m_headset_share = std::isfinite(share) && share > 0.0 && share <= 1.0 ? share : 1.0;
 }
 
 void LiwcPolicy::setLinkEstimate(double throughput_bps) {
@@ -452,6 +482,10 @@ void LiwcPolicy::observe(const FrameMeasurement& m) {
         else
             updateGpuRates(m.triangles_local, m.pixels_local, m.t_local_ms);
     }
+    // A held frame's periphery, all in on time: its decode (a move's key frames decode longer).
+    if (m_config.frame_period_objective && kind == FrameKind::kHeld && m.t_decode_ms > 0.0 &&
+        !m.periphery_late && !m.periphery_withheld)
+        m_decode_fit.add({1.0, m.middle_pixels * 1e-5, m.outer_pixels * 1e-5}, m.t_decode_ms);
     if (m.throughput_bps > 0.0)
         m_throughput_bps = (1.0 - b) * m_throughput_bps + b * m.throughput_bps;
     if (m_config.frame_period_objective && decided && m.t_remote_ms > 0.0) {

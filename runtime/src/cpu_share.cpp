@@ -2,11 +2,13 @@
 // sched-bwc.rst): cpu.cfs_quota_us / cpu.cfs_period_us in v1, "quota period" in cpu.max in v2.
 #include "qvr/runtime/cpu_share.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <sys/stat.h>
@@ -152,6 +154,73 @@ CpuShareGroup::Throttling CpuShareGroup::throttling() const {
             t.throttled_ms = double(v) * 1e-3;
     }
     return t;
+}
+
+namespace {
+
+// quota / period of one group's directory; nullopt when it sets none or cannot be read.
+std::optional<double> groupShare(const std::string& dir, bool v2) {
+    long long quota = -1, period = 0;
+    if (v2) {
+        std::ifstream in(dir + "/cpu.max");
+        std::string q;
+        if (!(in >> q >> period) || q == "max")
+            return std::nullopt;
+        try {
+            quota = std::stoll(q);
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+    } else {
+        std::ifstream q(dir + "/cpu.cfs_quota_us"), p(dir + "/cpu.cfs_period_us");
+        if (!(q >> quota) || !(p >> period))
+            return std::nullopt;
+    }
+    if (quota <= 0 || period <= 0)
+        return std::nullopt;
+    return double(quota) / double(period);
+}
+
+// The smallest share of `path` and the groups above it, under `base`.
+double shareAlong(const std::string& base, std::string path, bool v2) {
+    double share = 1.0;
+    while (true) {
+        if (auto s = groupShare(base + path, v2))
+            share = std::min(share, *s);
+        if (path.empty() || path == "/")
+            break;
+        const size_t slash = path.find_last_of('/');
+        path = slash == std::string::npos ? std::string() : path.substr(0, slash);
+    }
+    return share;
+}
+
+}  // namespace
+
+double cpuQuotaShare(const std::string& proc_cgroup, const std::string& root) {
+    // Each line: hierarchy-id:controllers:path (man 7 cgroups). v1 names "cpu" among the
+    // controllers; v2 is the line "0::path".
+    std::ifstream in(proc_cgroup);
+    std::string line;
+    double share = 1.0;
+    while (std::getline(in, line)) {
+        const size_t a = line.find(':');
+        const size_t b = a == std::string::npos ? a : line.find(':', a + 1);
+        if (b == std::string::npos || b + 1 >= line.size() || line[b + 1] != '/')
+            continue;
+        const std::string controllers = line.substr(a + 1, b - a - 1);
+        const std::string path = line.substr(b + 1);
+        std::istringstream names(controllers);
+        bool cpu = false;
+        for (std::string n; std::getline(names, n, ',');)
+            cpu = cpu || n == "cpu";
+        if (cpu)
+            share = std::min(share,
+                             shareAlong(root.empty() ? "/sys/fs/cgroup/cpu" : root, path, false));
+        else if (controllers.empty() && line.compare(0, a, "0") == 0)
+            share = std::min(share, shareAlong(root.empty() ? "/sys/fs/cgroup" : root, path, true));
+    }
+    return std::clamp(share, CpuShareGroup::kMinShare, 1.0);
 }
 
 }  // namespace qvr::runtime

@@ -19,6 +19,7 @@
 #include "qvr/core/silence.h"
 #include "qvr/render/camera.h"
 #include "qvr/runtime/affinity.h"
+#include "qvr/runtime/cpu_share.h"
 #include "qvr/runtime/workload_probe.h"
 
 namespace qvr::runtime {
@@ -165,14 +166,18 @@ public:
                 auto liwc = std::make_unique<LiwcPolicy>(m_probe.header(),
                                                          liwcConfig(false, pipelineDepth()));
                 m_liwc = liwc.get();
+                m_liwc_any = m_liwc;
                 m_policy = std::move(liwc);
                 break;
             }
-            case Design::Sw:
+            case Design::Sw: {
                 // The same model as qvr's, fed as software would be (docs/RUNTIME.md).
-                m_policy = std::make_unique<LiwcPolicy>(m_probe.header(),
-                                                        liwcConfig(true, pipelineDepth()));
+                auto sw = std::make_unique<LiwcPolicy>(m_probe.header(),
+                                                       liwcConfig(true, pipelineDepth()));
+                m_liwc_any = sw.get();
+                m_policy = std::move(sw);
                 break;
+            }
             case Design::Ffr:
             case Design::Fixed:
                 m_policy = std::make_unique<FixedPolicy>(m_config.fixed_e1_deg);
@@ -202,6 +207,9 @@ public:
         m_origin_ns = m_clock.nowNs();
         result.origin_ns = m_origin_ns;
         m_pacer.reset();
+        // Read as the frames start: a headset joins its share group after it is set up.
+        if (m_liwc_any)
+            m_liwc_any->setHeadsetShare(cpuQuotaShare());
         if (m_client)
             tryConnect(true);
         // Frames are prepared (pose, decision, request) up to pipeline_depth ahead of the one
@@ -828,11 +836,13 @@ private:
         m.index = i;
         m.e1_deg = plan.e1_deg;
         setHeadsetTimes(m, static_cast<int64_t>(m_depth), t->headset_busy_ms, t->t_local_ms);
+        m.t_decode_ms = t->decode_ms;
         m.t_remote_ms = t->remote_requested ? t->t_remote_ms : 0.0;
         if (isStartUpFrame(i, static_cast<int64_t>(m_depth), t->remote_requested || prep.withheld,
                            m_first_composed_frame)) {
             m.t_local_ms = 0.0;
             m.t_render_ms = 0.0;
+            m.t_decode_ms = 0.0;
             m.t_remote_ms = 0.0;
         }
         if (prep.wf) {
@@ -884,7 +894,8 @@ private:
     Compositor m_compositor;
     std::unique_ptr<Renderer> m_renderer;
     std::unique_ptr<FoveaPolicy> m_policy;
-    LiwcPolicy* m_liwc = nullptr;  // m_policy when it is qvr's LIWC
+    LiwcPolicy* m_liwc = nullptr;      // m_policy when it is qvr's LIWC
+    LiwcPolicy* m_liwc_any = nullptr;  // m_policy when it is LIWC, qvr's or sw's
     double m_last_e1_deg = kFfrE1Deg;
     std::unique_ptr<net::Client> m_client;
     std::array<std::unique_ptr<VideoDecoder>, net::kMaxStreams> m_decoders;

@@ -526,6 +526,74 @@ TEST(LiwcPeriodObjective, SettlesNearTheBestPipelinedPeriodWhenLocalRisesAndRemo
     }
 }
 
+// A headset under a CFS quota of 0.3 of its core (seed 11235 c10: 2CylinderEngine, a Verizon LTE
+// trace, share 0.3): the fovea render and the periphery's decode run before the quota throttles,
+// so their own times are their CPU, but the headset's busy time is its whole CPU over the share.
+// The render's time alone gave L a slope a third of the busy time's; the period looked flat in e1
+// while the busy time rose, the tie went to the smaller motion-to-photon of a larger fovea, and qvr
+// ran at e1 8-10° (30-38 FPS) where fixed 4-6° ran at 43.
+TEST(LiwcPeriodObjective, UnderACpuQuotaTheRendersSlopeIsItsCpuOverTheShare) {
+    const WorkloadHeader h = header();
+    const LayerPlanner planner(h.profile);
+    constexpr double kShare = 0.3;
+    Truth truth;
+    truth.local_fixed_ms = 4.0;  // UCA, decode and the rest, in CPU ms
+    truth.local_triangles_per_ms = 100'000.0;
+    truth.local_pixels_per_ms = 1'500'000.0;
+    truth.server_triangles_per_ms = 200'000.0;
+    truth.throughput_bps = 20e6;
+    truth.noise = 0.02;
+    const WorkloadFrame f = frame(0, 20'000.0);
+    auto renderCpu = [&](double e1) { return truth.localMs(f, e1) - truth.local_fixed_ms; };
+    // The periphery's decode: 1 ms a million pixels, falling as the fovea grows.
+    auto decodeCpu = [&](double e1) {
+        const LayerPlan plan = planner.plan(f.gaze, e1);
+        return plan.hasRemote() ? 2.0 * double(plan.middle_pixels + plan.outer_pixels) * 1e-6 : 0.0;
+    };
+    auto busy = [&](double e1) { return (truth.localMs(f, e1) + decodeCpu(e1)) / kShare; };
+    auto periodAt = [&](double e1) {
+        const LayerPlan plan = planner.plan(f.gaze, e1);
+        const double remote = truth.remoteMs(f, plan);
+        const double link = plan.hasRemote() ? truth.transmissionMs(plan) : 0.0;
+        return std::max({busy(e1), remote - link, link, remote / 2.0});
+    };
+    double best_e = 0.0, best_period = INFINITY;
+    for (double e = 1.0; e <= 40.0; e += 0.1)
+        if (periodAt(e) < best_period) {
+            best_period = periodAt(e);
+            best_e = e;
+        }
+    // The made-up headset: the link binds at small e1, the quota past the best.
+    ASSERT_GT(best_e, 4.0);
+    ASSERT_LT(best_e, 25.0);
+    ASSERT_GT(periodAt(best_e + 8.0), 1.15 * best_period);
+    auto runAt = [&](double share) {
+        LiwcConfig c = periodConfig();
+        c.e1_initial_deg = 3.0;
+        LiwcPolicy liwc(h, c);
+        liwc.setHeadsetShare(share);
+        return runWithLink(liwc, truth, planner, f, 150, 2, 11, [&](FrameMeasurement& m, int) {
+            m.t_render_ms = renderCpu(m.e1_deg);
+            m.t_decode_ms = decodeCpu(m.e1_deg);
+            m.t_local_ms = busy(m.e1_deg);
+        });
+    };
+    auto meanPeriod = [&](const std::vector<Decision>& d) {
+        double sum = 0.0;
+        for (size_t i = 100; i < d.size(); ++i)
+            sum += periodAt(d[i].e1_deg);
+        return sum / double(d.size() - 100);
+    };
+    const std::vector<Decision> told = runAt(kShare);
+    for (size_t i = 100; i < told.size(); ++i)
+        EXPECT_NEAR(told[i].e1_deg, best_e, 2.5) << "frame " << i;
+    EXPECT_LE(meanPeriod(told), 1.03 * best_period);
+    // Not told of the quota, the same LIWC sees a third of L's slope and runs past the best e1.
+    const std::vector<Decision> untold = runAt(1.0);
+    EXPECT_GT(meanPeriod(untold), 1.02 * meanPeriod(told));
+    EXPECT_GT(untold.back().e1_deg, told.back().e1_deg);
+}
+
 // Two frames in flight on one timeline: the headset starts frame n once it has done frame n − 1
 // and frame n − 2's layers have arrived; the server serves the requests in turn, and the link
 // carries the frames in turn, so the server works on a frame while the link carries the one
@@ -791,7 +859,7 @@ TEST(LiwcPeriodObjective, AHeldFramesNewCanvasIsAMovesCostNotTheSteadyState) {
     const WorkloadFrame f = frame(0, 20'000.0);
     auto decisions = [&](double extra_bits, bool flagged) {
         Truth truth;
-        truth.throughput_bps = 10e6;  // the link matters: a frame's bits move the period
+        truth.throughput_bps = 20e6;  // the link matters: a frame's bits move the period
         truth.canvas_frame = 80;
         truth.canvas_extra_bits = extra_bits;
         truth.canvas_flagged = flagged;
@@ -824,7 +892,7 @@ TEST(LiwcPeriodObjective, TheSessionsOpeningKeyFramesDoNotTeachTheSteadyState) {
     const WorkloadFrame f = frame(0, 20'000.0);
     auto decisions = [&](double opening_extra_bits) {
         Truth truth;
-        truth.throughput_bps = 10e6;  // the link matters: a frame's bits move the period
+        truth.throughput_bps = 20e6;  // the link matters: a frame's bits move the period
         truth.opening_extra_bits = opening_extra_bits;
         truth.move_extra_bits = 1.0;
         LiwcConfig c = periodConfig();

@@ -89,6 +89,14 @@ public:
     // The link's throughput as the acknowledgements show it now (the hardware monitors them at
     // decision time, §4.1); ignored by the reactive variant.
     void setLinkEstimate(double throughput_bps);
+    // The fraction of a core the headset's CPU quota allows (runtime/cpu_share.h
+    // cpuQuotaShare; 1: none). Under a quota s a ms more of the fovea's render costs the
+    // headset 1/s ms of wall time once the quota throttles it, while the render's own time,
+    // measured before the throttle lands, rises by that ms alone: L's slope in e1 is the render's
+    // over s, and so is the periphery's decode, which falls as e1 grows (docs/LIWC.md "Fits").
+    // Values outside (0, 1] read as 1.
+    void setHeadsetShare(double share);
+    double headsetShare() const { return m_headset_share; }
 
     // Eq. 2 with the current estimates, without the table's offset.
     double predictLocalMs(const WorkloadFrame& frame, double e1_deg) const;
@@ -111,6 +119,12 @@ private:
     // Per-frame quantities every candidate shares: computed once in decide().
     void prepareFrame(const WorkloadFrame& frame) const;
     double localMs(double e1_deg) const;
+    // frame_period_objective, render apart: the fovea render's fit at e1 for its cone's counts.
+    double renderMs(double tris, double pixels, double e1_deg) const;
+    // The CPU a candidate's fovea and periphery cost the headset: its render and its decode.
+    double headsetCpuMs(double e1_deg) const;
+    // The periphery's decode at e1 (0 once the fovea covers the frame), fitted on held frames.
+    double decodeMs(double e1_deg) const;
     double remoteMs(const Gaze& gaze, double e1_deg) const;
     // frame_period_objective: the server's part and the transmission, separately.
     double transmissionMs(const Gaze& gaze, double e1_deg) const;
@@ -147,6 +161,7 @@ private:
 
     // A cache of the frame being decided, so mutable.
     mutable double m_cover_deg = 90.0;
+    mutable Gaze m_gaze;
     mutable std::vector<double> m_prefix_tris;  // [k] = triangles in rings < k
     mutable std::vector<double> m_prefix_pixels;
 
@@ -182,6 +197,8 @@ private:
     // the render alone and the rest of the headset's busy time (UCA, decode, the frame's
     // overheads, the host's preemptions) is its mean over the same window: L = rest + render.
     bool m_render_apart = false;
+    double m_headset_share = 1.0;
+    WindowedFit m_decode_fit{WindowedFit::Vec{0.0, 0.0, 0.0}};  // [1, middle, outer pixels]
     std::deque<double> m_local_rest;
     double m_local_rest_sum = 0.0;
     void learnLocal(const FrameMeasurement& m);

@@ -29,6 +29,8 @@ struct FrameMeasurement {
     // When t_local_ms is the headset's whole busy time (frames in flight): the part of it that
     // rendered the fovea, the only part e1 moves (0: not measured apart).
     double t_render_ms = 0.0;
+    // The headset's decode calls for the frame's periphery (0: not measured).
+    double t_decode_ms = 0.0;
     double t_remote_ms = 0.0;
     double triangles_local = 0.0;  // triangles in the fovea cone, both eyes
     double pixels_local = 0.0;     // shaded fovea pixels, both eyes

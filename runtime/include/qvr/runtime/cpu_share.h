@@ -56,4 +56,12 @@ private:
     double m_share = 1.0;
 };
 
+// The fraction of one core this process's cgroup allows it: the smallest quota / period of its
+// cpu cgroup and the groups above it (v1 cpu.cfs_quota_us / cpu.cfs_period_us under the cpu
+// controller's mount, v2 cpu.max), capped at 1. 1 when no quota is set or none can be read (a
+// line or file it cannot parse is skipped). `proc_cgroup` is /proc/self/cgroup's path and `root`
+// the cgroup mount (v1: the cpu controller's, default /sys/fs/cgroup/cpu; v2: /sys/fs/cgroup).
+double cpuQuotaShare(const std::string& proc_cgroup = "/proc/self/cgroup",
+                     const std::string& root = "");
+
 }  // namespace qvr::runtime
