@@ -53,6 +53,35 @@ void BM_LiwcDecideAndUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_LiwcDecideAndUpdate);
 
+// The runtime's LIWC (docs/LIWC.md "The runtime's objective"): the pipelined period over the
+// window and the far grid, its fits refitted every frame; arg 1: told a CPU quota of 0.6.
+void BM_LiwcPeriodDecideAndUpdate(benchmark::State& state) {
+    Fixture& fx = fixture();
+    LiwcConfig c;
+    c.learn_remote_base = true;
+    c.frame_period_objective = true;
+    c.frames_in_flight = 2;
+    LiwcPolicy liwc(fx.trace.header, c);
+    if (state.range(0) != 0)
+        liwc.setHeadsetShare(0.6);
+    size_t i = 0;
+    for (auto _ : state) {
+        const WorkloadFrame& f = fx.trace.frames[i];
+        liwc.setLinkEstimate(fx.truth.throughputBps());
+        const Decision d = liwc.decide(f);
+        benchmark::DoNotOptimize(d);
+        FrameMeasurement m = fx.measurements[i];
+        m.e1_deg = d.e1_deg;
+        m.t_render_ms = 0.5 * m.t_local_ms;
+        m.t_decode_ms = 0.5;
+        m.server_ms = 0.5 * m.t_remote_ms;
+        liwc.observe(m);
+        i = (i + 1) % fx.trace.frames.size();
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_LiwcPeriodDecideAndUpdate)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 void BM_OracleDecide(benchmark::State& state) {
     Fixture& fx = fixture();
     auto oracle = makeOraclePolicy(fx.trace.header, fx.truth);
