@@ -266,8 +266,10 @@ void addTrianglesPerRing(const DrawList& list, const RenderView& view, float lod
         const float d = glm::length(v);
         double lo = 0.0, hi = M_PI;  // the eye inside the sphere: every direction
         if (d > radius) {
-            const double angle = std::acos(std::clamp(double(glm::dot(v, axis)) / d, -1.0, 1.0));
-            const double spread = std::asin(std::min(1.0, double(radius) / d));
+            // In single precision (a cluster's extent is known to far less): the probe runs on
+            // the headset's core before every frame.
+            const double angle = std::acos(std::clamp(glm::dot(v, axis) / d, -1.0f, 1.0f));
+            const double spread = std::asin(std::min(1.0f, radius / d));
             lo = std::max(0.0, angle - spread);
             hi = std::min(M_PI, angle + spread);
         }

@@ -244,7 +244,9 @@ public:
             retire(t);
             result.frames.push_back(std::move(t));
         }
+        m_frames_base += m_frames.size();
         m_frames.clear();
+        writeRetiredWorkload();
         result.summary = m_summary.finish();
         return result;
     }
@@ -285,10 +287,19 @@ private:
             m_frames.pop_front();
             ++m_frames_base;
         }
+        writeRetiredWorkload();
         // A frame that old is long past its wait limit: its streams, if they ever come, only
         // feed the decoders' reference chains.
         for (auto it = m_pending.begin(); it != m_pending.end();)
             it = it->telemetry < m_frames_base ? m_pending.erase(it) : std::next(it);
+    }
+    // The recorded workload of the frames retired so far, in frame order.
+    void writeRetiredWorkload() {
+        while (!m_unwritten_workload.empty() &&
+               m_unwritten_workload.front().index < static_cast<int64_t>(m_frames_base)) {
+            m_config.workload->writeFrame(m_unwritten_workload.front());
+            m_unwritten_workload.pop_front();
+        }
     }
     int64_t rel(int64_t t_ns) const { return t_ns - m_origin_ns; }
     double frameTimeMs(int64_t i) const { return contentTimeMs(i, m_config.profile.refresh_hz); }
@@ -705,12 +716,13 @@ private:
     }
 
     // The frame's workload as LIWC counted it, with the fragments its fovea pass shaded per
-    // fovea pixel (written after the pass, in frame order; docs/WORKLOAD_FORMAT.md frag_px).
+    // fovea pixel (docs/WORKLOAD_FORMAT.md frag_px); written when the frame retires, so the
+    // frames do not pay the JSON.
     void recordWorkload(Prepared& prep, double fragments_per_px) {
         if (!m_config.workload || !prep.wf)
             return;
         prep.wf->fovea_fragments_per_px = std::min(fragments_per_px, 1e3);
-        m_config.workload->writeFrame(*prep.wf);
+        m_unwritten_workload.push_back(*prep.wf);
     }
 
     // When to stop waiting for a frame's remote layers. The wait limit runs from when the server
@@ -903,6 +915,7 @@ private:
     std::deque<PendingFrame> m_pending;
     std::deque<FrameTelemetry> m_frames;  // the frames not yet retired, from m_frames_base
     size_t m_frames_base = 0;
+    std::deque<WorkloadFrame> m_unwritten_workload;  // recorded, not yet retired (in order)
     RunSummarizer m_summary;
     std::array<ImageRgba8, 2> m_display;
     HeadsetStats m_stats;

@@ -12,11 +12,46 @@ namespace {
 // Pixel rings are counted on a grid of this many samples per side at most; each sample stands
 // for the pixels around it, so a frame costs ~16k direction tests whatever the resolution.
 constexpr int kMaxPixelSamplesPerSide = 128;
+// Bins of the cosine table: 2 / 8192 wide, narrower than a 1° ring's cosine span everywhere but
+// within ~2° of the gaze or of its opposite, where the search takes over.
+constexpr int kCosineBins = 8192;
 }  // namespace
+
+WorkloadProbe::RingOfCosine::RingOfCosine(double ring_deg, int rings) {
+    constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
+    for (int k = 1; k < rings; ++k)
+        m_edges.push_back(std::cos(k * ring_deg * kRadPerDeg));
+    m_bins.resize(kCosineBins);
+    for (int b = 0; b < kCosineBins; ++b) {
+        const double lo = -1.0 + 2.0 * b / kCosineBins, hi = -1.0 + 2.0 * (b + 1) / kCosineBins;
+        m_bins[static_cast<size_t>(b)] = {search(std::min(hi, 1.0)), search(lo)};
+    }
+}
+
+int WorkloadProbe::RingOfCosine::search(double c) const {
+    // The number of edges at or above c: the edges decrease, so they form a prefix.
+    const auto it = std::partition_point(m_edges.begin(), m_edges.end(),
+                                         [c](double edge) { return edge >= c; });
+    return static_cast<int>(it - m_edges.begin());
+}
+
+int WorkloadProbe::RingOfCosine::operator()(double c) const {
+    c = std::clamp(c, -1.0, 1.0);
+    const int b = std::min(kCosineBins - 1, static_cast<int>((c + 1.0) * (kCosineBins / 2)));
+    const Bin& bin = m_bins[static_cast<size_t>(b)];
+    if (bin.low_ring == bin.high_ring)
+        return bin.low_ring;
+    if (bin.high_ring == bin.low_ring + 1)
+        return c <= m_edges[static_cast<size_t>(bin.low_ring)] ? bin.high_ring : bin.low_ring;
+    return search(c);
+}
 
 WorkloadProbe::WorkloadProbe(const HmdProfile& profile, std::shared_ptr<const TriangleBvh> bvh,
                              double ring_deg, int rings)
-    : m_profile(profile), m_geometry(profile), m_bvh(std::move(bvh)) {
+    : m_profile(profile),
+      m_geometry(profile),
+      m_ring_of_cosine(ring_deg, rings),
+      m_bvh(std::move(bvh)) {
     m_header.name = "qvr-run";
     m_header.source = "recorded by qvr run";
     m_header.profile = profile;
@@ -51,12 +86,8 @@ std::vector<double> WorkloadProbe::pixelsPerRing(const Gaze& gaze) const {
     // The same eccentricity as EyeGeometry::eccentricityDeg, the gaze's direction computed once.
     std::vector<double> rings(static_cast<size_t>(m_header.rings), 0.0);
     const glm::dvec3 g = m_geometry.gazeDirection(gaze);
-    constexpr double kDegPerRad = 180.0 / 3.14159265358979323846;
-    for (const PixelSample& s : m_pixel_samples) {
-        const double e = std::acos(std::clamp(glm::dot(g, s.direction), -1.0, 1.0)) * kDegPerRad;
-        const int k = std::clamp(static_cast<int>(e / m_header.ring_deg), 0, m_header.rings - 1);
-        rings[static_cast<size_t>(k)] += s.pixels;
-    }
+    for (const PixelSample& s : m_pixel_samples)
+        rings[static_cast<size_t>(m_ring_of_cosine(glm::dot(g, s.direction)))] += s.pixels;
     return rings;
 }
 

@@ -1,6 +1,7 @@
 // WorkloadProbe's pixel rings (LIWC's pixel input) against the eccentricity of every grid sample
 // computed from scratch by EyeGeometry::eccentricityDeg: the probe caches the grid's directions,
-// and must count exactly the same pixels into the same rings for any gaze.
+// and must count exactly the same pixels into the same rings for any gaze and any ring width (it
+// finds a sample's ring from its cosine through a table, not an acos).
 #include "qvr/runtime/workload_probe.h"
 
 #include <gtest/gtest.h>
@@ -31,24 +32,27 @@ std::vector<double> referenceRings(const HmdProfile& profile, const Gaze& gaze, 
 
 TEST(WorkloadProbe, PixelRingsMatchTheEccentricityOfEverySampleForAnyGaze) {
     for (const auto& [w, h] : {std::pair{1920, 2160}, std::pair{480, 540}, std::pair{333, 97}}) {
-        HmdProfile profile;
-        profile.width_px = w;
-        profile.height_px = h;
-        WorkloadProbe probe(profile, nullptr);
-        std::mt19937 rng(7);
-        std::uniform_real_distribution<double> deg(-30.0, 30.0);
-        for (int i = 0; i < 20; ++i) {
-            const Gaze gaze{deg(rng), deg(rng)};
-            const std::vector<double> got = probe.pixelsPerRing(gaze);
-            const auto want =
-                referenceRings(profile, gaze, probe.header().ring_deg, probe.header().rings);
-            ASSERT_EQ(got.size(), want.size());
-            double total = 0.0;
-            for (size_t k = 0; k < want.size(); ++k) {
-                EXPECT_EQ(got[k], want[k]) << w << "x" << h << " ring " << k;
-                total += got[k];
+        for (const auto& [ring_deg, rings] :
+             {std::pair{1.0, 120}, std::pair{0.375, 480}, std::pair{1.5, 30}}) {
+            HmdProfile profile;
+            profile.width_px = w;
+            profile.height_px = h;
+            WorkloadProbe probe(profile, nullptr, ring_deg, rings);
+            std::mt19937 rng(7);
+            std::uniform_real_distribution<double> deg(-30.0, 30.0);
+            for (int i = 0; i < 20; ++i) {
+                const Gaze gaze{deg(rng), deg(rng)};
+                const std::vector<double> got = probe.pixelsPerRing(gaze);
+                const auto want =
+                    referenceRings(profile, gaze, probe.header().ring_deg, probe.header().rings);
+                ASSERT_EQ(got.size(), want.size());
+                double total = 0.0;
+                for (size_t k = 0; k < want.size(); ++k) {
+                    EXPECT_EQ(got[k], want[k]) << w << "x" << h << " ring " << k;
+                    total += got[k];
+                }
+                EXPECT_EQ(total, 2.0 * w * h);  // every pixel of both eyes, once
             }
-            EXPECT_EQ(total, 2.0 * w * h);  // every pixel of both eyes, once
         }
     }
 }

@@ -84,7 +84,9 @@ struct HeadsetConfig {
     bool cluster_ring_counts = true;
     Clock* clock = nullptr;  // steady clock when null
     DisplaySink* display = nullptr;
-    WorkloadTraceWriter* workload = nullptr;          // records each frame's WorkloadFrame when set
+    // Records each frame's WorkloadFrame when set: held with the frame's telemetry and written
+    // as it retires (at the session's end when keep_frames is 0), off the frames' path.
+    WorkloadTraceWriter* workload = nullptr;
     std::function<void(int64_t frame)> before_frame;  // test hook, called at each frame start
     // Every frame's telemetry, once final, in order (e.g. a CSV written as the session runs).
     std::function<void(const FrameTelemetry&)> frame_sink;

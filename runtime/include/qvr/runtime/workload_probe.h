@@ -47,12 +47,32 @@ private:
     HmdProfile m_profile;
     EyeGeometry m_geometry;
     // The pixel-ring grid's view directions and the pixels each stands for, fixed by the
-    // profile: computed once, so a frame's pixel rings cost one dot product and one acos a sample.
+    // profile: computed once, so a frame's pixel rings cost one dot product and one table
+    // lookup a sample (RingOfCosine).
     struct PixelSample {
         glm::dvec3 direction;
         double pixels = 0.0;
     };
     std::vector<PixelSample> m_pixel_samples;
+    // The ring of a direction from the cosine of its angle to the gaze, without an acos: ring k
+    // holds the cosines in (cos((k+1)·ring_deg), cos(k·ring_deg)]. A table over [−1, 1] names
+    // the ring of each bin's ends; a bin that straddles one ring edge compares once against it,
+    // one that straddles several (near ±1 for narrow rings) searches the edges.
+    class RingOfCosine {
+    public:
+        RingOfCosine(double ring_deg, int rings);
+        int operator()(double c) const;
+
+    private:
+        int search(double c) const;
+        std::vector<double> m_edges;  // cos(k·ring_deg) for k = 1 … rings−1, decreasing
+        struct Bin {
+            int low_ring;   // the ring at the bin's upper cosine (the smaller one)
+            int high_ring;  // the ring at its lower cosine
+        };
+        std::vector<Bin> m_bins;
+    };
+    RingOfCosine m_ring_of_cosine;
     std::shared_ptr<const TriangleBvh> m_bvh;
     std::shared_ptr<const DrawList> m_clusters;
     float m_lod_error_px = 0.0f;
