@@ -17,6 +17,7 @@
 #include "qvr/render/camera.h"
 #include "qvr/render/draw_list.h"
 #include "qvr/render/renderer.h"
+#include "qvr/runtime/cpu_share.h"
 #include "qvr/runtime/workload_probe.h"
 #include "qvr/sim/capacity.h"
 #include "qvr/sim/network.h"
@@ -170,6 +171,12 @@ std::optional<RuntimeRunResult> runModel(const WorkloadTrace& trace, Design desi
     rc.frames = static_cast<int>(trace.frames.size());
     rc.warmup_frames = settings.warmup_frames;
     rc.record_scanout = settings.record_scanout;
+    // One headset under a quota runs as the kernel throttles it; several share the core by the
+    // capacity model's speed factors (predictDesign).
+    if (settings.headsets <= 1) {
+        rc.headset_share = settings.headset_share;
+        rc.quota_period_ms = runtime::CpuShareGroup::kDefaultPeriodUs * 1e-3;
+    }
     // The trace's frame k is the run's frame k (same poses).
     rc.layer_triangles = inputs.layer_triangles;
     rc.fovea_fragments = inputs.fovea_fragments;
@@ -189,10 +196,11 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     if (!simDesignOf(inputs.design, sd, fixed_e1))
         return p;
     p.speed = inputs.speed;
-    // A quota of `share` of the core per period: the headset's work takes 1 / share the wall
-    // time (docs/MODEL.md, the headset's share); N headsets on one server each get 1/N of its
-    // time and share the headset's core (sim/capacity.h capacityFactors).
-    const SideFactors f = capacityFactors(settings.headsets, settings.headset_share, true);
+    // One headset under a quota of `share` of the core per period is throttled as CFS does
+    // (runModel; docs/MODEL.md §13); N headsets on one server each get 1/N of its time and share
+    // the headset's core (sim/capacity.h capacityFactors).
+    const SideFactors f = capacityFactors(
+        settings.headsets, settings.headsets <= 1 ? 1.0 : settings.headset_share, true);
     const RuntimeCosts costs =
         f.headset != 1.0 || f.server != 1.0 ? calibrated.atSpeed(f.headset, f.server) : calibrated;
     if (auto r = runModel(trace, sd, fixed_e1, costs, settings, inputs)) {
@@ -469,11 +477,10 @@ RunPrediction predictRun(const RunOptions& plan, const HmdProfile& profile,
     if (plan.headset_share < 1.0 && measurement.share_group) {
         const auto t = measurement.share_group->throttling();
         rp.sim_note += fmt::format(
-            "{}the model ran the headset at {:.2f}x its calibrated times (--headset-share {:g}); "
-            "the quota throttled {} of {} periods: where few, a busy host gave the headset less "
-            "than its share anyway and the prediction is low (docs/MODEL.md §13)",
-            rp.sim_note.empty() ? "" : "; ", 1.0 / plan.headset_share, plan.headset_share,
-            t.throttled_periods, t.periods);
+            "{}the model throttled the headset as its quota does ({:g} of every {} ms, "
+            "--headset-share); the quota throttled {} of {} periods (docs/MODEL.md §13)",
+            rp.sim_note.empty() ? "" : "; ", plan.headset_share,
+            runtime::CpuShareGroup::kDefaultPeriodUs / 1000, t.throttled_periods, t.periods);
     }
     return rp;
 }

@@ -277,6 +277,7 @@ private:
 
     void makePolicy();
     void work(double ms);
+    double throttledEnd(double start, double run_ms);
     double serverWork(double start, double ms);
     double bitsPerPx(const WorkloadFrame& wf, double scale, bool outer) const;
     double drawn(int64_t j, const LayerPlan& plan, int eye, int kind, double rings_both_eyes,
@@ -325,6 +326,8 @@ private:
 
     // Headset core.
     double m_hs = 0.0;
+    int64_t m_quota_period = -1;  // the CFS period m_quota_used_ms was spent in
+    double m_quota_used_ms = 0.0;
     double m_busy = 0.0;  // busy time since the previous frame finished
     double m_last_e1_deg = 5.0;
     double m_last_complete_rx_ms = 0.0;
@@ -358,10 +361,13 @@ void PassReplay::makePolicy() {
     };
     if (m_liwc) {
         auto p = runtimeLiwc(false);
+        p->setHeadsetShare(m_config.headset_share);  // as the runtime reads its cgroup's
         m_link_aware = p.get();
         m_policy = std::move(p);
     } else if (m_sw_liwc) {
-        m_policy = runtimeLiwc(true);
+        auto p = runtimeLiwc(true);
+        p->setHeadsetShare(m_config.headset_share);
+        m_policy = std::move(p);
     } else if (m_sw) {
         m_policy = makeSoftwareReactivePolicy(m_header);
     } else if (m_traits.policy == "fixed") {
@@ -372,11 +378,44 @@ void PassReplay::makePolicy() {
 }
 
 void PassReplay::work(double ms) {
-    const double end = coRunEnd(m_hs, ms, m_server_spans, m_headset_slowdown);
+    double end = coRunEnd(m_hs, ms, m_server_spans, m_headset_slowdown);
+    if (m_config.headset_share < 1.0)
+        end = throttledEnd(m_hs, end - m_hs);
     if (m_log)
         logSpan(m_log->headset, m_hs, end);
     m_busy += end - m_hs;
     m_hs = end;
+}
+
+// CFS bandwidth control (the kernel's sched-bwc): the headset's group gets share × period of
+// CPU in each period and is throttled to the period's end once it has used that. Work that fits
+// in a period's budget runs at full speed; the headset's waits spend none.
+double PassReplay::throttledEnd(double start, double run_ms) {
+    const double period = std::max(m_config.quota_period_ms, 0.1);
+    const double budget = std::clamp(m_config.headset_share, 1e-3, 1.0) * period;
+    double t = start;
+    // The headset's clock never goes back: periods are counted from the one last spent in.
+    int64_t k = std::max(m_quota_period, static_cast<int64_t>(std::floor(t / period)));
+    while (t >= double(k + 1) * period)
+        ++k;
+    while (run_ms > 1e-12) {
+        if (k != m_quota_period) {
+            m_quota_period = k;
+            m_quota_used_ms = 0.0;
+        }
+        const double period_end = double(k + 1) * period;
+        const double run = std::min({run_ms, budget - m_quota_used_ms, period_end - t});
+        if (run > 0.0) {
+            t += run;
+            m_quota_used_ms += run;
+            run_ms -= run;
+        }
+        if (run_ms > 1e-12 && (m_quota_used_ms >= budget - 1e-12 || t >= period_end - 1e-12)) {
+            t = std::max(t, period_end);  // throttled, or the period ran out: the next one
+            ++k;
+        }
+    }
+    return t;
 }
 
 double PassReplay::serverWork(double start, double ms) {

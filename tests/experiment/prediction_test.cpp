@@ -3,6 +3,8 @@
 // hand-made workload with hand-made costs.
 #include "qvr/experiment/prediction.h"
 
+#include "qvr/runtime/cpu_share.h"
+
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -200,7 +202,7 @@ TEST(PredictDesign, ChargesTheLinksDelayAndTheProbesSpeed) {
     EXPECT_GT(fast.at_probe_speed->mtp_ms_mean, fast.calibrated->metrics.mtp_ms_mean);
 }
 
-TEST(PredictDesign, AHeadsetShareStretchesTheHeadsetsCostsOnly) {
+TEST(PredictDesign, AHeadsetShareRunsTheHeadsetUnderItsQuota) {
     const WorkloadTrace trace = flatTrace(60);
     const RuntimeCosts costs = flatCosts();
     ModelSettings settings;
@@ -210,13 +212,26 @@ TEST(PredictDesign, AHeadsetShareStretchesTheHeadsetsCostsOnly) {
     settings.headset_share = 0.5;
     const DesignPrediction half =
         predictDesign(trace, {"local", std::nullopt, {}, {}, {}}, costs, settings, std::nullopt);
-    // The same as the costs at half the headset's speed, set by hand.
+    ASSERT_TRUE(whole.calibrated && half.calibrated);
+    EXPECT_LT(half.calibrated->metrics.fps_mean, 0.6 * whole.calibrated->metrics.fps_mean);
+    // The runtime model with the runtime's quota: half of every CFS period.
+    RuntimeSimConfig rc;
+    rc.design = Design::Local;
+    rc.costs = costs;
+    rc.frames = 60;
+    rc.headset_share = 0.5;
+    rc.quota_period_ms = runtime::CpuShareGroup::kDefaultPeriodUs * 1e-3;
+    auto link = makeRuntimeLink("rate:100", nullptr);
+    const RuntimeSummary direct = simulateRuntime(trace, rc, **link).summary;
+    EXPECT_DOUBLE_EQ(half.calibrated->metrics.fps_mean, direct.fps_mean);
+    EXPECT_DOUBLE_EQ(half.calibrated->metrics.mtp_ms_mean, direct.mtp_ms_mean);
+    // Local never idles: within a period of a headset at half speed.
     settings.headset_share = 1.0;
     const DesignPrediction by_hand = predictDesign(trace, {"local", std::nullopt, {}, {}, {}},
                                                    costs.atSpeed(2.0, 1.0), settings, std::nullopt);
-    ASSERT_TRUE(whole.calibrated && half.calibrated && by_hand.calibrated);
-    EXPECT_LT(half.calibrated->metrics.fps_mean, 0.6 * whole.calibrated->metrics.fps_mean);
-    EXPECT_DOUBLE_EQ(half.calibrated->metrics.fps_mean, by_hand.calibrated->metrics.fps_mean);
+    ASSERT_TRUE(by_hand.calibrated);
+    EXPECT_NEAR(half.calibrated->metrics.mtp_ms_mean, by_hand.calibrated->metrics.mtp_ms_mean,
+                rc.quota_period_ms);
     RunOptions plan;
     plan.headset_share = 0.4;
     EXPECT_DOUBLE_EQ(modelSettings(plan).headset_share, 0.4);

@@ -585,6 +585,36 @@ TEST(RuntimeModel, QueuedScanOutLetsTheHeadsetRunAtItsOwnRate) {
         EXPECT_NEAR(fast.frames[k].pose_ms, fast.frames[k - 1].display_ms - kSlotMs, 1e-6);
 }
 
+RuntimeRunResult runUnderQuota(const RuntimeCosts& costs, double share, bool wait_for_vsync) {
+    const int frames = 60;
+    const WorkloadTrace trace = flatTrace(frames);
+    RuntimeSimConfig cfg;
+    cfg.design = Design::Local;
+    cfg.costs = costs;
+    cfg.frames = frames;
+    cfg.wait_for_vsync = wait_for_vsync;
+    cfg.headset_share = share;
+    cfg.quota_period_ms = 10.0;
+    NoisyLink link = fastLink();
+    return simulateRuntime(trace, cfg, link);
+}
+
+TEST(RuntimeModel, AQuotaThrottlesTheHeadsetOnlyOnceItsPeriodsBudgetIsSpent) {
+    // 65 ms of CPU a frame, never idle, half of every 10 ms period: 5 ms run, 5 ms throttled, so
+    // a frame every 130 ms (the same as a half-speed headset).
+    const RuntimeRunResult busy = runUnderQuota(flatCosts(30.0, 5.0, 0.0), 0.5, false);
+    EXPECT_NEAR(1000.0 / busy.summary.fps_mean, 130.0, 130.0 / 59.0);
+    // 3 ms a frame, shown at 90 Hz with the headset idle until its slot: no period holds more
+    // than 5 ms of work, so nothing is throttled and a frame still takes 3 ms (a half-speed
+    // headset would take 6).
+    const RuntimeRunResult light = runUnderQuota(flatCosts(1.0, 1.0, 0.0), 0.5, true);
+    EXPECT_NEAR(light.summary.fps_mean, 90.0, 1e-6);
+    EXPECT_NEAR(light.summary.mtp_ms_mean, 3.0, 1e-6);
+    // No quota: the same as before.
+    const RuntimeRunResult none = runUnderQuota(flatCosts(30.0, 5.0, 0.0), 1.0, false);
+    EXPECT_NEAR(none.summary.mtp_ms_mean, 65.0, 1e-6);
+}
+
 TEST(RuntimeModel, RecordingTheDisplayVideoCostsEveryFrameItsCopyAfterTheFrameIsQueued) {
     // Local at 65 ms a frame with the video's 3 ms copy after each frame is queued: a frame every
     // 68 ms, its MTP still 65 ms (the copy comes after UCA), and the next frame's busy time 68.

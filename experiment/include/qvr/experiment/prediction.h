@@ -102,8 +102,8 @@ struct ModelSettings {
     double remote_timeout_ms = 250.0;
     int warmup_frames = 0;
     bool record_scanout = false;
-    // The headset's CFS share of its core (--headset-share): its busy time stretches by 1 / share
-    // in wall time, so the model takes the headset's costs at that speed.
+    // The headset's CFS share of its core (--headset-share): the model throttles its headset as
+    // the quota does (RuntimeSimConfig::headset_share).
     double headset_share = 1.0;
     // Headsets on the one server (qvr run --headsets), all on the headset's core: the model runs
     // one of them with the capacity model's factors (sim/capacity.h capacityFactors).

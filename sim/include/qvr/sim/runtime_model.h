@@ -50,6 +50,11 @@ struct RuntimeSimConfig {
     // T_remote as the policies see it: to the last packet's arrival (the runtime's t_remote_ms),
     // or, when set, to the last stream decoded (t_remote_decoded_ms).
     bool t_remote_to_decode = false;
+    // The headset's CFS quota (qvr run --headset-share): in every quota_period_ms it runs at
+    // most headset_share of the period, at full speed, and waits for the next period once that
+    // is spent; idle time spends none of it. 1: no quota.
+    double headset_share = 1.0;
+    double quota_period_ms = 10.0;
     // The run records its display video (qvr run --video): every frame's headset also pays
     // costs.scanout_record_ms, after the frame is queued for its slot (in the next frame's busy
     // time, as the runtime's DisplaySink is called).
