@@ -445,8 +445,8 @@ Expected<bool> DesignRunner::runDesign(const DesignSpec& spec, size_t designs_re
             m_m.recorder->reserve(m_plan.frames);
             hc.display = m_m.recorder.get();
         }
-        // The qvr design probes its ring counts anyway; recording them costs it the write, and
-        // no other design pays the probe.
+        // The qvr design probes its ring counts anyway; they are written after its frames
+        // (HeadsetConfig::workload), and no other design pays the probe.
         workload_out.open(m_out / "workload.jsonl");
         if (workload_out) {
             writer = std::make_unique<WorkloadTraceWriter>(workload_out);
