@@ -87,7 +87,7 @@ double LiwcPolicy::localMs(double e1_deg) const {
         // Under a CFS quota the rest holds the throttling the current e1's work brought on:
         // the CPU a candidate costs more or less than the current e1 (its render, its
         // periphery's decode) moves the busy time by 1/s of it, s the quota's share.
-        const double extra = headsetCpuMs(e1_deg) - headsetCpuMs(m_e1_deg);
+        const double extra = render + decodeMs(e1_deg) - headsetCpuMs(m_e1_deg);
         return std::max(render, rest + render + (1.0 / m_headset_share - 1.0) * extra);
     }
     return std::max(0.0,

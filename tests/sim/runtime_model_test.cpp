@@ -87,7 +87,8 @@ double slots(double ms) {
 }
 
 RuntimeRunResult run(Design d, const RuntimeCosts& costs, int depth, int frames = 60,
-                     double wait_limit_ms = 250.0, bool wait_for_vsync = true) {
+                     double wait_limit_ms = 250.0, bool wait_for_vsync = true,
+                     double headset_share = 1.0) {
     const WorkloadTrace trace = flatTrace(frames);
     RuntimeSimConfig cfg;
     cfg.design = d;
@@ -96,6 +97,8 @@ RuntimeRunResult run(Design d, const RuntimeCosts& costs, int depth, int frames 
     cfg.frames = frames;
     cfg.wait_limit_ms = wait_limit_ms;
     cfg.wait_for_vsync = wait_for_vsync;
+    cfg.headset_share = headset_share;
+    cfg.quota_period_ms = 10.0;
     NoisyLink link = fastLink();
     return simulateRuntime(trace, cfg, link);
 }
@@ -585,33 +588,22 @@ TEST(RuntimeModel, QueuedScanOutLetsTheHeadsetRunAtItsOwnRate) {
         EXPECT_NEAR(fast.frames[k].pose_ms, fast.frames[k - 1].display_ms - kSlotMs, 1e-6);
 }
 
-RuntimeRunResult runUnderQuota(const RuntimeCosts& costs, double share, bool wait_for_vsync) {
-    const int frames = 60;
-    const WorkloadTrace trace = flatTrace(frames);
-    RuntimeSimConfig cfg;
-    cfg.design = Design::Local;
-    cfg.costs = costs;
-    cfg.frames = frames;
-    cfg.wait_for_vsync = wait_for_vsync;
-    cfg.headset_share = share;
-    cfg.quota_period_ms = 10.0;
-    NoisyLink link = fastLink();
-    return simulateRuntime(trace, cfg, link);
-}
-
 TEST(RuntimeModel, AQuotaThrottlesTheHeadsetOnlyOnceItsPeriodsBudgetIsSpent) {
     // 65 ms of CPU a frame, never idle, half of every 10 ms period: 5 ms run, 5 ms throttled, so
     // a frame every 130 ms (the same as a half-speed headset).
-    const RuntimeRunResult busy = runUnderQuota(flatCosts(30.0, 5.0, 0.0), 0.5, false);
+    const RuntimeRunResult busy =
+        run(Design::Local, flatCosts(30.0, 5.0, 0.0), 2, 60, 250.0, false, 0.5);
     EXPECT_NEAR(1000.0 / busy.summary.fps_mean, 130.0, 130.0 / 59.0);
     // 3 ms a frame, shown at 90 Hz with the headset idle until its slot: no period holds more
     // than 5 ms of work, so nothing is throttled and a frame still takes 3 ms (a half-speed
     // headset would take 6).
-    const RuntimeRunResult light = runUnderQuota(flatCosts(1.0, 1.0, 0.0), 0.5, true);
+    const RuntimeRunResult light =
+        run(Design::Local, flatCosts(1.0, 1.0, 0.0), 2, 60, 250.0, true, 0.5);
     EXPECT_NEAR(light.summary.fps_mean, 90.0, 1e-6);
     EXPECT_NEAR(light.summary.mtp_ms_mean, 3.0, 1e-6);
     // No quota: the same as before.
-    const RuntimeRunResult none = runUnderQuota(flatCosts(30.0, 5.0, 0.0), 1.0, false);
+    const RuntimeRunResult none =
+        run(Design::Local, flatCosts(30.0, 5.0, 0.0), 2, 60, 250.0, false);
     EXPECT_NEAR(none.summary.mtp_ms_mean, 65.0, 1e-6);
 }
 
