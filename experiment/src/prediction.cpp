@@ -151,6 +151,12 @@ DesignMetrics metricsOf(const RuntimeSummary& s, double server_factor = 1.0) {
             s.server_busy_ms_mean / server_factor};
 }
 
+// One headset's share is modelled as its CFS quota (RuntimeSimConfig::headset_share); several
+// headsets share the headset's core by the capacity model's speed factors (capacityFactors).
+bool shareIsAQuota(const ModelSettings& settings) {
+    return settings.headsets <= 1;
+}
+
 // One pass of the calibrated runtime model with `costs` on the run's link (none: the model
 // cannot make that link).
 std::optional<RuntimeRunResult> runModel(const WorkloadTrace& trace, Design design,
@@ -171,9 +177,7 @@ std::optional<RuntimeRunResult> runModel(const WorkloadTrace& trace, Design desi
     rc.frames = static_cast<int>(trace.frames.size());
     rc.warmup_frames = settings.warmup_frames;
     rc.record_scanout = settings.record_scanout;
-    // One headset under a quota runs as the kernel throttles it; several share the core by the
-    // capacity model's speed factors (predictDesign).
-    if (settings.headsets <= 1) {
+    if (shareIsAQuota(settings)) {
         rc.headset_share = settings.headset_share;
         rc.quota_period_ms = runtime::CpuShareGroup::kDefaultPeriodUs * 1e-3;
     }
@@ -196,11 +200,10 @@ DesignPrediction predictDesign(const WorkloadTrace& trace, const DesignModelInpu
     if (!simDesignOf(inputs.design, sd, fixed_e1))
         return p;
     p.speed = inputs.speed;
-    // One headset under a quota of `share` of the core per period is throttled as CFS does
-    // (runModel; docs/MODEL.md §13); N headsets on one server each get 1/N of its time and share
-    // the headset's core (sim/capacity.h capacityFactors).
+    // One headset's share is throttled in runModel as CFS does (docs/MODEL.md §13); N headsets
+    // on one server each get 1/N of its time and share the headset's core (capacityFactors).
     const SideFactors f = capacityFactors(
-        settings.headsets, settings.headsets <= 1 ? 1.0 : settings.headset_share, true);
+        settings.headsets, shareIsAQuota(settings) ? 1.0 : settings.headset_share, true);
     const RuntimeCosts costs =
         f.headset != 1.0 || f.server != 1.0 ? calibrated.atSpeed(f.headset, f.server) : calibrated;
     if (auto r = runModel(trace, sd, fixed_e1, costs, settings, inputs)) {
